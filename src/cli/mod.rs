@@ -1,0 +1,43 @@
+//! Command-line parsing and dispatch. Each command lives in its own file;
+//! `anyhow` is used only here, at the edge.
+
+mod info;
+
+use clap::{Parser, Subcommand};
+
+/// zoovr: exact volume rendering of unstructured and curvilinear zoo-cell grids.
+#[derive(Parser, Debug)]
+#[command(name = "zoovr", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print what a file holds: cells by kind, points, bounds, arrays, time
+    /// steps, topology and cell-quality counts.
+    Info(info::InfoArgs),
+}
+
+/// Parses the arguments, runs the command and returns the exit code.
+pub fn run() -> i32 {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return code;
+        }
+    };
+    let result = match cli.command {
+        Command::Info(args) => info::run(&args),
+    };
+    match result {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("zoovr: error: {e:#}");
+            1
+        }
+    }
+}

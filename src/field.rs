@@ -1,0 +1,422 @@
+//! Data arrays attached to a mesh and the scalar field a render uses.
+//!
+//! [`DataArray`] keeps the values as the file stored them (`f32` and `f64`
+//! without loss, integers widened to `i64`). [`select_field`] turns a
+//! `--field` request (or its absence: the default-field rule of DESIGN.md) into
+//! a [`ScalarField`]: one `f64` per point or per cell, with its range.
+
+use thiserror::Error;
+
+use crate::mesh::Mesh;
+
+/// The values of a data array.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ArrayData {
+    F32(Vec<f32>),
+    F64(Vec<f64>),
+    /// Any integer type, widened.
+    Int(Vec<i64>),
+}
+
+impl ArrayData {
+    /// Number of scalar values (tuples x components).
+    pub fn len(&self) -> usize {
+        match self {
+            ArrayData::F32(v) => v.len(),
+            ArrayData::F64(v) => v.len(),
+            ArrayData::Int(v) => v.len(),
+        }
+    }
+
+    /// Whether there are no values.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Value `i` as `f64`.
+    #[inline]
+    pub fn get(&self, i: usize) -> f64 {
+        match self {
+            ArrayData::F32(v) => v[i] as f64,
+            ArrayData::F64(v) => v[i],
+            ArrayData::Int(v) => v[i] as f64,
+        }
+    }
+
+    /// Whether the values are floating point.
+    pub fn is_float(&self) -> bool {
+        !matches!(self, ArrayData::Int(_))
+    }
+}
+
+/// Where an array lives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Association {
+    Point,
+    Cell,
+}
+
+impl Association {
+    /// `"point"` or `"cell"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Association::Point => "point",
+            Association::Cell => "cell",
+        }
+    }
+}
+
+/// A named array with `components` values per tuple.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DataArray {
+    /// Name, percent-decoded.
+    pub name: String,
+    /// Values per tuple (1 for scalars, 3 for vectors, 6 or 9 for tensors).
+    pub components: usize,
+    /// The values, tuple-major.
+    pub data: ArrayData,
+    /// The VTK type name of the stored values (`Float32`, `Int64`, ...).
+    pub vtk_type: String,
+}
+
+impl DataArray {
+    /// Number of tuples.
+    pub fn tuples(&self) -> usize {
+        self.data.len() / self.components.max(1)
+    }
+
+    /// Component `k` of tuple `i`.
+    #[inline]
+    pub fn component(&self, i: usize, k: usize) -> f64 {
+        self.data.get(i * self.components + k)
+    }
+
+    /// Euclidean norm of tuple `i`.
+    pub fn magnitude(&self, i: usize) -> f64 {
+        let mut s = 0.0;
+        for k in 0..self.components {
+            let v = self.component(i, k);
+            s += v * v;
+        }
+        s.sqrt()
+    }
+
+    /// Min and max over finite values of the component (or magnitude when
+    /// `component` is `None`); `None` when no value is finite.
+    pub fn range(&self, component: Option<usize>) -> Option<(f64, f64)> {
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for i in 0..self.tuples() {
+            let v = match component {
+                Some(k) => self.component(i, k),
+                None => self.magnitude(i),
+            };
+            if v.is_finite() {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        (lo <= hi).then_some((lo, hi))
+    }
+}
+
+/// The scalar field a render integrates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScalarField {
+    /// Display name, e.g. `Density` or `velocity:mag`.
+    pub name: String,
+    /// Point or cell values.
+    pub association: Association,
+    /// One value per point or per cell.
+    pub values: Vec<f64>,
+    /// Min and max of the finite values (`(0, 0)` when none).
+    pub range: (f64, f64),
+}
+
+/// Errors selecting a field.
+#[derive(Debug, Error, PartialEq)]
+pub enum FieldError {
+    #[error("no array named '{name}' (available: {available})")]
+    NotFound { name: String, available: String },
+    #[error("array '{name}' has {components} components; component {index} does not exist")]
+    BadComponent {
+        name: String,
+        components: usize,
+        index: usize,
+    },
+    #[error("bad field specification '{0}': expected NAME, point:NAME or cell:NAME, optionally with :mag, :x, :y, :z or :N")]
+    BadSpec(String),
+    #[error("array '{name}' has {got} tuples but the mesh has {want} {assoc}s")]
+    WrongLength {
+        name: String,
+        got: usize,
+        want: usize,
+        assoc: &'static str,
+    },
+}
+
+/// Which component of an array to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Component {
+    /// The single component of a scalar array, or the magnitude of a vector.
+    Auto,
+    Magnitude,
+    Index(usize),
+}
+
+/// A parsed `--field` value.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FieldSpec {
+    pub association: Option<Association>,
+    pub name: String,
+    pub component: Component,
+}
+
+impl FieldSpec {
+    /// Parses `NAME`, `point:NAME`, `cell:NAME`, each optionally followed by
+    /// `:mag`, `:x|:y|:z` or `:N`. Names may contain `:`; only a known suffix
+    /// and prefix are split off. Percent escapes in the name are decoded.
+    pub fn parse(s: &str) -> Result<FieldSpec, FieldError> {
+        let mut rest = s;
+        let mut association = None;
+        if let Some(r) = rest.strip_prefix("point:") {
+            association = Some(Association::Point);
+            rest = r;
+        } else if let Some(r) = rest.strip_prefix("cell:") {
+            association = Some(Association::Cell);
+            rest = r;
+        }
+        let mut component = Component::Auto;
+        if let Some((head, suffix)) = rest.rsplit_once(':') {
+            let c = match suffix {
+                "mag" | "magnitude" => Some(Component::Magnitude),
+                "x" | "X" => Some(Component::Index(0)),
+                "y" | "Y" => Some(Component::Index(1)),
+                "z" | "Z" => Some(Component::Index(2)),
+                n => n.parse::<usize>().ok().map(Component::Index),
+            };
+            if let Some(c) = c {
+                if !head.is_empty() {
+                    component = c;
+                    rest = head;
+                }
+            }
+        }
+        if rest.is_empty() {
+            return Err(FieldError::BadSpec(s.to_string()));
+        }
+        Ok(FieldSpec {
+            association,
+            name: percent_decode(rest),
+            component,
+        })
+    }
+}
+
+/// Decodes `%XX` escapes (as VTK legacy files write names with spaces).
+/// Malformed escapes are kept literally.
+pub fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' && i + 2 < b.len() {
+            let hex = std::str::from_utf8(&b[i + 1..i + 3]).ok();
+            if let Some(v) = hex.and_then(|h| u8::from_str_radix(h, 16).ok()) {
+                out.push(v);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+fn extract(arr: &DataArray, assoc: Association, component: Component) -> Result<ScalarField, FieldError> {
+    let n = arr.tuples();
+    let (values, name): (Vec<f64>, String) = match component {
+        Component::Index(k) if k >= arr.components => {
+            return Err(FieldError::BadComponent {
+                name: arr.name.clone(),
+                components: arr.components,
+                index: k,
+            })
+        }
+        Component::Index(k) if arr.components > 1 => {
+            ((0..n).map(|i| arr.component(i, k)).collect(), format!("{}:{k}", arr.name))
+        }
+        Component::Magnitude if arr.components > 1 => {
+            ((0..n).map(|i| arr.magnitude(i)).collect(), format!("{}:mag", arr.name))
+        }
+        Component::Auto if arr.components > 1 => {
+            ((0..n).map(|i| arr.magnitude(i)).collect(), format!("{}:mag", arr.name))
+        }
+        _ => ((0..n).map(|i| arr.component(i, 0)).collect(), arr.name.clone()),
+    };
+    let range = finite_range(&values);
+    Ok(ScalarField {
+        name,
+        association: assoc,
+        values,
+        range,
+    })
+}
+
+/// Min and max of the finite values, `(0, 0)` when there are none.
+pub fn finite_range(values: &[f64]) -> (f64, f64) {
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    for &v in values {
+        if v.is_finite() {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    if lo <= hi {
+        (lo, hi)
+    } else {
+        (0.0, 0.0)
+    }
+}
+
+/// Selects the scalar field: the named one, or by the default rule of
+/// DESIGN.md when `spec` is `None`. Returns `Ok(None)` when the mesh has no
+/// usable array (render the geometry with a constant scalar).
+pub fn select_field(mesh: &Mesh, spec: Option<&FieldSpec>) -> Result<Option<ScalarField>, FieldError> {
+    let field = match spec {
+        Some(spec) => Some(select_named(mesh, spec)?),
+        None => select_default(mesh)?,
+    };
+    if let Some(f) = &field {
+        let want = match f.association {
+            Association::Point => mesh.points.len(),
+            Association::Cell => mesh.cells.len(),
+        };
+        if f.values.len() != want {
+            return Err(FieldError::WrongLength {
+                name: f.name.clone(),
+                got: f.values.len(),
+                want,
+                assoc: f.association.as_str(),
+            });
+        }
+    }
+    Ok(field)
+}
+
+fn select_named(mesh: &Mesh, spec: &FieldSpec) -> Result<ScalarField, FieldError> {
+    let point = mesh.point_data.iter().find(|a| a.name == spec.name);
+    let cell = mesh.cell_data.iter().find(|a| a.name == spec.name);
+    let found = match spec.association {
+        Some(Association::Point) => point.map(|a| (a, Association::Point)),
+        Some(Association::Cell) => cell.map(|a| (a, Association::Cell)),
+        None => point
+            .map(|a| (a, Association::Point))
+            .or(cell.map(|a| (a, Association::Cell))),
+    };
+    match found {
+        Some((arr, assoc)) => extract(arr, assoc, spec.component),
+        None => {
+            let mut names: Vec<String> = mesh
+                .point_data
+                .iter()
+                .map(|a| format!("point:{}", a.name))
+                .chain(mesh.cell_data.iter().map(|a| format!("cell:{}", a.name)))
+                .collect();
+            if names.is_empty() {
+                names.push("none".into());
+            }
+            Err(FieldError::NotFound {
+                name: spec.name.clone(),
+                available: names.join(", "),
+            })
+        }
+    }
+}
+
+fn select_default(mesh: &Mesh) -> Result<Option<ScalarField>, FieldError> {
+    use Association::{Cell, Point};
+    let pd = &mesh.point_data;
+    let cd = &mesh.cell_data;
+    // (1) active point scalars with one component
+    if let Some(name) = &mesh.active_point_scalars {
+        if let Some(a) = pd.iter().find(|a| &a.name == name && a.components == 1) {
+            return extract(a, Point, Component::Auto).map(Some);
+        }
+    }
+    let rules: [(&Vec<DataArray>, Association, fn(&DataArray) -> bool); 4] = [
+        (pd, Point, |a| a.data.is_float() && a.components == 1),
+        (cd, Cell, |a| a.data.is_float() && a.components == 1),
+        (pd, Point, |a| a.data.is_float() && a.components > 1),
+        (cd, Cell, |a| a.data.is_float() && a.components > 1),
+    ];
+    for (arrays, assoc, pred) in rules {
+        if let Some(a) = arrays.iter().find(|a| pred(a)) {
+            return extract(a, assoc, Component::Auto).map(Some);
+        }
+    }
+    // (6) the first integer array, point before cell
+    if let Some(a) = pd.iter().find(|a| !a.data.is_float()) {
+        return extract(a, Point, Component::Auto).map(Some);
+    }
+    if let Some(a) = cd.iter().find(|a| !a.data.is_float()) {
+        return extract(a, Cell, Component::Auto).map(Some);
+    }
+    Ok(None)
+}
+
+/// Averages a cell field to points (`--cell-to-point`): each point gets the
+/// mean of the cells that use it; points used by no cell get 0.
+pub fn cell_to_point(mesh: &Mesh, field: &ScalarField) -> ScalarField {
+    if field.association == Association::Point {
+        return field.clone();
+    }
+    let mut sum = vec![0.0f64; mesh.points.len()];
+    let mut cnt = vec![0u32; mesh.points.len()];
+    for c in 0..mesh.cells.len() {
+        let v = field.values[c];
+        for &n in mesh.cells.nodes(c) {
+            sum[n as usize] += v;
+            cnt[n as usize] += 1;
+        }
+    }
+    let values: Vec<f64> = sum
+        .iter()
+        .zip(&cnt)
+        .map(|(s, &n)| if n > 0 { s / n as f64 } else { 0.0 })
+        .collect();
+    let range = finite_range(&values);
+    ScalarField {
+        name: field.name.clone(),
+        association: Association::Point,
+        values,
+        range,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_specs() {
+        let s = FieldSpec::parse("point:velocity:mag").unwrap();
+        assert_eq!(s.association, Some(Association::Point));
+        assert_eq!(s.name, "velocity");
+        assert_eq!(s.component, Component::Magnitude);
+        let s = FieldSpec::parse("Nodal%20Stress:2").unwrap();
+        assert_eq!(s.name, "Nodal Stress");
+        assert_eq!(s.component, Component::Index(2));
+        let s = FieldSpec::parse("a:b").unwrap();
+        assert_eq!(s.name, "a:b");
+        assert!(FieldSpec::parse("cell:").is_err());
+    }
+
+    #[test]
+    fn percent() {
+        assert_eq!(percent_decode("a%20b%2"), "a b%2");
+        assert_eq!(percent_decode("%"), "%");
+    }
+}

@@ -1,0 +1,1 @@
+//! wgpu compositor (issue 7).

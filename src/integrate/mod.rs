@@ -1,0 +1,1 @@
+//! Exact Williams-Max segment integrals and pre-integration tables (issue 3).

@@ -1,0 +1,151 @@
+//! Readers: every supported file format produces one [`Mesh`].
+//!
+//! [`read`] picks the reader from the extension, falling back to the file's
+//! first bytes, so callers never know which reader (or which library) read a
+//! file. Time collections (`.pvd`, `.series`) are read with [`read_series`],
+//! which lists the steps; each step is then read with [`read`].
+//!
+//! Hostile input: every reader checks counts against the bytes actually
+//! present before allocating, so a header that claims 10^12 points is refused
+//! with a [`IoError::Parse`] naming the file and the place.
+
+pub mod collection;
+pub mod error;
+pub mod legacy;
+pub mod plot3d;
+pub mod xml;
+
+use std::path::{Path, PathBuf};
+
+pub use error::{IoError, Location};
+
+use crate::mesh::Mesh;
+
+/// Options for [`read`].
+#[derive(Clone, Debug, Default)]
+pub struct ReadOptions {
+    /// PLOT3D solution (`--q FILE`) to attach to a PLOT3D grid.
+    pub q_file: Option<PathBuf>,
+}
+
+/// One time step of a collection.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimeStep {
+    /// Time value of the step.
+    pub time: f64,
+    /// File of the step (resolved relative to the collection file).
+    pub path: PathBuf,
+}
+
+/// The formats zoovr reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Legacy,
+    XmlUnstructured,
+    XmlStructured,
+    XmlRectilinear,
+    XmlImage,
+    XmlParallelUnstructured,
+    Pvd,
+    Series,
+    Plot3d,
+}
+
+/// Detects the format from the extension, then from the first bytes.
+pub fn detect_format(path: &Path) -> Result<Format, IoError> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    let by_ext = match ext.as_str() {
+        "vtk" => Some(Format::Legacy),
+        "vtu" => Some(Format::XmlUnstructured),
+        "vts" => Some(Format::XmlStructured),
+        "vtr" => Some(Format::XmlRectilinear),
+        "vti" => Some(Format::XmlImage),
+        "pvtu" => Some(Format::XmlParallelUnstructured),
+        "pvd" => Some(Format::Pvd),
+        "series" => Some(Format::Series),
+        "xyz" | "p3d" | "x" | "g" => Some(Format::Plot3d),
+        _ if name.ends_with(".vtu.series") || name.ends_with(".vtk.series") => Some(Format::Series),
+        _ if name.contains("xyz") && ext == "bin" => Some(Format::Plot3d),
+        _ => None,
+    };
+    if let Some(f) = by_ext {
+        return Ok(f);
+    }
+    sniff(path)
+}
+
+fn sniff(path: &Path) -> Result<Format, IoError> {
+    use std::io::Read;
+    let mut head = [0u8; 512];
+    let mut f = std::fs::File::open(path).map_err(|e| IoError::open(path, e))?;
+    let n = f.read(&mut head).map_err(|e| IoError::open(path, e))?;
+    let text = String::from_utf8_lossy(&head[..n]);
+    if text.starts_with("# vtk DataFile") {
+        return Ok(Format::Legacy);
+    }
+    for (tag, fmt) in [
+        ("\"UnstructuredGrid\"", Format::XmlUnstructured),
+        ("\"StructuredGrid\"", Format::XmlStructured),
+        ("\"RectilinearGrid\"", Format::XmlRectilinear),
+        ("\"ImageData\"", Format::XmlImage),
+        ("\"PUnstructuredGrid\"", Format::XmlParallelUnstructured),
+        ("\"Collection\"", Format::Pvd),
+    ] {
+        if text.contains("<VTKFile") && text.contains(tag) {
+            return Ok(fmt);
+        }
+    }
+    if text.trim_start().starts_with('{') && text.contains("\"files\"") {
+        return Ok(Format::Series);
+    }
+    if plot3d::looks_like_grid(&head[..n]) {
+        return Ok(Format::Plot3d);
+    }
+    Err(IoError::UnknownFormat {
+        path: path.to_path_buf(),
+    })
+}
+
+/// Reads one dataset (not a collection: see [`read_series`]).
+pub fn read(path: &Path, opts: &ReadOptions) -> Result<Mesh, IoError> {
+    let format = detect_format(path)?;
+    match format {
+        Format::Legacy => legacy::read(path),
+        Format::XmlUnstructured
+        | Format::XmlStructured
+        | Format::XmlRectilinear
+        | Format::XmlImage
+        | Format::XmlParallelUnstructured => xml::read(path, format),
+        Format::Plot3d => plot3d::read(path, opts.q_file.as_deref()),
+        Format::Pvd | Format::Series => {
+            // A collection given where one dataset is expected: its first step.
+            let steps = read_series(path)?;
+            let first = steps.first().ok_or_else(|| IoError::Parse {
+                path: path.to_path_buf(),
+                location: Location::None,
+                msg: "the collection lists no time steps".into(),
+            })?;
+            read(&first.path, opts)
+        }
+    }
+}
+
+/// Lists the steps of a time collection (`.pvd`, `.series`); a plain dataset
+/// is one step at time 0.
+pub fn read_series(path: &Path) -> Result<Vec<TimeStep>, IoError> {
+    match detect_format(path)? {
+        Format::Pvd => collection::read_pvd(path),
+        Format::Series => collection::read_series_json(path),
+        _ => Ok(vec![TimeStep {
+            time: 0.0,
+            path: path.to_path_buf(),
+        }]),
+    }
+}

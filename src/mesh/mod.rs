@@ -1,0 +1,170 @@
+//! The mesh model: points, 3D cells and the data arrays attached to them.
+//!
+//! Readers in [`crate::io`] produce one [`Mesh`]. Points are `f64` (the
+//! readers convert `f32` coordinates exactly); cells are stored in a compact
+//! CSR layout ([`Cells`]): one kind byte, an offset and the corner node ids.
+//! Only 3D cells are kept; 0D-2D cells are dropped by the readers and counted
+//! in [`SourceInfo::ignored_cells`], and cell arrays are filtered to match.
+//!
+//! Topology (unique faces, adjacency) lives in [`topology`]; consistent
+//! tetrahedralisation in [`tetra`].
+
+pub mod cell;
+pub mod tetra;
+pub mod topology;
+
+use std::collections::BTreeMap;
+
+use glam::DVec3;
+
+pub use cell::CellKind;
+
+use crate::field::DataArray;
+
+/// Sentinel for "no cell" / "no face".
+pub const NONE: u32 = u32::MAX;
+
+/// The 3D cells of a mesh in CSR layout.
+#[derive(Clone, Debug, Default)]
+pub struct Cells {
+    /// Kind of each cell.
+    pub kinds: Vec<CellKind>,
+    /// `offsets[c]..offsets[c + 1]` indexes `conn` for cell `c`; `len = n + 1`.
+    pub offsets: Vec<u32>,
+    /// Corner node ids (point indices) in the kind's VTK node order.
+    pub conn: Vec<u32>,
+    /// Faces of [`CellKind::Polyhedron`] cells: cell id -> faces, each face a
+    /// list of point ids ordered so the right-hand normal points outward.
+    pub poly_faces: BTreeMap<u32, Vec<Vec<u32>>>,
+}
+
+impl Cells {
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.kinds.len()
+    }
+
+    /// Whether there are no cells.
+    pub fn is_empty(&self) -> bool {
+        self.kinds.is_empty()
+    }
+
+    /// Corner node ids of cell `c`.
+    #[inline]
+    pub fn nodes(&self, c: usize) -> &[u32] {
+        &self.conn[self.offsets[c] as usize..self.offsets[c + 1] as usize]
+    }
+
+    /// Appends a cell (node ids in the kind's order).
+    pub fn push(&mut self, kind: CellKind, nodes: &[u32]) {
+        if self.offsets.is_empty() {
+            self.offsets.push(0);
+        }
+        self.kinds.push(kind);
+        self.conn.extend_from_slice(nodes);
+        self.offsets.push(self.conn.len() as u32);
+    }
+
+    /// Appends a general polyhedron given by its faces (point ids); its node
+    /// list is the sorted set of the faces' point ids.
+    pub fn push_polyhedron(&mut self, faces: Vec<Vec<u32>>) {
+        let mut nodes: Vec<u32> = faces.iter().flatten().copied().collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        let id = self.len() as u32;
+        self.push(CellKind::Polyhedron, &nodes);
+        self.poly_faces.insert(id, faces);
+    }
+
+    /// Calls `f` with each face of cell `c` as a list of point ids, in the
+    /// cell's local face order.
+    pub fn for_each_face(&self, c: usize, mut f: impl FnMut(usize, &[u32])) {
+        let kind = self.kinds[c];
+        if kind == CellKind::Polyhedron {
+            if let Some(faces) = self.poly_faces.get(&(c as u32)) {
+                for (i, face) in faces.iter().enumerate() {
+                    f(i, face);
+                }
+            }
+            return;
+        }
+        let nodes = self.nodes(c);
+        let mut buf = [0u32; 6];
+        for (i, lf) in kind.faces().iter().enumerate() {
+            for (k, &ln) in lf.iter().enumerate() {
+                buf[k] = nodes[ln as usize];
+            }
+            f(i, &buf[..lf.len()]);
+        }
+    }
+
+    /// Number of faces of cell `c`.
+    pub fn face_count(&self, c: usize) -> usize {
+        match self.kinds[c] {
+            CellKind::Polyhedron => self.poly_faces.get(&(c as u32)).map_or(0, |f| f.len()),
+            k => k.faces().len(),
+        }
+    }
+}
+
+/// Facts about the source file that the mesh model itself does not keep.
+#[derive(Clone, Debug, Default)]
+pub struct SourceInfo {
+    /// Counts of the 3D cells by their VTK type name as written in the file
+    /// (e.g. `quadratic_tetra`, `voxel`), see [`cell::vtk_type_name`].
+    pub cells_by_type: BTreeMap<String, usize>,
+    /// 0D-2D cells in the file, which zoovr ignores.
+    pub ignored_cells: usize,
+    /// Human-readable notes about repairs the reader made.
+    pub notes: Vec<String>,
+}
+
+/// One dataset: points, 3D cells and attached arrays.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Point coordinates.
+    pub points: Vec<DVec3>,
+    /// The 3D cells.
+    pub cells: Cells,
+    /// Point data arrays (one tuple per point).
+    pub point_data: Vec<DataArray>,
+    /// Cell data arrays (one tuple per kept 3D cell).
+    pub cell_data: Vec<DataArray>,
+    /// Name of the active point scalars, when the file marks one.
+    pub active_point_scalars: Option<String>,
+    /// Name of the active cell scalars, when the file marks one.
+    pub active_cell_scalars: Option<String>,
+    /// What the reader saw.
+    pub source: SourceInfo,
+}
+
+impl Mesh {
+    /// Axis-aligned bounds `[xmin, xmax, ymin, ymax, zmin, zmax]` of the points
+    /// used by cells (all points when there are no cells).
+    pub fn bounds(&self) -> [f64; 6] {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        if self.cells.is_empty() {
+            for p in &self.points {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+            }
+        } else {
+            for &n in &self.cells.conn {
+                let p = self.points[n as usize];
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        if lo.x > hi.x {
+            return [0.0; 6];
+        }
+        [lo.x, hi.x, lo.y, hi.y, lo.z, hi.z]
+    }
+
+    /// Length of the bounds diagonal.
+    pub fn diagonal(&self) -> f64 {
+        let b = self.bounds();
+        DVec3::new(b[1] - b[0], b[3] - b[2], b[5] - b[4]).length()
+    }
+}

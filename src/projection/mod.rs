@@ -1,0 +1,1 @@
+//! Winged-edge projection of convex cells into regions (issue 6).

@@ -1,0 +1,1 @@
+//! The reference software ray caster (issue 4).

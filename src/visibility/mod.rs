@@ -1,0 +1,1 @@
+//! Exact back-to-front visibility order of drawable pieces (issue 5).
