@@ -94,7 +94,11 @@ impl Camera {
             0.5 * (bounds[2] + bounds[3]),
             0.5 * (bounds[4] + bounds[5]),
         );
-        let diag = DVec3::new(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4]);
+        let diag = DVec3::new(
+            bounds[1] - bounds[0],
+            bounds[3] - bounds[2],
+            bounds[5] - bounds[4],
+        );
         let mut radius = 0.5 * diag.length();
         if !(radius > 0.0) || !radius.is_finite() {
             radius = 0.5;
@@ -125,7 +129,11 @@ impl Camera {
         let right = forward.cross(up).normalize();
         let up = right.cross(forward).normalize();
 
-        let zoom = if p.zoom > 0.0 && p.zoom.is_finite() { p.zoom } else { 1.0 };
+        let zoom = if p.zoom > 0.0 && p.zoom.is_finite() {
+            p.zoom
+        } else {
+            1.0
+        };
         Camera {
             position,
             focal_point: focal,

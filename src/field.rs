@@ -234,7 +234,11 @@ pub fn percent_decode(s: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-fn extract(arr: &DataArray, assoc: Association, component: Component) -> Result<ScalarField, FieldError> {
+fn extract(
+    arr: &DataArray,
+    assoc: Association,
+    component: Component,
+) -> Result<ScalarField, FieldError> {
     let n = arr.tuples();
     let (values, name): (Vec<f64>, String) = match component {
         Component::Index(k) if k >= arr.components => {
@@ -244,16 +248,22 @@ fn extract(arr: &DataArray, assoc: Association, component: Component) -> Result<
                 index: k,
             })
         }
-        Component::Index(k) if arr.components > 1 => {
-            ((0..n).map(|i| arr.component(i, k)).collect(), format!("{}:{k}", arr.name))
-        }
-        Component::Magnitude if arr.components > 1 => {
-            ((0..n).map(|i| arr.magnitude(i)).collect(), format!("{}:mag", arr.name))
-        }
-        Component::Auto if arr.components > 1 => {
-            ((0..n).map(|i| arr.magnitude(i)).collect(), format!("{}:mag", arr.name))
-        }
-        _ => ((0..n).map(|i| arr.component(i, 0)).collect(), arr.name.clone()),
+        Component::Index(k) if arr.components > 1 => (
+            (0..n).map(|i| arr.component(i, k)).collect(),
+            format!("{}:{k}", arr.name),
+        ),
+        Component::Magnitude if arr.components > 1 => (
+            (0..n).map(|i| arr.magnitude(i)).collect(),
+            format!("{}:mag", arr.name),
+        ),
+        Component::Auto if arr.components > 1 => (
+            (0..n).map(|i| arr.magnitude(i)).collect(),
+            format!("{}:mag", arr.name),
+        ),
+        _ => (
+            (0..n).map(|i| arr.component(i, 0)).collect(),
+            arr.name.clone(),
+        ),
     };
     let range = finite_range(&values);
     Ok(ScalarField {
@@ -284,7 +294,10 @@ pub fn finite_range(values: &[f64]) -> (f64, f64) {
 /// Selects the scalar field: the named one, or by the default rule of
 /// DESIGN.md when `spec` is `None`. Returns `Ok(None)` when the mesh has no
 /// usable array (render the geometry with a constant scalar).
-pub fn select_field(mesh: &Mesh, spec: Option<&FieldSpec>) -> Result<Option<ScalarField>, FieldError> {
+pub fn select_field(
+    mesh: &Mesh,
+    spec: Option<&FieldSpec>,
+) -> Result<Option<ScalarField>, FieldError> {
     let field = match spec {
         Some(spec) => Some(select_named(mesh, spec)?),
         None => select_default(mesh)?,

@@ -77,7 +77,11 @@ impl Image {
             let a = p[3].clamp(0.0, 1.0);
             if alpha {
                 for k in 0..3 {
-                    out.push(if a > 0.0 { (p[k] / a).clamp(0.0, 1.0) } else { 0.0 });
+                    out.push(if a > 0.0 {
+                        (p[k] / a).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    });
                 }
                 out.push(a);
             } else {
@@ -98,7 +102,12 @@ impl Image {
     }
 
     /// Writes an 8-bit PNG (atomically: temp file + rename).
-    pub fn write_png(&self, path: &Path, background: [f32; 3], alpha: bool) -> Result<(), ImageError> {
+    pub fn write_png(
+        &self,
+        path: &Path,
+        background: [f32; 3],
+        alpha: bool,
+    ) -> Result<(), ImageError> {
         let bytes = self.to_png_bytes(background, alpha);
         let ct = if alpha {
             image::ExtendedColorType::Rgba8
@@ -106,8 +115,15 @@ impl Image {
             image::ExtendedColorType::Rgb8
         };
         write_atomic(path, |tmp| {
-            image::save_buffer_with_format(tmp, &bytes, self.width, self.height, ct, image::ImageFormat::Png)
-                .map_err(|e| e.to_string())
+            image::save_buffer_with_format(
+                tmp,
+                &bytes,
+                self.width,
+                self.height,
+                ct,
+                image::ImageFormat::Png,
+            )
+            .map_err(|e| e.to_string())
         })
     }
 
@@ -133,7 +149,10 @@ impl Image {
         let img = image::open(path).map_err(|e| err(e.to_string()))?;
         let rgba = img.to_rgba32f();
         let (w, h) = rgba.dimensions();
-        let is_float = matches!(img, image::DynamicImage::ImageRgba32F(_) | image::DynamicImage::ImageRgb32F(_));
+        let is_float = matches!(
+            img,
+            image::DynamicImage::ImageRgba32F(_) | image::DynamicImage::ImageRgb32F(_)
+        );
         let pixels = rgba
             .pixels()
             .map(|p| {
@@ -153,10 +172,22 @@ impl Image {
     }
 }
 
-fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), ImageError> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let ext = path.extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
+fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), ImageError> {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let tmp = dir.join(format!(".{name}.{}.tmp.{ext}", std::process::id()));
     if let Err(msg) = write(&tmp) {
         let _ = std::fs::remove_file(&tmp);
@@ -196,7 +227,11 @@ pub struct ImageDiff {
 
 /// Compares display values (`background`, RGB, as PNG values in [0, 1]
 /// before quantisation) of two images.
-pub fn compare_display(a: &Image, b: &Image, background: [f32; 3]) -> Result<(ImageDiff, Image), ImageError> {
+pub fn compare_display(
+    a: &Image,
+    b: &Image,
+    background: [f32; 3],
+) -> Result<(ImageDiff, Image), ImageError> {
     if (a.width, a.height) != (b.width, b.height) {
         return Err(ImageError::SizeMismatch {
             a: (a.width, a.height),
@@ -276,7 +311,13 @@ pub fn test_output_dir() -> PathBuf {
 /// fails (with a message) when `max_abs` or `rms` exceed the bounds; on
 /// failure writes `NAME.actual.png`, `NAME.expected.png` and `NAME.diff.png`
 /// (difference scaled x10) under [`test_output_dir`]. Returns the statistics.
-pub fn check_images(name: &str, actual: &Image, expected: &Image, max_abs: f64, rms: f64) -> Result<ImageDiff, String> {
+pub fn check_images(
+    name: &str,
+    actual: &Image,
+    expected: &Image,
+    max_abs: f64,
+    rms: f64,
+) -> Result<ImageDiff, String> {
     let (d, diff) = compare_display(actual, expected, [0.0; 3]).map_err(|e| e.to_string())?;
     let bad_nan = actual.count_non_finite() > 0;
     if d.max_abs <= max_abs && d.rms <= rms && !bad_nan {
@@ -340,6 +381,8 @@ mod tests {
         img.write_png(&png, [0.0; 3], false).unwrap();
         let back = Image::read(&png).unwrap();
         assert!((back.get(2, 1)[1] - 0.4).abs() < 1.0 / 255.0);
-        assert!(img.write_png(Path::new("/nonexistent/dir/x.png"), [0.0; 3], false).is_err());
+        assert!(img
+            .write_png(Path::new("/nonexistent/dir/x.png"), [0.0; 3], false)
+            .is_err());
     }
 }

@@ -15,5 +15,7 @@ pub mod mesh;
 pub mod numeric;
 pub mod projection;
 pub mod raycast;
+#[doc(hidden)]
+pub mod testdata;
 pub mod tf;
 pub mod visibility;

@@ -41,7 +41,10 @@ fn arrays_json(mesh: &Mesh) -> Vec<Value> {
     for (assoc, arrays) in [("point", &mesh.point_data), ("cell", &mesh.cell_data)] {
         for a in arrays {
             let comp = if a.components == 1 { Some(0) } else { None };
-            let range = a.range(comp).map(|(lo, hi)| json!([lo, hi])).unwrap_or(Value::Null);
+            let range = a
+                .range(comp)
+                .map(|(lo, hi)| json!([lo, hi]))
+                .unwrap_or(Value::Null);
             out.push(json!({
                 "name": a.name,
                 "association": assoc,

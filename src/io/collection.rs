@@ -6,10 +6,18 @@ use super::{IoError, TimeStep};
 
 /// Reads a `.pvd` collection.
 pub fn read_pvd(path: &Path) -> Result<Vec<TimeStep>, IoError> {
-    Err(IoError::parse(path, super::Location::None, "pvd reader pending"))
+    Err(IoError::parse(
+        path,
+        super::Location::None,
+        "pvd reader pending",
+    ))
 }
 
 /// Reads a `.series` JSON collection.
 pub fn read_series_json(path: &Path) -> Result<Vec<TimeStep>, IoError> {
-    Err(IoError::parse(path, super::Location::None, "series reader pending"))
+    Err(IoError::parse(
+        path,
+        super::Location::None,
+        "series reader pending",
+    ))
 }

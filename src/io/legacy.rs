@@ -7,5 +7,9 @@ use crate::mesh::Mesh;
 
 /// Reads a legacy `.vtk` file.
 pub fn read(path: &Path) -> Result<Mesh, IoError> {
-    Err(IoError::parse(path, super::Location::None, "legacy reader pending"))
+    Err(IoError::parse(
+        path,
+        super::Location::None,
+        "legacy reader pending",
+    ))
 }

@@ -12,5 +12,9 @@ pub fn looks_like_grid(_head: &[u8]) -> bool {
 
 /// Reads a PLOT3D grid (and optional Q solution).
 pub fn read(path: &Path, _q: Option<&Path>) -> Result<Mesh, IoError> {
-    Err(IoError::parse(path, super::Location::None, "plot3d reader pending"))
+    Err(IoError::parse(
+        path,
+        super::Location::None,
+        "plot3d reader pending",
+    ))
 }

@@ -7,5 +7,9 @@ use crate::mesh::Mesh;
 
 /// Reads a VTK XML dataset.
 pub fn read(path: &Path, _format: Format) -> Result<Mesh, IoError> {
-    Err(IoError::parse(path, super::Location::None, "xml reader pending"))
+    Err(IoError::parse(
+        path,
+        super::Location::None,
+        "xml reader pending",
+    ))
 }

@@ -64,7 +64,10 @@ impl Topology {
             cells.for_each_face(c, |local, verts| {
                 let key = face_key(verts);
                 let id = match map.get(&key) {
-                    Some(&f) if t.face_cells[f as usize][1] == NONE && t.face_cells[f as usize][0] != c as u32 => {
+                    Some(&f)
+                        if t.face_cells[f as usize][1] == NONE
+                            && t.face_cells[f as usize][0] != c as u32 =>
+                    {
                         t.face_cells[f as usize][1] = c as u32;
                         t.face_local[f as usize][1] = local as u8;
                         f

@@ -45,10 +45,26 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Side {
     // robust::orient3d is positive when d lies *below* the plane (the side
     // opposite the right-hand normal of a, b, c).
     let v = robust::orient3d(
-        robust::Coord3D { x: a.x, y: a.y, z: a.z },
-        robust::Coord3D { x: b.x, y: b.y, z: b.z },
-        robust::Coord3D { x: c.x, y: c.y, z: c.z },
-        robust::Coord3D { x: d.x, y: d.y, z: d.z },
+        robust::Coord3D {
+            x: a.x,
+            y: a.y,
+            z: a.z,
+        },
+        robust::Coord3D {
+            x: b.x,
+            y: b.y,
+            z: b.z,
+        },
+        robust::Coord3D {
+            x: c.x,
+            y: c.y,
+            z: c.z,
+        },
+        robust::Coord3D {
+            x: d.x,
+            y: d.y,
+            z: d.z,
+        },
     );
     Side::of(-v)
 }
@@ -68,6 +84,14 @@ mod tests {
         assert_eq!(orient3d(z, DVec3::X, DVec3::Y, -DVec3::Z), Side::Negative);
         // Exact: a point on the plane up to the last bit.
         let a = DVec3::new(0.1, 0.2, 0.3);
-        assert_eq!(orient3d(a, a + DVec3::X, a + DVec3::Y, a + DVec3::new(0.5, 0.25, 0.0)), Side::On);
+        assert_eq!(
+            orient3d(
+                a,
+                a + DVec3::X,
+                a + DVec3::Y,
+                a + DVec3::new(0.5, 0.25, 0.0)
+            ),
+            Side::On
+        );
     }
 }
