@@ -156,14 +156,18 @@ impl Layout {
 }
 
 /// Finds the layout (framing, precision, IBLANK) whose size fits the file
-/// with the least trailing padding. A grid has one record after the header
-/// (coordinates and IBLANK); a q file two (the four conditions, the data).
-fn detect(b: &[u8], q: bool) -> Option<Layout> {
+/// with the least trailing padding (`want`: dimensions the header must
+/// give). A grid has one record after the header (coordinates and IBLANK);
+/// a q file two (the four conditions, the data).
+fn detect(b: &[u8], q: bool, want: Option<[usize; 3]>) -> Option<Layout> {
     let mut best: Option<Layout> = None;
     for framing in Framing::ALL {
         let Some((dims, off)) = framing.header(b) else {
             continue;
         };
+        if want.is_some_and(|w| w != dims) {
+            continue;
+        }
         let Some(n) = dims[0].checked_mul(dims[1]).and_then(|x| x.checked_mul(dims[2])) else {
             continue;
         };
@@ -227,13 +231,54 @@ fn detect(b: &[u8], q: bool) -> Option<Layout> {
                     data,
                     padding,
                 };
-                if best.is_none_or(|x| padding < x.padding) {
+                // A 3D reading beats one with a dimension of 1 (which could be
+                // an `nblocks = 1` prefix misread), then the least padding wins.
+                let key = |l: &Layout| (l.dims.contains(&1), l.padding);
+                if best.is_none_or(|x| key(&cand) < key(&x)) {
                     best = Some(cand);
                 }
             }
         }
     }
     best
+}
+
+/// Explains why no layout fits: for the first framing whose header reads as
+/// dimensions, where the data should start and how many bytes it needs.
+fn diagnose(path: &Path, b: &[u8], q: bool) -> IoError {
+    let kind = if q { "q solution" } else { "grid" };
+    for framing in Framing::ALL {
+        let Some((d, off)) = framing.header(b) else {
+            continue;
+        };
+        let n = d[0] as u128 * d[1] as u128 * d[2] as u128;
+        let min = if q { 5 * 4 * n + 16 } else { 3 * 4 * n };
+        let order = if framing.big_endian { "big" } else { "little" };
+        let marks = if framing.markers { "with" } else { "without" };
+        return IoError::parse(
+            path,
+            Location::Byte(off as u64),
+            format!(
+                "PLOT3D {kind} header says {}x{}x{} points ({order}-endian, {marks} record markers), \
+                 but no precision/IBLANK layout fits: the data needs at least {min} bytes \
+                 (with matching record markers), {} remain",
+                d[0],
+                d[1],
+                d[2],
+                b.len() - off
+            ),
+        );
+    }
+    IoError::parse(
+        path,
+        Location::Byte(0),
+        format!(
+            "not a single-grid 3D whole-format PLOT3D {kind}: the first bytes hold no plausible \
+             dimensions (1..=2^24 each) in either byte order, with or without record markers \
+             ({} bytes in the file)",
+            b.len()
+        ),
+    )
 }
 
 /// Whether the first bytes look like a PLOT3D grid header (used by format
@@ -284,16 +329,7 @@ pub fn read(path: &Path, q: Option<&Path>) -> Result<Mesh, IoError> {
 /// Reads a PLOT3D grid (and optional q solution: its path and bytes) from
 /// memory; paths only name the files in errors.
 pub fn read_bytes(path: &Path, grid: &[u8], q: Option<(&Path, &[u8])>) -> Result<Mesh, IoError> {
-    let lay = detect(grid, false).ok_or_else(|| {
-        IoError::parse(
-            path,
-            Location::Byte(0),
-            format!(
-                "not a single-grid 3D whole-format PLOT3D grid: no header framing, precision and IBLANK option fits the {} bytes of the file",
-                grid.len()
-            ),
-        )
-    })?;
+    let lay = detect(grid, false, None).ok_or_else(|| diagnose(path, grid, false))?;
     let n = lay.points();
     let rs = lay.real_size();
     let mut points = Vec::with_capacity(n);
@@ -370,16 +406,13 @@ fn drop_blanked(mesh: &mut Mesh, flags: &[i64]) {
 
 /// Reads a q file and attaches its arrays.
 fn attach_q(mesh: &mut Mesh, dims: [usize; 3], path: &Path, b: &[u8]) -> Result<(), IoError> {
-    let lay = detect(b, true).ok_or_else(|| {
-        IoError::parse(
-            path,
-            Location::Byte(0),
-            format!(
-                "not a single-grid 3D PLOT3D q file: no layout fits its {} bytes",
-                b.len()
-            ),
-        )
-    })?;
+    let lay = match detect(b, true, Some(dims)) {
+        Some(l) => l,
+        None => match detect(b, true, None) {
+            Some(other) => other,
+            None => return Err(diagnose(path, b, true)),
+        },
+    };
     if lay.dims != dims {
         return Err(IoError::parse(
             path,

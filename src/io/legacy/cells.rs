@@ -250,7 +250,7 @@ pub(crate) fn convert(
         ));
     }
     if u32::try_from(arr.ids.len()).is_err() {
-        return Err(cur.err_at(Location::None, "more than 2^32 cell node ids"));
+        return Err(cur.err_at(cur.loc_here(), "more than 2^32 cell node ids"));
     }
     let mut out = Converted {
         cells: Cells::default(),

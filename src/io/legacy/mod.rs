@@ -78,6 +78,18 @@ enum Dataset {
     PolyData,
 }
 
+impl Dataset {
+    fn name(self) -> &'static str {
+        match self {
+            Dataset::Unstructured => "UNSTRUCTURED_GRID",
+            Dataset::Structured => "STRUCTURED_GRID",
+            Dataset::Rectilinear => "RECTILINEAR_GRID",
+            Dataset::Image => "STRUCTURED_POINTS",
+            Dataset::PolyData => "POLYDATA",
+        }
+    }
+}
+
 /// Parses the four header items and returns the dataset type.
 fn header(cur: &mut Cursor<'_>) -> Result<Dataset, IoError> {
     let first = cur.line_rest();
@@ -260,8 +272,9 @@ impl Reader {
                 }
                 _ => {
                     return Err(cur.err(format!(
-                        "unexpected keyword '{}' in a {ds:?} dataset",
-                        tokens::show(tok)
+                        "unexpected keyword '{}' in a {} dataset",
+                        tokens::show(tok),
+                        ds.name()
                     )))
                 }
             }
