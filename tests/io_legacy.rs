@@ -87,7 +87,11 @@ fn disk_out_ref_legacy51_offsets_connectivity() {
     };
     assert_eq!(m.points.len(), 8_499);
     assert_eq!(by_type(&m), [("hexahedron", 7_472)]);
-    assert!(close(arr(&m.point_data, "Temp").range(Some(0)).unwrap(), (293.0, 913.0), 0.5));
+    assert!(close(
+        arr(&m.point_data, "Temp").range(Some(0)).unwrap(),
+        (293.0, 913.0),
+        0.5
+    ));
     assert_eq!(arr(&m.cell_data, "ObjectId").tuples(), 7_472);
 }
 
@@ -99,7 +103,11 @@ fn notch_quadratic_cells_labelled_linear() {
     assert_eq!(m.points.len(), 12_717);
     assert_eq!(by_type(&m), [("hexahedron", 2_188), ("wedge", 4)]);
     // Only corners are kept.
-    assert!(m.cells.offsets.windows(2).all(|w| w[1] - w[0] == 8 || w[1] - w[0] == 6));
+    assert!(m
+        .cells
+        .offsets
+        .windows(2)
+        .all(|w| w[1] - w[0] == 8 || w[1] - w[0] == 6));
     assert_eq!(m.active_point_scalars.as_deref(), Some("Nodal Stress-0"));
     assert_eq!(arr(&m.point_data, "Nodal Stress").components, 6);
     arr(&m.point_data, "Nodal Stress-normed");
@@ -112,7 +120,7 @@ fn angular_sector_ascii_30() {
     };
     assert_eq!(m.points.len(), 10_141);
     assert_eq!(by_type(&m), [("hexahedron", 7_632), ("pyramid", 144)]);
-    assert_eq!(arr(&m.point_data, "PointId").data.is_float(), false);
+    assert!(!arr(&m.point_data, "PointId").data.is_float());
     assert_eq!(arr(&m.cell_data, "CellId").tuples(), 7_776);
 }
 
@@ -122,16 +130,33 @@ fn sphere_hybrid_ascii_42() {
         return;
     };
     assert_eq!(m.points.len(), 5_750);
-    assert_eq!(by_type(&m), [("pyramid", 318), ("tetra", 312), ("wedge", 7_950)]);
-    assert!(close(arr(&m.point_data, "Pressure").range(Some(0)).unwrap(), (-3.2, 4.0), 0.05));
+    assert_eq!(
+        by_type(&m),
+        [("pyramid", 318), ("tetra", 312), ("wedge", 7_950)]
+    );
+    assert!(close(
+        arr(&m.point_data, "Pressure").range(Some(0)).unwrap(),
+        (-3.2, 4.0),
+        0.05
+    ));
     assert_eq!(arr(&m.point_data, "Velocity").components, 3);
 }
 
 #[test]
 fn prisms_zoo() {
     if let Some(m) = load("prisms_zoo/PentaHexa.vtk") {
-        assert_eq!(by_type(&m), [("hexagonal_prism", 150), ("pentagonal_prism", 60)]);
-        assert_eq!(m.cells.kinds.iter().filter(|&&k| k == CellKind::PentagonalPrism).count(), 60);
+        assert_eq!(
+            by_type(&m),
+            [("hexagonal_prism", 150), ("pentagonal_prism", 60)]
+        );
+        assert_eq!(
+            m.cells
+                .kinds
+                .iter()
+                .filter(|&&k| k == CellKind::PentagonalPrism)
+                .count(),
+            60
+        );
         assert_eq!(arr(&m.cell_data, "scalar1").vtk_type, "UInt64");
         arr(&m.point_data, "scalar2");
     }
@@ -152,7 +177,12 @@ fn synthetic_mixed_binary() {
     };
     assert_eq!(
         by_type(&m),
-        [("hexahedron", 32_000), ("pyramid", 8_000), ("tetra", 80_000), ("wedge", 76_800)]
+        [
+            ("hexahedron", 32_000),
+            ("pyramid", 8_000),
+            ("tetra", 80_000),
+            ("wedge", 76_800)
+        ]
     );
 }
 
@@ -185,11 +215,17 @@ fn agrees_with_vtkio() {
         let DataSet::UnstructuredGrid { pieces, .. } = theirs.data else {
             panic!("{rel}: not unstructured")
         };
-        let Piece::Inline(piece) = &pieces[0] else { panic!() };
+        let Piece::Inline(piece) = &pieces[0] else {
+            panic!()
+        };
         let pts: Vec<f64> = piece.points.cast_into().unwrap();
         assert_eq!(pts.len(), 3 * ours.points.len(), "{rel}");
         for (i, p) in ours.points.iter().enumerate() {
-            assert_eq!([pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]], p.to_array(), "{rel}");
+            assert_eq!(
+                [pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]],
+                p.to_array(),
+                "{rel}"
+            );
         }
         let (_, verts) = piece.cells.cell_verts.clone().into_legacy();
         let mut k = 0;
@@ -281,7 +317,10 @@ fn mixed_cells_voxel_quadratic_and_filtered_cell_data() {
     assert_eq!(m.cells.nodes(0), &[0, 1, 2, 3, 4, 5, 6, 7]);
     assert_eq!(m.cells.nodes(1), &[0, 1, 3, 4]);
     assert_eq!(m.cells.nodes(2), &[0, 1, 2, 4]);
-    assert_eq!(arr(&m.cell_data, "id no").data, ArrayData::Int(vec![10, 12, 14]));
+    assert_eq!(
+        arr(&m.cell_data, "id no").data,
+        ArrayData::Int(vec![10, 12, 14])
+    );
     let t = arr(&m.cell_data, "t");
     assert_eq!(t.components, 9);
     assert_eq!(t.component(1, 0), 18.0);
@@ -309,12 +348,17 @@ fn polyhedron_face_stream() {
 
 /// Minimal big-endian binary file writer for the tests.
 fn binary_51(int_type: &str, width: usize, extra: &[u8]) -> Vec<u8> {
-    let mut b = b"# vtk DataFile Version 5.1\nvtk output\nBINARY\nDATASET UNSTRUCTURED_GRID\n".to_vec();
+    let mut b =
+        b"# vtk DataFile Version 5.1\nvtk output\nBINARY\nDATASET UNSTRUCTURED_GRID\n".to_vec();
     b.extend_from_slice(b"POINTS 5 double\n");
-    for v in [0.0f64, 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1., 1., 1., 1.] {
+    for v in [
+        0.0f64, 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1., 1., 1., 1.,
+    ] {
         b.extend_from_slice(&v.to_be_bytes());
     }
-    b.extend_from_slice(b"\nMETADATA\nINFORMATION 1\nNAME L2_NORM_RANGE LOCATION vtkDataArray\nDATA 2 0 1.7\n\n");
+    b.extend_from_slice(
+        b"\nMETADATA\nINFORMATION 1\nNAME L2_NORM_RANGE LOCATION vtkDataArray\nDATA 2 0 1.7\n\n",
+    );
     let put = |b: &mut Vec<u8>, v: i64| b.extend_from_slice(&v.to_be_bytes()[8 - width..]);
     b.extend_from_slice(format!("CELLS 3 7\nOFFSETS {int_type}\n").as_bytes());
     for v in [0, 4, 7] {
@@ -342,13 +386,21 @@ fn binary_51(int_type: &str, width: usize, extra: &[u8]) -> Vec<u8> {
 
 #[test]
 fn binary_51_any_integer_width() {
-    for (ty, w) in [("vtktypeint64", 8), ("vtktypeint32", 4), ("short", 2), ("unsigned_char", 1)] {
+    for (ty, w) in [
+        ("vtktypeint64", 8),
+        ("vtktypeint32", 4),
+        ("short", 2),
+        ("unsigned_char", 1),
+    ] {
         let m = read_bytes(Path::new("b.vtk"), &binary_51(ty, w, b"\n")).unwrap();
         assert_eq!(m.cells.len(), 1, "{ty}");
         assert_eq!(m.cells.nodes(0), &[0, 1, 2, 3]);
         assert_eq!(m.source.ignored_cells, 1);
         assert_eq!(arr(&m.cell_data, "f").data, ArrayData::F32(vec![1.5]));
-        assert_eq!(arr(&m.point_data, "s").data, ArrayData::Int(vec![10, 11, 12, 10, 32]));
+        assert_eq!(
+            arr(&m.point_data, "s").data,
+            ArrayData::Int(vec![10, 11, 12, 10, 32])
+        );
         assert_eq!(arr(&m.point_data, "s").vtk_type, "UInt16");
         assert_eq!(m.points[4].to_array(), [1.0, 1.0, 1.0]);
     }
@@ -357,7 +409,8 @@ fn binary_51_any_integer_width() {
 #[test]
 fn f32_values_are_bit_exact() {
     let vals = [0.1f32, f32::MIN_POSITIVE, 3.4e38, -1.0e-7, 0.3];
-    let mut b = b"# vtk DataFile Version 3.0\nx\nBINARY\nDATASET POLYDATA\nPOINTS 1 float\n".to_vec();
+    let mut b =
+        b"# vtk DataFile Version 3.0\nx\nBINARY\nDATASET POLYDATA\nPOINTS 1 float\n".to_vec();
     for v in [0f32, 0., 0.] {
         b.extend_from_slice(&v.to_be_bytes());
     }
@@ -401,7 +454,10 @@ fn errors_name_line_or_byte_of_the_bad_value() {
     let pos = find(&b, b"CONNECTIVITY vtktypeint64\n") + 26 + 2 * 8;
     b[pos + 7] = 99;
     let e = parse_err(&b);
-    assert!(e.contains(&format!("byte {pos}")), "{e} (expected byte {pos})");
+    assert!(
+        e.contains(&format!("byte {pos}")),
+        "{e} (expected byte {pos})"
+    );
 }
 
 fn find(hay: &[u8], needle: &[u8]) -> usize {
@@ -455,7 +511,10 @@ fn corrupt_corpus_fails_with_file_and_location() {
             Ok(_) => panic!("{name}: read without error"),
             Err(e) => e.to_string(),
         };
-        assert!(msg.contains(&name), "{name}: message does not name the file: {msg}");
+        assert!(
+            msg.contains(&name),
+            "{name}: message does not name the file: {msg}"
+        );
         assert!(loc(&msg), "{name}: message has no line/byte: {msg}");
     }
 }
@@ -521,7 +580,7 @@ fn seeded_mutations_never_panic() {
     if let Some(p) = shared_file("prisms_zoo/uGridEx.vtk") {
         bases.push(std::fs::read(p).unwrap());
     }
-    let mut rng = Rng(0x5eed_1e9a_c7);
+    let mut rng = Rng(0x005e_ed1e_9ac7);
     let t = Instant::now();
     let mut errors = 0;
     let mut n = 0;

@@ -32,20 +32,32 @@ fn bluntfin_grid_and_q_match_vtk_conversion() {
     assert_eq!(m.cells.len(), 37_479);
     assert_eq!(m.source.cells_by_type.get("hexahedron"), Some(&37_479));
     let (lo, hi) = arr(&m, "Density").range(Some(0)).unwrap();
-    assert!((lo - 0.19).abs() < 0.005 && (hi - 4.98).abs() < 0.005, "{lo} {hi}");
+    assert!(
+        (lo - 0.19).abs() < 0.005 && (hi - 4.98).abs() < 0.005,
+        "{lo} {hi}"
+    );
     assert_eq!(m.active_point_scalars.as_deref(), Some("Density"));
     // VTK wrote the legacy copy from these files: same points, same cells,
     // and the same f32 bits in every array, derived ones included.
     let l = zoovr::io::legacy::read(&vtk).unwrap();
     assert_eq!(m.points, l.points);
     assert_eq!(m.cells.conn, l.cells.conn);
-    for name in ["Density", "Momentum", "StagnationEnergy", "VelocityMagnitude", "Pressure"] {
+    for name in [
+        "Density",
+        "Momentum",
+        "StagnationEnergy",
+        "VelocityMagnitude",
+        "Pressure",
+    ] {
         let (a, b) = (arr(&m, name), arr(&l, name));
         assert_eq!(a.components, b.components, "{name}");
         let (ArrayData::F32(x), ArrayData::F32(y)) = (&a.data, &b.data) else {
             panic!("{name} not f32")
         };
-        assert!(x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits()), "{name}");
+        assert!(
+            x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits()),
+            "{name}"
+        );
     }
     // Without the solution: geometry only.
     let g = read(&xyz, None).unwrap();
@@ -110,7 +122,11 @@ fn coords(dims: [usize; 3]) -> Vec<[f64; 3]> {
         for j in 0..dims[1] {
             for i in 0..dims[0] {
                 let (x, y, z) = (i as f64, j as f64, k as f64);
-                v.push([x + 0.25 * (y * z % 3.0), y * 1.5 - 0.125 * x, z * 0.5 + 0.0625 * x * y]);
+                v.push([
+                    x + 0.25 * (y * z % 3.0),
+                    y * 1.5 - 0.125 * x,
+                    z * 0.5 + 0.0625 * x * y,
+                ]);
             }
         }
     }
@@ -190,7 +206,14 @@ fn every_layout_variant_round_trips() {
 
 #[test]
 fn iblank_zero_drops_the_cells_around_a_point() {
-    let o = Opts { big: false, markers: true, nblocks: false, double: false, iblank: true, padding: 0 };
+    let o = Opts {
+        big: false,
+        markers: true,
+        nblocks: false,
+        double: false,
+        iblank: true,
+        padding: 0,
+    };
     let dims = [3, 3, 3];
     // Point 13 is the centre: all 8 cells touch it. Point 0 touches only cell 0.
     let m = read_bytes(Path::new("g.xyz"), &write_grid(o, dims, &[0]), None).unwrap();
@@ -224,7 +247,10 @@ fn q_solution_and_derived_quantities() {
             assert_eq!(arr(&m, "StagnationEnergy").component(i, 0), v[4]);
             let speed2 = (v[1] * v[1] + v[2] * v[2] + v[3] * v[3]) / (v[0] * v[0]);
             let vm = arr(&m, "VelocityMagnitude").component(i, 0);
-            assert!((vm - speed2.sqrt()).abs() <= 1e-6 * speed2.sqrt().max(1.0), "{vm}");
+            assert!(
+                (vm - speed2.sqrt()).abs() <= 1e-6 * speed2.sqrt().max(1.0),
+                "{vm}"
+            );
             let p = 0.4 * (v[4] - 0.5 * v[0] * speed2);
             let got = arr(&m, "Pressure").component(i, 0);
             assert!((got - p).abs() <= 1e-6 * p.abs().max(1.0), "{got} vs {p}");
@@ -248,11 +274,21 @@ fn sniffing_and_dispatch() {
     assert!(!looks_like_grid(b"# vtk DataFile Version 3.0\nx\nASCII\n"));
     assert!(!looks_like_grid(b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR\0\0\0\x10"));
     assert!(!looks_like_grid(&[0u8; 64]));
-    let o = Opts { big: true, markers: false, nblocks: false, double: false, iblank: false, padding: 0 };
+    let o = Opts {
+        big: true,
+        markers: false,
+        nblocks: false,
+        double: false,
+        iblank: false,
+        padding: 0,
+    };
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("grid.dat");
     std::fs::write(&p, write_grid(o, [4, 3, 2], &[])).unwrap();
-    assert_eq!(zoovr::io::detect_format(&p).unwrap(), zoovr::io::Format::Plot3d);
+    assert_eq!(
+        zoovr::io::detect_format(&p).unwrap(),
+        zoovr::io::Format::Plot3d
+    );
     let m = zoovr::io::read(&p, &zoovr::io::ReadOptions::default()).unwrap();
     assert_eq!(m.cells.len(), 6);
 }
@@ -287,9 +323,7 @@ fn seeded_mutations_never_panic() {
             let r = std::panic::catch_unwind(|| {
                 read_bytes(Path::new("m.xyz"), &g, Some((Path::new("m.q"), &qq)))
             });
-            let Ok(r) = r else {
-                panic!("panic on {o:?}")
-            };
+            let Ok(r) = r else { panic!("panic on {o:?}") };
             if let Err(e) = r {
                 let s = e.to_string();
                 assert!(s.contains("byte "), "{s}");

@@ -97,7 +97,9 @@ impl Framing {
         let mut d = [0usize; 3];
         for (i, v) in d.iter_mut().enumerate() {
             let x = self.int(b, off + 4 * i)?;
-            *v = usize::try_from(x).ok().filter(|&x| (1..=1 << 24).contains(&x))?;
+            *v = usize::try_from(x)
+                .ok()
+                .filter(|&x| (1..=1 << 24).contains(&x))?;
         }
         off += 12;
         if self.markers {
@@ -168,7 +170,10 @@ fn detect(b: &[u8], q: bool, want: Option<[usize; 3]>) -> Option<Layout> {
         if want.is_some_and(|w| w != dims) {
             continue;
         }
-        let Some(n) = dims[0].checked_mul(dims[1]).and_then(|x| x.checked_mul(dims[2])) else {
+        let Some(n) = dims[0]
+            .checked_mul(dims[1])
+            .and_then(|x| x.checked_mul(dims[2]))
+        else {
             continue;
         };
         for double in [false, true] {
@@ -294,22 +299,30 @@ pub fn looks_like_grid(head: &[u8]) -> bool {
         }
         if f.markers {
             // The data record marker must announce a plausible grid size.
-            return f.int(head, off).is_some_and(|m| {
-                [12, 16, 24, 28].iter().any(|&per| m == (per * n) as i64)
-            });
+            return f
+                .int(head, off)
+                .is_some_and(|m| [12, 16, 24, 28].iter().any(|&per| m == (per * n) as i64));
         }
         // Without markers, the first coordinates must be sane numbers.
         let sane32 = (0..2).all(|i| {
             head.get(off + 4 * i..off + 4 * i + 4).is_some_and(|s| {
                 let a = [s[0], s[1], s[2], s[3]];
-                let v = if f.big_endian { f32::from_be_bytes(a) } else { f32::from_le_bytes(a) };
+                let v = if f.big_endian {
+                    f32::from_be_bytes(a)
+                } else {
+                    f32::from_le_bytes(a)
+                };
                 v.is_finite() && v.abs() < 1e30
             })
         });
         let sane64 = head.get(off..off + 8).is_some_and(|s| {
             let mut a = [0u8; 8];
             a.copy_from_slice(s);
-            let v = if f.big_endian { f64::from_be_bytes(a) } else { f64::from_le_bytes(a) };
+            let v = if f.big_endian {
+                f64::from_be_bytes(a)
+            } else {
+                f64::from_le_bytes(a)
+            };
             v.is_finite() && v.abs() < 1e30
         });
         sane32 || sane64
@@ -398,9 +411,9 @@ fn drop_blanked(mesh: &mut Mesh, flags: &[i64]) {
         }
     }
     if dropped > 0 {
-        mesh.source
-            .notes
-            .push(format!("{dropped} cells touching blanked points (IBLANK = 0) dropped"));
+        mesh.source.notes.push(format!(
+            "{dropped} cells touching blanked points (IBLANK = 0) dropped"
+        ));
     }
 }
 
@@ -417,7 +430,10 @@ fn attach_q(mesh: &mut Mesh, dims: [usize; 3], path: &Path, b: &[u8]) -> Result<
         return Err(IoError::parse(
             path,
             Location::Byte(0),
-            format!("q dimensions {:?} differ from the grid's {:?}", lay.dims, dims),
+            format!(
+                "q dimensions {:?} differ from the grid's {:?}",
+                lay.dims, dims
+            ),
         ));
     }
     let n = lay.points();

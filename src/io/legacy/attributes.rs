@@ -88,13 +88,18 @@ pub(crate) fn read_attribute(
                     .and_then(|s| s.parse::<usize>().ok())
                     .filter(|&c| (1..=1024).contains(&c))
                     .ok_or_else(|| {
-                        cur.err(format!("SCALARS '{name}': invalid component count '{}'", show(t)))
+                        cur.err(format!(
+                            "SCALARS '{name}': invalid component count '{}'",
+                            show(t)
+                        ))
                     })?;
             }
             if cur.accept_keyword("LOOKUP_TABLE") {
                 cur.token("the lookup table name")?;
             }
-            Ok(Attribute::Scalars(read_array(cur, name, comps, tuples, ty)?))
+            Ok(Attribute::Scalars(read_array(
+                cur, name, comps, tuples, ty,
+            )?))
         }
         "VECTORS" | "NORMALS" | "TENSORS" | "TENSORS6" | "GLOBAL_IDS" | "PEDIGREE_IDS" => {
             let comps = match kw {
@@ -105,30 +110,48 @@ pub(crate) fn read_attribute(
             };
             let name = name(cur, kw)?;
             let ty = cur.value_type()?;
-            Ok(Attribute::Arrays(vec![read_array(cur, name, comps, tuples, ty)?]))
+            Ok(Attribute::Arrays(vec![read_array(
+                cur, name, comps, tuples, ty,
+            )?]))
         }
         "TEXTURE_COORDINATES" => {
             let name = name(cur, kw)?;
             let dim = cur.count("the texture dimension")?;
             if !(1..=3).contains(&dim) {
-                return Err(cur.err(format!("TEXTURE_COORDINATES '{name}': dimension {dim} not in 1..=3")));
+                return Err(cur.err(format!(
+                    "TEXTURE_COORDINATES '{name}': dimension {dim} not in 1..=3"
+                )));
             }
             let ty = cur.value_type()?;
-            Ok(Attribute::Arrays(vec![read_array(cur, name, dim, tuples, ty)?]))
+            Ok(Attribute::Arrays(vec![read_array(
+                cur, name, dim, tuples, ty,
+            )?]))
         }
         "COLOR_SCALARS" => {
             let name = name(cur, kw)?;
             let comps = cur.count("the colour component count")?;
             if !(1..=4).contains(&comps) {
-                return Err(cur.err(format!("COLOR_SCALARS '{name}': {comps} components not in 1..=4")));
+                return Err(cur.err(format!(
+                    "COLOR_SCALARS '{name}': {comps} components not in 1..=4"
+                )));
             }
-            let ty = if cur.is_binary() { ValueType::U8 } else { ValueType::F32 };
-            Ok(Attribute::Arrays(vec![read_array(cur, name, comps, tuples, ty)?]))
+            let ty = if cur.is_binary() {
+                ValueType::U8
+            } else {
+                ValueType::F32
+            };
+            Ok(Attribute::Arrays(vec![read_array(
+                cur, name, comps, tuples, ty,
+            )?]))
         }
         "LOOKUP_TABLE" => {
             let name = name(cur, kw)?;
             let size = cur.count("the lookup table size")?;
-            let ty = if cur.is_binary() { ValueType::U8 } else { ValueType::F32 };
+            let ty = if cur.is_binary() {
+                ValueType::U8
+            } else {
+                ValueType::F32
+            };
             read_array(cur, name, 4, size, ty)?;
             Ok(Attribute::Skipped)
         }

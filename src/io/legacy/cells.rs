@@ -94,7 +94,9 @@ pub(crate) fn read_cell_array(cur: &mut Cursor<'_>, keyword: &str) -> Result<Cel
                 None => {
                     return Err(cur.err_at(
                         section.clone(),
-                        format!("{keyword}: offset {i} = {o} is not increasing from 0 within 0..={b}"),
+                        format!(
+                            "{keyword}: offset {i} = {o} is not increasing from 0 within 0..={b}"
+                        ),
                     ))
                 }
             }
@@ -260,8 +262,7 @@ pub(crate) fn convert(
     };
     out.cells.offsets.push(0);
     let mut nodes_u32: Vec<u32> = Vec::with_capacity(32);
-    for c in 0..arr.len() {
-        let code = types[c];
+    for (c, &code) in types.iter().enumerate() {
         let t = u8::try_from(code).map_err(|_| {
             cur.err_at(
                 cur.value_location(types_span, c),
@@ -348,16 +349,25 @@ fn face_stream(
     let (lo, hi) = (arr.offsets[c], arr.offsets[c + 1]);
     let s = &arr.ids[lo..hi];
     let bad = |j: usize, msg: String| {
-        cur.err_at(arr.location(cur, c, lo + j.min(s.len().saturating_sub(1))), format!("polyhedron cell {c}: {msg}"))
+        cur.err_at(
+            arr.location(cur, c, lo + j.min(s.len().saturating_sub(1))),
+            format!("polyhedron cell {c}: {msg}"),
+        )
     };
     let nf = s.first().copied().unwrap_or(0);
     if nf < 4 || nf as usize > s.len() {
-        return Err(bad(0, format!("invalid face count {nf} in its face stream")));
+        return Err(bad(
+            0,
+            format!("invalid face count {nf} in its face stream"),
+        ));
     }
     let mut faces = Vec::with_capacity(nf as usize);
     let mut j = 1usize;
     for f in 0..nf as usize {
-        let np = s.get(j).copied().ok_or_else(|| bad(j, format!("face stream ends at face {f}")))?;
+        let np = s
+            .get(j)
+            .copied()
+            .ok_or_else(|| bad(j, format!("face stream ends at face {f}")))?;
         let np = usize::try_from(np)
             .ok()
             .filter(|&np| np >= 3 && np < s.len() - j)
@@ -368,14 +378,22 @@ fn face_stream(
             let p = usize::try_from(id)
                 .ok()
                 .filter(|&p| p < n_points)
-                .ok_or_else(|| bad(j + 1 + k, format!("point id {id} out of range ({n_points} points)")))?;
+                .ok_or_else(|| {
+                    bad(
+                        j + 1 + k,
+                        format!("point id {id} out of range ({n_points} points)"),
+                    )
+                })?;
             face.push(p as u32);
         }
         faces.push(face);
         j += 1 + np;
     }
     if j != s.len() {
-        return Err(bad(j, format!("face stream has {} values, the faces use {j}", s.len())));
+        return Err(bad(
+            j,
+            format!("face stream has {} values, the faces use {j}", s.len()),
+        ));
     }
     Ok(faces)
 }

@@ -134,10 +134,7 @@ fn header(cur: &mut Cursor<'_>) -> Result<Dataset, IoError> {
     }
     let kw = cur.token("DATASET")?;
     if !kw.eq_ignore_ascii_case(b"DATASET") {
-        return Err(cur.err(format!(
-            "expected DATASET, got '{}'",
-            tokens::show(kw)
-        )));
+        return Err(cur.err(format!("expected DATASET, got '{}'", tokens::show(kw))));
     }
     let ty = cur.token("the dataset type")?;
     Ok(match ty.to_ascii_uppercase().as_slice() {
@@ -146,12 +143,7 @@ fn header(cur: &mut Cursor<'_>) -> Result<Dataset, IoError> {
         b"RECTILINEAR_GRID" => Dataset::Rectilinear,
         b"STRUCTURED_POINTS" => Dataset::Image,
         b"POLYDATA" => Dataset::PolyData,
-        _ => {
-            return Err(cur.err(format!(
-                "unsupported dataset type '{}'",
-                tokens::show(ty)
-            )))
-        }
+        _ => return Err(cur.err(format!("unsupported dataset type '{}'", tokens::show(ty)))),
     })
 }
 
@@ -212,7 +204,9 @@ impl Reader {
                     let (t, span) = cells::read_cell_types(cur)?;
                     self.types = Some((t, span, loc));
                 }
-                "VERTICES" | "LINES" | "POLYGONS" | "TRIANGLE_STRIPS" if ds == Dataset::PolyData => {
+                "VERTICES" | "LINES" | "POLYGONS" | "TRIANGLE_STRIPS"
+                    if ds == Dataset::PolyData =>
+                {
                     self.poly_cells += cells::read_cell_array(cur, &kw)?.len();
                 }
                 "DIMENSIONS" if ds != Dataset::Unstructured && ds != Dataset::PolyData => {
@@ -235,7 +229,9 @@ impl Reader {
                     }
                     self.spacing = Some(s);
                 }
-                "X_COORDINATES" | "Y_COORDINATES" | "Z_COORDINATES" if ds == Dataset::Rectilinear => {
+                "X_COORDINATES" | "Y_COORDINATES" | "Z_COORDINATES"
+                    if ds == Dataset::Rectilinear =>
+                {
                     let axis = usize::from(kw.as_bytes()[0] - b'X');
                     self.once(cur, self.coords[axis].is_some(), &kw)?;
                     let n = cur.count("the coordinate count")?;
@@ -262,7 +258,14 @@ impl Reader {
                     if let Some(m) = known.filter(|&m| m != n) {
                         return Err(cur.err_at(
                             loc,
-                            format!("{kw} {n} does not match the {m} {} of the dataset", if sec == Section::Point { "points" } else { "cells" }),
+                            format!(
+                                "{kw} {n} does not match the {m} {} of the dataset",
+                                if sec == Section::Point {
+                                    "points"
+                                } else {
+                                    "cells"
+                                }
+                            ),
                         ));
                     }
                     self.section = Some(sec);
@@ -315,9 +318,10 @@ impl Reader {
     /// Point count implied by what was read so far.
     fn known_points(&self) -> Option<usize> {
         match self.dataset {
-            Dataset::Image | Dataset::Rectilinear => self.dims.as_ref().and_then(|(d, _)| {
-                d[0].checked_mul(d[1]).and_then(|x| x.checked_mul(d[2]))
-            }),
+            Dataset::Image | Dataset::Rectilinear => self
+                .dims
+                .as_ref()
+                .and_then(|(d, _)| d[0].checked_mul(d[1]).and_then(|x| x.checked_mul(d[2]))),
             _ => self.points.as_ref().map(Vec::len),
         }
     }
@@ -455,7 +459,8 @@ impl Reader {
                 Ok(pts)
             }
             Dataset::Image => {
-                let (d, n, _) = dims.ok_or_else(|| cur.err_at(end.clone(), "missing DIMENSIONS"))?;
+                let (d, n, _) =
+                    dims.ok_or_else(|| cur.err_at(end.clone(), "missing DIMENSIONS"))?;
                 let o = DVec3::from(self.origin);
                 let s = DVec3::from(self.spacing.unwrap_or([1.0; 3]));
                 let mut pts = Vec::with_capacity(n);
@@ -469,7 +474,8 @@ impl Reader {
                 Ok(pts)
             }
             Dataset::Rectilinear => {
-                let (d, n, loc) = dims.ok_or_else(|| cur.err_at(end.clone(), "missing DIMENSIONS"))?;
+                let (d, n, loc) =
+                    dims.ok_or_else(|| cur.err_at(end.clone(), "missing DIMENSIONS"))?;
                 let mut axes: [&[f64]; 3] = [&[], &[], &[]];
                 for (a, name) in ["X", "Y", "Z"].iter().enumerate() {
                     let c = self.coords[a].as_deref().ok_or_else(|| {
@@ -478,7 +484,11 @@ impl Reader {
                     if c.len() != d[a] {
                         return Err(cur.err_at(
                             loc.clone(),
-                            format!("{name}_COORDINATES has {} values, DIMENSIONS says {}", c.len(), d[a]),
+                            format!(
+                                "{name}_COORDINATES has {} values, DIMENSIONS says {}",
+                                c.len(),
+                                d[a]
+                            ),
                         ));
                     }
                     axes[a] = c;
@@ -515,7 +525,10 @@ fn read_points(cur: &mut Cursor<'_>) -> Result<Vec<DVec3>, IoError> {
             let c = (0..3).find(|&c| !v[c].is_finite()).unwrap_or(0);
             return Err(cur.err_at(
                 cur.value_location(span, 3 * p + c),
-                format!("point {p} has a non-finite coordinate ({}, {}, {})", v.x, v.y, v.z),
+                format!(
+                    "point {p} has a non-finite coordinate ({}, {}, {})",
+                    v.x, v.y, v.z
+                ),
             ));
         }
         pts.push(v);

@@ -231,30 +231,33 @@ impl<'a> Cursor<'a> {
         let t = self.token(what)?;
         let s = std::str::from_utf8(t).unwrap_or("");
         match s.parse::<i64>() {
-            Ok(v) if v >= 0 => usize::try_from(v).map_err(|_| self.err(format!("{what} {v} is too large"))),
+            Ok(v) if v >= 0 => {
+                usize::try_from(v).map_err(|_| self.err(format!("{what} {v} is too large")))
+            }
             Ok(v) => Err(self.err(format!("{what} must not be negative, got {v}"))),
-            Err(_) => Err(self.err(format!(
-                "expected {what} (an integer), got '{}'",
-                show(t)
-            ))),
+            Err(_) => Err(self.err(format!("expected {what} (an integer), got '{}'", show(t)))),
         }
     }
 
     /// A floating-point header value (ORIGIN, SPACING).
     pub(crate) fn real(&mut self, what: &str) -> Result<f64, IoError> {
         let t = self.token(what)?;
-        let v = std::str::from_utf8(t).ok().and_then(|s| s.parse::<f64>().ok());
+        let v = std::str::from_utf8(t)
+            .ok()
+            .and_then(|s| s.parse::<f64>().ok());
         match v {
             Some(v) if v.is_finite() => Ok(v),
-            _ => Err(self.err(format!("expected {what} (a finite number), got '{}'", show(t)))),
+            _ => Err(self.err(format!(
+                "expected {what} (a finite number), got '{}'",
+                show(t)
+            ))),
         }
     }
 
     /// A value type name.
     pub(crate) fn value_type(&mut self) -> Result<ValueType, IoError> {
         let t = self.token("a data type")?;
-        ValueType::parse(t)
-            .ok_or_else(|| self.err(format!("unsupported data type '{}'", show(t))))
+        ValueType::parse(t).ok_or_else(|| self.err(format!("unsupported data type '{}'", show(t))))
     }
 
     /// Consumes the next token if it equals `kw` (ignoring case).
@@ -395,7 +398,9 @@ impl<'a> Cursor<'a> {
                 for _ in 0..n {
                     let x = self.ascii_num::<u64>(what)?;
                     let x = i64::try_from(x).map_err(|_| {
-                        self.err(format!("{what}: value {x} does not fit in a 64-bit signed integer"))
+                        self.err(format!(
+                            "{what}: value {x} does not fit in a 64-bit signed integer"
+                        ))
                     })?;
                     v.push(x);
                 }
