@@ -569,8 +569,8 @@ fn mutate(rng: &mut Rng, base: &[u8]) -> Vec<u8> {
     b
 }
 
-#[test]
-fn seeded_mutations_never_panic() {
+/// Applies `per_base` seeded mutations to each base file; returns the count.
+fn run_mutations(per_base: usize, seed: u64) -> usize {
     let mut bases: Vec<Vec<u8>> = vec![
         binary_51("vtktypeint64", 8, b"\n"),
         binary_51("int", 4, b"\n"),
@@ -580,12 +580,12 @@ fn seeded_mutations_never_panic() {
     if let Some(p) = shared_file("prisms_zoo/uGridEx.vtk") {
         bases.push(std::fs::read(p).unwrap());
     }
-    let mut rng = Rng(0x005e_ed1e_9ac7);
+    let mut rng = Rng(seed);
     let t = Instant::now();
     let mut errors = 0;
     let mut n = 0;
     for base in &bases {
-        for _ in 0..800 {
+        for _ in 0..per_base {
             let input = mutate(&mut rng, base);
             let r = std::panic::catch_unwind(|| read_bytes(Path::new("mut.vtk"), &input));
             match r {
@@ -609,5 +609,22 @@ fn seeded_mutations_never_panic() {
         }
     }
     assert!(errors > n / 4, "only {errors} of {n} mutations rejected");
+    eprintln!("{n} mutations in {:?}", t.elapsed());
+    n
+}
+
+#[test]
+fn seeded_mutations_never_panic() {
+    let t = Instant::now();
+    assert!(run_mutations(800, 0x005e_ed1e_9ac7) >= 3200);
     assert!(t.elapsed() < Duration::from_secs(20), "{:?}", t.elapsed());
+}
+
+/// A longer run for local fuzzing: `cargo test --test io_legacy -- --ignored`.
+#[test]
+#[ignore]
+fn many_seeded_mutations_never_panic() {
+    for seed in 1..=20u64 {
+        run_mutations(5_000, seed.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    }
 }

@@ -260,8 +260,12 @@ pub(crate) fn convert(
         by_type: BTreeMap::new(),
         ignored: 0,
     };
+    out.cells.kinds.reserve(arr.len());
+    out.cells.offsets.reserve(arr.len() + 1);
+    out.cells.conn.reserve(arr.ids.len());
     out.cells.offsets.push(0);
     let mut nodes_u32: Vec<u32> = Vec::with_capacity(32);
+    let mut counts = [0usize; 256];
     for (c, &code) in types.iter().enumerate() {
         let t = u8::try_from(code).map_err(|_| {
             cur.err_at(
@@ -286,7 +290,7 @@ pub(crate) fn convert(
                 let faces = face_stream(cur, arr, c, n_points)?;
                 out.cells.push_polyhedron(faces);
                 out.keep[c] = true;
-                *out.by_type.entry(type_name(t).to_string()).or_default() += 1;
+                counts[t as usize] += 1;
                 continue;
             }
             Class::Voxel => (CellKind::Hexahedron, Nodes::Exact(&[8]), true),
@@ -334,7 +338,12 @@ pub(crate) fn convert(
             out.cells.push(kind, &nodes_u32[..corners]);
         }
         out.keep[c] = true;
-        *out.by_type.entry(type_name(t).to_string()).or_default() += 1;
+        counts[t as usize] += 1;
+    }
+    for (t, &n) in counts.iter().enumerate() {
+        if n > 0 {
+            out.by_type.insert(type_name(t as u8).to_string(), n);
+        }
     }
     Ok(out)
 }
