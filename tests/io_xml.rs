@@ -606,6 +606,21 @@ fn polyhedron_from_faces() {
     assert_eq!(m.cells.nodes(0), &[0, 1, 2, 3, 4, 5, 6, 7]);
     assert_eq!(m.cells.poly_faces[&0][2], vec![4, 5, 6, 7]);
     assert_eq!(by_type(&m, "polyhedron"), 1);
+    // The VTK 9.4 layout: faces shared through face ids.
+    let v94 = POLY
+        .replace(
+            r#"<DataArray type="Int64" Name="faces" format="ascii">6 4 0 3 2 1 4 0 4 7 3 4 4 5 6 7 4 5 1 2 6 4 0 1 5 4 4 2 3 7 6</DataArray>"#,
+            r#"<DataArray type="Int32" Name="face_connectivity" format="ascii">0 3 2 1 0 4 7 3 4 5 6 7 5 1 2 6 0 1 5 4 2 3 7 6</DataArray>
+            <DataArray type="Int32" Name="face_offsets" format="ascii">4 8 12 16 20 24</DataArray>
+            <DataArray type="Int32" Name="polyhedron_to_faces" format="ascii">0 1 2 3 4 5</DataArray>"#,
+        )
+        .replace(
+            r#"<DataArray type="Int64" Name="faceoffsets" format="ascii">31 -1</DataArray>"#,
+            r#"<DataArray type="Int64" Name="polyhedron_offsets" format="ascii">0 6 6</DataArray>"#,
+        );
+    let m2 = read_str("poly94.vtu", &v94, Format::XmlUnstructured).unwrap();
+    check_mesh(&m2);
+    assert_eq!(m2.cells.poly_faces, m.cells.poly_faces);
     // A face stream pointing outside the points is refused.
     let bad = POLY.replace("4 4 5 6 7 4 5", "4 4 5 6 70 4 5");
     let e = read_str("poly.vtu", &bad, Format::XmlUnstructured).unwrap_err();

@@ -52,6 +52,9 @@ pub fn read(path: &Path, grid: &Element, depth: usize) -> Result<Mesh, IoError> 
             if Some(&canon) == me.as_ref() {
                 return Err(IoError::parse(path, at(), "the piece is the .pvtu file itself"));
             }
+            if !canon.is_file() {
+                return Err(IoError::parse(path, at(), format!("piece {} is not a regular file", file.display())));
+            }
             let bytes = std::fs::read(file).map_err(|e| {
                 IoError::parse(path, at(), format!("piece file {} cannot be read: {e}", file.display()))
             })?;

@@ -5,7 +5,10 @@
 //! `types` (VTK cell type codes, any integer width). Polyhedra (type 42) add
 //! `faces` (per polyhedron: face count, then per face its point count and
 //! ids) and `faceoffsets` (end of each cell's stream in `faces`, -1 for cells
-//! that are not polyhedra).
+//! that are not polyhedra). VTK 9.4+ writes polyhedra as four arrays instead:
+//! `face_connectivity`/`face_offsets` (the faces' point ids) and
+//! `polyhedron_to_faces`/`polyhedron_offsets` (each cell's face ids); offsets
+//! are accepted with or without a leading 0.
 //!
 //! Each cell is mapped as `mesh::cell` describes: 0D-2D cells are dropped and
 //! counted (cell data is filtered to match), voxels are reordered to
@@ -171,10 +174,12 @@ fn read_cells(
     if types.iter().all(|&t| linear(t)) {
         return fast_path(src, conn_el, types, offsets, conn, mesh).map(|_| None);
     }
-    let polys = if types.contains(&42) {
-        Some(read_faces(src, cells_el, nc, np)?)
-    } else {
+    let polys = if !types.contains(&42) {
         None
+    } else if cells_array(cells_el, "polyhedron_offsets").is_some() {
+        Some(read_faces_vtk94(src, cells_el, nc, np)?)
+    } else {
+        Some(read_faces(src, cells_el, nc, np)?)
     };
     general_path(src, conn_el, &types, &offsets, &conn, polys, mesh)
 }
@@ -329,6 +334,78 @@ fn read_faces(
             return Err(err(i, "face stream longer than its faces"));
         }
         out.push(Some(cell_faces));
+    }
+    Ok(out)
+}
+
+/// Offsets as `n + 1` starts (a leading 0 added when the file gives `n` ends).
+fn with_leading_zero(v: Vec<i64>, n: usize) -> Vec<i64> {
+    if v.len() == n + 1 {
+        return v;
+    }
+    let mut out = Vec::with_capacity(n + 1);
+    out.push(0);
+    out.extend(v);
+    out
+}
+
+/// Reads the VTK 9.4+ polyhedron arrays into per-cell face lists.
+fn read_faces_vtk94(
+    src: &Source,
+    cells_el: &Element,
+    nc: usize,
+    np: usize,
+) -> Result<Vec<Option<Vec<Vec<u32>>>>, IoError> {
+    let need = |name: &str| {
+        cells_array(cells_el, name).ok_or_else(|| {
+            IoError::parse(src.path, cells_el.location(), format!("polyhedra need a '{name}' array"))
+        })
+    };
+    let dec = |el: &Element| -> Result<Vec<i64>, IoError> { src.decode(el, scalar_type(src, el)?, None) };
+    let (fc_el, fo_el, p2f_el, po_el) = (
+        need("face_connectivity")?,
+        need("face_offsets")?,
+        need("polyhedron_to_faces")?,
+        need("polyhedron_offsets")?,
+    );
+    let fc = dec(fc_el)?;
+    let fo = dec(fo_el)?;
+    let p2f = dec(p2f_el)?;
+    let po = dec(po_el)?;
+    if po.len() != nc && po.len() != nc + 1 {
+        return Err(IoError::parse(src.path, po_el.location(), format!("{} offsets for {nc} cells", po.len())));
+    }
+    let po = with_leading_zero(po, nc);
+    let nfaces = if fo.first() == Some(&0) { fo.len().saturating_sub(1) } else { fo.len() };
+    let fo = with_leading_zero(fo, nfaces);
+    let bad = |el: &Element, i: usize, what: &str| {
+        IoError::parse(src.path, el.location(), format!("polyhedron cell {i}: {what}"))
+    };
+    let range = |v: &[i64], k: usize| -> Option<(usize, usize)> {
+        let (a, b) = (*v.get(k)?, *v.get(k + 1)?);
+        (0 <= a && a <= b).then_some((a as usize, b as usize))
+    };
+    let mut out = Vec::with_capacity(nc);
+    for i in 0..nc {
+        let (a, b) = range(&po, i).ok_or_else(|| bad(po_el, i, "bad polyhedron offsets"))?;
+        let ids = p2f.get(a..b).ok_or_else(|| bad(p2f_el, i, "face ids out of range"))?;
+        if ids.is_empty() {
+            out.push(None);
+            continue;
+        }
+        let mut faces = Vec::with_capacity(ids.len());
+        for &f in ids {
+            let (fa, fb) = usize::try_from(f)
+                .ok()
+                .and_then(|f| range(&fo, f))
+                .ok_or_else(|| bad(p2f_el, i, "face id out of range"))?;
+            let pts = fc.get(fa..fb).ok_or_else(|| bad(fo_el, i, "face offsets out of range"))?;
+            if pts.len() < 3 || pts.iter().any(|&p| p < 0 || p as usize >= np) {
+                return Err(bad(fc_el, i, "face with fewer than 3 points or a point id out of range"));
+            }
+            faces.push(pts.iter().map(|&p| p as u32).collect());
+        }
+        out.push(Some(faces));
     }
     Ok(out)
 }
