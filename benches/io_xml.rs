@@ -58,7 +58,11 @@ fn million_hex_file() -> PathBuf {
     for k in 0..n1 {
         for j in 0..n1 {
             for i in 0..n1 {
-                let (x, y, z) = (i as f32 / N as f32, j as f32 / N as f32, k as f32 / N as f32);
+                let (x, y, z) = (
+                    i as f32 / N as f32,
+                    j as f32 / N as f32,
+                    k as f32 / N as f32,
+                );
                 let r = 1.0 + x;
                 let a = 4.7 * y;
                 let w = 0.05 * (7.0 * z).sin() * (5.0 * x).sin();
@@ -89,7 +93,9 @@ fn million_hex_file() -> PathBuf {
             }
         }
     }
-    let offsets: Vec<u8> = (1..=nc as i64).flat_map(|c| (8 * c).to_le_bytes()).collect();
+    let offsets: Vec<u8> = (1..=nc as i64)
+        .flat_map(|c| (8 * c).to_le_bytes())
+        .collect();
     let types = vec![12u8; nc];
     let mut app = Vec::new();
     let mut offs = Vec::new();
@@ -105,7 +111,8 @@ fn million_hex_file() -> PathBuf {
     let mut file = std::fs::File::create(&tmp).unwrap();
     file.write_all(head.as_bytes()).unwrap();
     file.write_all(&app).unwrap();
-    file.write_all(b"\n  </AppendedData>\n</VTKFile>\n").unwrap();
+    file.write_all(b"\n  </AppendedData>\n</VTKFile>\n")
+        .unwrap();
     drop(file);
     std::fs::rename(&tmp, &path).unwrap();
     path
@@ -118,7 +125,10 @@ fn load(p: &Path) -> usize {
 fn bench_xml(c: &mut Criterion) {
     let mut g = c.benchmark_group("xml_load");
     g.sample_size(10);
-    for rel in ["bluntfin/bluntfin_converted.vts", "synthetic/hex_shell_zlib.vtu"] {
+    for rel in [
+        "bluntfin/bluntfin_converted.vts",
+        "synthetic/hex_shell_zlib.vtu",
+    ] {
         if let Some(p) = zoovr::testdata::shared_file(rel) {
             g.bench_function(rel, |b| b.iter(|| load(&p)));
         }

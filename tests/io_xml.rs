@@ -35,7 +35,10 @@ fn check_mesh(m: &Mesh) {
         if let Some(k) = c.kinds[i].corner_count() {
             assert_eq!(n.len(), k, "cell {i}");
         }
-        assert!(n.iter().all(|&p| (p as usize) < m.points.len()), "cell {i} ids");
+        assert!(
+            n.iter().all(|&p| (p as usize) < m.points.len()),
+            "cell {i} ids"
+        );
     }
     for a in &m.point_data {
         assert_eq!(a.tuples(), m.points.len(), "point array {}", a.name);
@@ -81,13 +84,19 @@ fn file_ranges(path: &Path) -> Vec<(String, usize, f64, f64)> {
     let mut out = Vec::new();
     for part in text.split("<DataArray").skip(1) {
         let tag = &part[..part.find('>').unwrap_or(part.len())];
-        let (Some(name), Some(lo), Some(hi)) = (attr(tag, "Name"), attr(tag, "RangeMin"), attr(tag, "RangeMax")) else {
+        let (Some(name), Some(lo), Some(hi)) = (
+            attr(tag, "Name"),
+            attr(tag, "RangeMin"),
+            attr(tag, "RangeMax"),
+        ) else {
             continue;
         };
         let (Ok(lo), Ok(hi)) = (lo.parse(), hi.parse()) else {
             continue;
         };
-        let nc = attr(tag, "NumberOfComponents").and_then(|s| s.parse().ok()).unwrap_or(1);
+        let nc = attr(tag, "NumberOfComponents")
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(1);
         out.push((name, nc, lo, hi));
     }
     out
@@ -102,15 +111,26 @@ fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
 fn check_ranges(m: &Mesh, path: &Path) -> usize {
     let mut checked = 0;
     for (name, nc, lo, hi) in file_ranges(path) {
-        let Some(a) = m.point_data.iter().chain(&m.cell_data).find(|a| a.name == name) else {
+        let Some(a) = m
+            .point_data
+            .iter()
+            .chain(&m.cell_data)
+            .find(|a| a.name == name)
+        else {
             continue;
         };
-        if a.components != nc || (lo == 0.0 && hi == 0.0 && a.range(None).is_some_and(|r| r.1 != 0.0)) {
+        if a.components != nc
+            || (lo == 0.0 && hi == 0.0 && a.range(None).is_some_and(|r| r.1 != 0.0))
+        {
             continue;
         }
         let (l, h) = a.range(if nc == 1 { Some(0) } else { None }).unwrap();
         let tol = 1e-6 * (hi.abs().max(lo.abs()).max(1e-30));
-        assert!((l - lo).abs() <= tol && (h - hi).abs() <= tol, "{}: {name} range {l}..{h}, file says {lo}..{hi}", path.display());
+        assert!(
+            (l - lo).abs() <= tol && (h - hi).abs() <= tol,
+            "{}: {name} range {l}..{h}, file says {lo}..{hi}",
+            path.display()
+        );
         checked += 1;
     }
     checked
@@ -120,14 +140,19 @@ fn check_ranges(m: &Mesh, path: &Path) -> usize {
 
 #[test]
 fn bluntfin_vts_appended_raw() {
-    let Some(m) = load("bluntfin/bluntfin_converted.vts") else { return };
+    let Some(m) = load("bluntfin/bluntfin_converted.vts") else {
+        return;
+    };
     assert_eq!(m.cells.len(), 37_479);
     assert_eq!(m.points.len(), 40_960);
     assert_eq!(by_type(&m, "hexahedron"), 37_479);
     let d = array(&m, "Density");
     assert_eq!(d.vtk_type, "Float32");
     let (lo, hi) = d.range(Some(0)).unwrap();
-    assert!((0.19..0.2).contains(&lo) && (4.97..4.98).contains(&hi), "{lo} {hi}");
+    assert!(
+        (0.19..0.2).contains(&lo) && (4.97..4.98).contains(&hi),
+        "{lo} {hi}"
+    );
     assert_eq!(m.active_point_scalars.as_deref(), Some("Density"));
     assert!(check_ranges(&m, &shared_file("bluntfin/bluntfin_converted.vts").unwrap()) >= 7);
     // Node order: cell 0 is (0,0,0)-(1,1,1) of a 40 x 32 x 32 lattice.
@@ -136,18 +161,25 @@ fn bluntfin_vts_appended_raw() {
 
 #[test]
 fn fire_room_appended_base64_zlib() {
-    let Some(m) = load("fire_room/fire_ug.vtu") else { return };
+    let Some(m) = load("fire_room/fire_ug.vtu") else {
+        return;
+    };
     assert_eq!((m.cells.len(), m.points.len()), (10_462, 12_323));
     assert_eq!(by_type(&m, "hexahedron"), 10_462);
     let (lo, hi) = array(&m, "t").range(Some(0)).unwrap();
-    assert!((297.0..299.0).contains(&lo) && (691.0..693.0).contains(&hi), "{lo} {hi}");
+    assert!(
+        (297.0..299.0).contains(&lo) && (691.0..693.0).contains(&hi),
+        "{lo} {hi}"
+    );
     assert_eq!(array(&m, "uvw").components, 3);
     assert_eq!(m.active_point_scalars.as_deref(), Some("t"));
 }
 
 #[test]
 fn can_crush_appended_raw_and_series() {
-    let Some(m) = load("can_crush/can.vtu") else { return };
+    let Some(m) = load("can_crush/can.vtu") else {
+        return;
+    };
     assert_eq!((m.cells.len(), m.points.len()), (4_800, 6_724));
     assert_eq!(array(&m, "EQPS").tuples(), 4_800);
     assert_eq!(array(&m, "DISPL").components, 3);
@@ -174,61 +206,109 @@ fn can_crush_appended_raw_and_series() {
 
 #[test]
 fn disk_out_ref_inline_zlib() {
-    let Some(m) = load("disk_out_ref/disk_out_ref_converted.vtu") else { return };
+    let Some(m) = load("disk_out_ref/disk_out_ref_converted.vtu") else {
+        return;
+    };
     assert_eq!((m.cells.len(), m.points.len()), (7_472, 8_499));
     let (lo, hi) = array(&m, "Temp").range(Some(0)).unwrap();
     assert!((293.0..293.2).contains(&lo) && (913.0..913.2).contains(&hi));
-    assert!(check_ranges(&m, &shared_file("disk_out_ref/disk_out_ref_converted.vtu").unwrap()) >= 7);
+    assert!(
+        check_ranges(
+            &m,
+            &shared_file("disk_out_ref/disk_out_ref_converted.vtu").unwrap()
+        ) >= 7
+    );
 }
 
 #[test]
 fn notch_quadratic_cells_keep_corners() {
-    let Some(m) = load("notch/notch_disp.vtu") else { return };
+    let Some(m) = load("notch/notch_disp.vtu") else {
+        return;
+    };
     assert_eq!(m.cells.len(), 2_192);
     assert_eq!(m.points.len(), 12_717);
-    let hex = m.cells.kinds.iter().filter(|k| **k == CellKind::Hexahedron).count();
-    let wedge = m.cells.kinds.iter().filter(|k| **k == CellKind::Wedge).count();
+    let hex = m
+        .cells
+        .kinds
+        .iter()
+        .filter(|k| **k == CellKind::Hexahedron)
+        .count();
+    let wedge = m
+        .cells
+        .kinds
+        .iter()
+        .filter(|k| **k == CellKind::Wedge)
+        .count();
     assert_eq!((hex, wedge), (2_188, 4));
     let a = array(&m, "Nodal Displacement");
     assert_eq!(a.components, 3);
-    assert_eq!(m.active_point_scalars.as_deref(), Some("Nodal Displacement"));
+    assert_eq!(
+        m.active_point_scalars.as_deref(),
+        Some("Nodal Displacement")
+    );
 }
 
 #[test]
 fn fea_bracket_quadratic_tets_cell_data_only() {
-    let Some(m) = load("fea_bracket_qtet/kiefer_bracket.vtu") else { return };
+    let Some(m) = load("fea_bracket_qtet/kiefer_bracket.vtu") else {
+        return;
+    };
     assert_eq!(m.cells.len(), 56_786);
     assert_eq!(by_type(&m, "quadratic_tetra"), 56_786);
     assert_eq!(m.points.len(), 102_578);
     assert!(m.point_data.is_empty());
     let s = array(&m, "Equivalent (von-Mises) Stress (psi)");
     assert_eq!(s.tuples(), 56_786);
-    assert_eq!(m.active_cell_scalars.as_deref(), Some("Equivalent (von-Mises) Stress (psi)"));
-    assert_eq!(check_ranges(&m, &shared_file("fea_bracket_qtet/kiefer_bracket.vtu").unwrap()), 1);
+    assert_eq!(
+        m.active_cell_scalars.as_deref(),
+        Some("Equivalent (von-Mises) Stress (psi)")
+    );
+    assert_eq!(
+        check_ranges(
+            &m,
+            &shared_file("fea_bracket_qtet/kiefer_bracket.vtu").unwrap()
+        ),
+        1
+    );
 }
 
 #[test]
 fn su2_sphere_hybrid_mixed_cells() {
-    let Some(m) = load("su2_sphere_hybrid/sphere_hybrid_converted.vtu") else { return };
+    let Some(m) = load("su2_sphere_hybrid/sphere_hybrid_converted.vtu") else {
+        return;
+    };
     assert_eq!(by_type(&m, "tetra"), 312);
     assert_eq!(by_type(&m, "wedge"), 7_950);
     assert_eq!(by_type(&m, "pyramid"), 318);
     assert_eq!(m.points.len(), 5_750);
     let (lo, hi) = array(&m, "Pressure").range(Some(0)).unwrap();
-    assert!((-3.3..-3.1).contains(&lo) && (3.9..4.1).contains(&hi), "{lo} {hi}");
+    assert!(
+        (-3.3..-3.1).contains(&lo) && (3.9..4.1).contains(&hi),
+        "{lo} {hi}"
+    );
     assert_eq!(m.active_point_scalars.as_deref(), Some("Pressure"));
-    assert!(check_ranges(&m, &shared_file("su2_sphere_hybrid/sphere_hybrid_converted.vtu").unwrap()) >= 10);
+    assert!(
+        check_ranges(
+            &m,
+            &shared_file("su2_sphere_hybrid/sphere_hybrid_converted.vtu").unwrap()
+        ) >= 10
+    );
 }
 
 #[test]
 fn blood_vessels_pvtu_voxels_int8_types() {
-    let Some(m) = load("blood_vessels_pvtu/blood_vessels/T0000000500.pvtu") else { return };
+    let Some(m) = load("blood_vessels_pvtu/blood_vessels/T0000000500.pvtu") else {
+        return;
+    };
     assert_eq!(m.cells.len(), 39_353);
     assert_eq!(by_type(&m, "voxel"), 39_353);
     assert_eq!(m.points.len(), 48_823);
     assert!(m.cells.kinds.iter().all(|k| *k == CellKind::Hexahedron));
     for name in ["node_value", "simerr_type"] {
-        assert!(m.point_data.iter().any(|a| a.name == name && a.vtk_type == "Int32"));
+        assert!(m
+            .point_data
+            .iter()
+            .any(|a| a.name == name && a.vtk_type == "Int32"));
     }
     for name in ["density", "velocity", "shearstress"] {
         assert!(m.cell_data.iter().any(|a| a.name == name));
@@ -236,14 +316,25 @@ fn blood_vessels_pvtu_voxels_int8_types() {
     // Voxels reordered to hexahedron order: the quad 0-1-2-3 is a cycle, so
     // nodes 0 and 2 are diagonal opposites (differ in two coordinates).
     let n = m.cells.nodes(0);
-    let (p0, p1, p2) = (m.points[n[0] as usize], m.points[n[1] as usize], m.points[n[2] as usize]);
-    let diff = |a: glam::DVec3, b: glam::DVec3| [(a.x != b.x), (a.y != b.y), (a.z != b.z)].iter().filter(|&&d| d).count();
+    let (p0, p1, p2) = (
+        m.points[n[0] as usize],
+        m.points[n[1] as usize],
+        m.points[n[2] as usize],
+    );
+    let diff = |a: glam::DVec3, b: glam::DVec3| {
+        [(a.x != b.x), (a.y != b.y), (a.z != b.z)]
+            .iter()
+            .filter(|&&d| d)
+            .count()
+    };
     assert_eq!((diff(p0, p1), diff(p0, p2)), (1, 2));
 }
 
 #[test]
 fn hex_shell_synthetic_zlib() {
-    let Some(m) = load("synthetic/hex_shell_zlib.vtu") else { return };
+    let Some(m) = load("synthetic/hex_shell_zlib.vtu") else {
+        return;
+    };
     assert_eq!((m.cells.len(), m.points.len()), (250_047, 262_144));
     let (lo, hi) = array(&m, "f").range(Some(0)).unwrap();
     assert!(lo >= 0.0 && hi <= 1.0 && hi - lo > 0.99, "{lo} {hi}");
@@ -279,7 +370,11 @@ fn value_bytes(ty: &str, v: f64, be: bool) -> Vec<u8> {
     macro_rules! b {
         ($t:ty) => {{
             let x = v as $t;
-            if be { x.to_be_bytes().to_vec() } else { x.to_le_bytes().to_vec() }
+            if be {
+                x.to_be_bytes().to_vec()
+            } else {
+                x.to_le_bytes().to_vec()
+            }
         }};
     }
     match ty {
@@ -320,7 +415,8 @@ impl Enc {
         for b in &blocks {
             let c = match self.comp {
                 Comp::Zlib => {
-                    let mut e = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+                    let mut e =
+                        flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
                     e.write_all(b).unwrap();
                     e.finish().unwrap()
                 }
@@ -334,7 +430,10 @@ impl Enc {
 
     fn array(&self, name: &str, ty: &str, nc: usize, vals: &[f64], app: &mut Vec<u8>) -> String {
         let head = format!("<DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{nc}\"");
-        let bytes: Vec<u8> = vals.iter().flat_map(|&v| value_bytes(ty, v, self.be)).collect();
+        let bytes: Vec<u8> = vals
+            .iter()
+            .flat_map(|&v| value_bytes(ty, v, self.be))
+            .collect();
         let (h, b) = self.payload(&bytes);
         let b64 = |h: &[u8], b: &[u8]| {
             if self.comp == Comp::None {
@@ -345,10 +444,22 @@ impl Enc {
         };
         match self.fmt {
             Fmt::Ascii => {
-                let t: Vec<String> = vals.iter().map(|v| if ty.starts_with("Float32") { format!("{}", *v as f32) } else { format!("{v}") }).collect();
+                let t: Vec<String> = vals
+                    .iter()
+                    .map(|v| {
+                        if ty.starts_with("Float32") {
+                            format!("{}", *v as f32)
+                        } else {
+                            format!("{v}")
+                        }
+                    })
+                    .collect();
                 format!("{head} format=\"ascii\">\n{}\n</DataArray>\n", t.join(" "))
             }
-            Fmt::Binary => format!("{head} format=\"binary\">\n  {}\n</DataArray>\n", b64(&h, &b)),
+            Fmt::Binary => format!(
+                "{head} format=\"binary\">\n  {}\n</DataArray>\n",
+                b64(&h, &b)
+            ),
             Fmt::AppRaw => {
                 let off = app.len();
                 app.extend(h);
@@ -376,7 +487,11 @@ impl Enc {
         )
         .into_bytes();
         if matches!(self.fmt, Fmt::AppRaw | Fmt::AppB64) {
-            let enc = if self.fmt == Fmt::AppRaw { "raw" } else { "base64" };
+            let enc = if self.fmt == Fmt::AppRaw {
+                "raw"
+            } else {
+                "base64"
+            };
             f.extend(format!("<AppendedData encoding=\"{enc}\">\n   _").into_bytes());
             f.extend(app);
             f.extend(b"\n</AppendedData>\n");
@@ -423,7 +538,12 @@ fn sample() -> Sample {
         offsets.push(conn.len() as f64);
         types.push(t as f64);
     }
-    Sample { points, conn, offsets, types }
+    Sample {
+        points,
+        conn,
+        offsets,
+        types,
+    }
 }
 
 fn write_sample(enc: &Enc, int_ty: &str, types_ty: &str) -> Vec<u8> {
@@ -433,7 +553,9 @@ fn write_sample(enc: &Enc, int_ty: &str, types_ty: &str) -> Vec<u8> {
     let temp: Vec<f64> = (0..np).map(|i| (i as f32 * 0.1f32) as f64).collect();
     let vel: Vec<f64> = (0..np * 3).map(|i| i as f64 / 3.0).collect();
     let cid: Vec<f64> = (0..6).map(|i| (i * 10) as f64 - 20.0).collect();
-    let mut body = format!("<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"6\">\n<PointData Scalars=\"temp\">\n");
+    let mut body = format!(
+        "<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"6\">\n<PointData Scalars=\"temp\">\n"
+    );
     body += &enc.array("temp", "Float32", 1, &temp, &mut app);
     body += &enc.array("vel", "Float64", 3, &vel, &mut app);
     body += "</PointData>\n<CellData Scalars=\"cid\">\n";
@@ -456,16 +578,44 @@ fn check_sample(m: &Mesh, what: &str) {
     assert_eq!(m.cells.len(), 5, "{what}");
     assert_eq!(m.source.ignored_cells, 1, "{what}");
     assert_eq!(m.cells.nodes(0), &[0, 1, 4, 3, 6, 7, 10, 9], "{what}");
-    assert_eq!(m.cells.nodes(1), &[1, 2, 5, 4, 7, 8, 11, 10], "{what}: voxel to hex order");
-    assert_eq!(m.cells.nodes(3), &[0, 1, 3, 12], "{what}: quadratic tet corners");
-    assert_eq!(m.cells.kinds, vec![CellKind::Hexahedron, CellKind::Hexahedron, CellKind::Tetra, CellKind::Tetra, CellKind::Wedge]);
-    for (name, n) in [("hexahedron", 1), ("voxel", 1), ("tetra", 1), ("quadratic_tetra", 1), ("wedge", 1)] {
+    assert_eq!(
+        m.cells.nodes(1),
+        &[1, 2, 5, 4, 7, 8, 11, 10],
+        "{what}: voxel to hex order"
+    );
+    assert_eq!(
+        m.cells.nodes(3),
+        &[0, 1, 3, 12],
+        "{what}: quadratic tet corners"
+    );
+    assert_eq!(
+        m.cells.kinds,
+        vec![
+            CellKind::Hexahedron,
+            CellKind::Hexahedron,
+            CellKind::Tetra,
+            CellKind::Tetra,
+            CellKind::Wedge
+        ]
+    );
+    for (name, n) in [
+        ("hexahedron", 1),
+        ("voxel", 1),
+        ("tetra", 1),
+        ("quadratic_tetra", 1),
+        ("wedge", 1),
+    ] {
         assert_eq!(by_type(m, name), n, "{what}: {name}");
     }
     let t = array(m, "temp");
     assert_eq!(t.vtk_type, "Float32");
     match &t.data {
-        ArrayData::F32(v) => assert!(v.iter().enumerate().all(|(i, x)| x.to_bits() == (i as f32 * 0.1f32).to_bits()), "{what}"),
+        ArrayData::F32(v) => assert!(
+            v.iter()
+                .enumerate()
+                .all(|(i, x)| x.to_bits() == (i as f32 * 0.1f32).to_bits()),
+            "{what}"
+        ),
         other => panic!("{what}: temp is {other:?}"),
     }
     assert_eq!(array(m, "vel").component(4, 2), 14.0 / 3.0, "{what}");
@@ -488,12 +638,27 @@ fn every_encoding_round_trips() {
             }
             for h64 in [false, true] {
                 for be in [false, true] {
-                    for (int_ty, types_ty, block) in [("Int32", "UInt8", 64), ("Int64", "Int8", 40), ("UInt16", "Int32", 7), ("Int8", "Int64", 1 << 15)] {
-                        let enc = Enc { fmt, comp, h64, be, block };
+                    for (int_ty, types_ty, block) in [
+                        ("Int32", "UInt8", 64),
+                        ("Int64", "Int8", 40),
+                        ("UInt16", "Int32", 7),
+                        ("Int8", "Int64", 1 << 15),
+                    ] {
+                        let enc = Enc {
+                            fmt,
+                            comp,
+                            h64,
+                            be,
+                            block,
+                        };
                         let bytes = write_sample(&enc, int_ty, types_ty);
                         let what = format!("{enc:?} {int_ty} {types_ty}");
-                        let m = xml::read_bytes(Path::new("sample.vtu"), &bytes, Format::XmlUnstructured)
-                            .unwrap_or_else(|e| panic!("{what}: {e}"));
+                        let m = xml::read_bytes(
+                            Path::new("sample.vtu"),
+                            &bytes,
+                            Format::XmlUnstructured,
+                        )
+                        .unwrap_or_else(|e| panic!("{what}: {e}"));
                         check_sample(&m, &what);
                         n += 1;
                     }
@@ -507,7 +672,13 @@ fn every_encoding_round_trips() {
 #[test]
 fn hostile_header_is_refused_before_allocating() {
     // A zlib header claiming 2^40-byte blocks and 10^12 points.
-    let enc = Enc { fmt: Fmt::AppRaw, comp: Comp::Zlib, h64: true, be: false, block: 64 };
+    let enc = Enc {
+        fmt: Fmt::AppRaw,
+        comp: Comp::Zlib,
+        h64: true,
+        be: false,
+        block: 64,
+    };
     let mut app = enc.word(1);
     app.extend(enc.word(1 << 40));
     app.extend(enc.word(0));
@@ -515,12 +686,27 @@ fn hostile_header_is_refused_before_allocating() {
     app.extend([0u8; 16]);
     let body = "<Piece NumberOfPoints=\"1000000000000\" NumberOfCells=\"0\"><Points>\
         <DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points></Piece>";
-    let e = xml::read_bytes(Path::new("huge.vtu"), &enc.file(body, &app), Format::XmlUnstructured).unwrap_err().to_string();
+    let e = xml::read_bytes(
+        Path::new("huge.vtu"),
+        &enc.file(body, &app),
+        Format::XmlUnstructured,
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("huge.vtu"), "{e}");
     let body = "<Piece NumberOfPoints=\"300000000\" NumberOfCells=\"0\"><Points>\
         <DataArray type=\"Float32\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points></Piece>";
-    let e = xml::read_bytes(Path::new("huge.vtu"), &enc.file(body, &app), Format::XmlUnstructured).unwrap_err().to_string();
-    assert!(e.contains("huge.vtu") && e.contains("Points") && e.contains("ratio"), "{e}");
+    let e = xml::read_bytes(
+        Path::new("huge.vtu"),
+        &enc.file(body, &app),
+        Format::XmlUnstructured,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("huge.vtu") && e.contains("Points") && e.contains("ratio"),
+        "{e}"
+    );
 }
 
 // ---------------------------------------------------------------- hand-written files
@@ -638,7 +824,11 @@ fn several_pieces_are_merged() {
             x + 1.0
         )
     };
-    let text = format!(r#"<VTKFile type="UnstructuredGrid"><UnstructuredGrid>{}{}</UnstructuredGrid></VTKFile>"#, piece(0.0), piece(5.0));
+    let text = format!(
+        r#"<VTKFile type="UnstructuredGrid"><UnstructuredGrid>{}{}</UnstructuredGrid></VTKFile>"#,
+        piece(0.0),
+        piece(5.0)
+    );
     let m = read_str("two.vtu", &text, Format::XmlUnstructured).unwrap();
     check_mesh(&m);
     assert_eq!(m.cells.nodes(1), &[4, 5, 6, 7]);
@@ -679,30 +869,69 @@ fn pvd_and_series_resolve_sort_and_refuse() {
     let m = io::read(&pvd, &ReadOptions::default()).unwrap();
     assert_eq!(m.cells.len(), 2);
 
-    let series = write(d.path(), "c.vtu.series", r#"{"file-series-version": "1.0", "files": [{"name": "b.vtu", "time": 3}, {"name": "sub/a.vtu", "time": 0.5}]}"#);
+    let series = write(
+        d.path(),
+        "c.vtu.series",
+        r#"{"file-series-version": "1.0", "files": [{"name": "b.vtu", "time": 3}, {"name": "sub/a.vtu", "time": 0.5}]}"#,
+    );
     let steps = io::read_series(&series).unwrap();
-    assert_eq!(steps.iter().map(|s| s.time).collect::<Vec<_>>(), vec![0.5, 3.0]);
+    assert_eq!(
+        steps.iter().map(|s| s.time).collect::<Vec<_>>(),
+        vec![0.5, 3.0]
+    );
 
-    let missing = write(d.path(), "m.series", r#"{"file-series-version": "1.0", "files": [{"name": "gone.vtu", "time": 0}]}"#);
+    let missing = write(
+        d.path(),
+        "m.series",
+        r#"{"file-series-version": "1.0", "files": [{"name": "gone.vtu", "time": 0}]}"#,
+    );
     let e = io::read_series(&missing).unwrap_err().to_string();
-    assert!(e.contains("m.series") && e.contains("files[0]") && e.contains("gone.vtu"), "{e}");
-    let selfref = write(d.path(), "s.pvd", r#"<VTKFile type="Collection"><Collection><DataSet timestep="0" file="s.pvd"/></Collection></VTKFile>"#);
-    let e = io::read(&selfref, &ReadOptions::default()).unwrap_err().to_string();
+    assert!(
+        e.contains("m.series") && e.contains("files[0]") && e.contains("gone.vtu"),
+        "{e}"
+    );
+    let selfref = write(
+        d.path(),
+        "s.pvd",
+        r#"<VTKFile type="Collection"><Collection><DataSet timestep="0" file="s.pvd"/></Collection></VTKFile>"#,
+    );
+    let e = io::read(&selfref, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("s.pvd") && e.contains("itself"), "{e}");
 }
 
 #[test]
 fn pvtu_missing_and_self_pieces() {
     let d = tmp();
-    let p = write(d.path(), "p.pvtu", r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="p.pvtu"/></PUnstructuredGrid></VTKFile>"#);
-    let e = io::read(&p, &ReadOptions::default()).unwrap_err().to_string();
+    let p = write(
+        d.path(),
+        "p.pvtu",
+        r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="p.pvtu"/></PUnstructuredGrid></VTKFile>"#,
+    );
+    let e = io::read(&p, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("p.pvtu") && e.contains("itself"), "{e}");
-    let q = write(d.path(), "q.pvtu", r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="a.vtu"/><Piece Source="gone.vtu"/></PUnstructuredGrid></VTKFile>"#);
+    let q = write(
+        d.path(),
+        "q.pvtu",
+        r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="a.vtu"/><Piece Source="gone.vtu"/></PUnstructuredGrid></VTKFile>"#,
+    );
     write(d.path(), "a.vtu", POLY);
-    let e = io::read(&q, &ReadOptions::default()).unwrap_err().to_string();
-    assert!(e.contains("q.pvtu") && e.contains("piece 1") && e.contains("gone.vtu"), "{e}");
+    let e = io::read(&q, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("q.pvtu") && e.contains("piece 1") && e.contains("gone.vtu"),
+        "{e}"
+    );
     // A piece that is itself a .pvtu pointing back.
-    let r = write(d.path(), "r.pvtu", r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="p.pvtu"/></PUnstructuredGrid></VTKFile>"#);
+    let r = write(
+        d.path(),
+        "r.pvtu",
+        r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="p.pvtu"/></PUnstructuredGrid></VTKFile>"#,
+    );
     assert!(io::read(&r, &ReadOptions::default()).is_err());
 }
 
@@ -725,8 +954,15 @@ fn every_corrupt_xml_file_fails_naming_the_file() {
             Err(e) => e.to_string(),
         };
         eprintln!("{e}");
-        assert!(e.contains(&name), "{name}: error does not name the file: {e}");
-        assert!(t.elapsed().as_secs_f64() < 2.0, "{name} took {:?}", t.elapsed());
+        assert!(
+            e.contains(&name),
+            "{name}: error does not name the file: {e}"
+        );
+        assert!(
+            t.elapsed().as_secs_f64() < 2.0,
+            "{name} took {:?}",
+            t.elapsed()
+        );
         n += 1;
     }
     assert!(n >= 8, "only {n} corrupt xml files");
@@ -749,10 +985,50 @@ impl Rng {
 #[test]
 fn mutations_never_panic() {
     let seeds: Vec<Vec<u8>> = vec![
-        write_sample(&Enc { fmt: Fmt::AppRaw, comp: Comp::Zlib, h64: true, be: false, block: 48 }, "Int64", "UInt8"),
-        write_sample(&Enc { fmt: Fmt::Binary, comp: Comp::Lz4, h64: false, be: true, block: 40 }, "Int32", "Int8"),
-        write_sample(&Enc { fmt: Fmt::AppB64, comp: Comp::None, h64: false, be: false, block: 64 }, "Int32", "UInt8"),
-        write_sample(&Enc { fmt: Fmt::Ascii, comp: Comp::None, h64: false, be: false, block: 64 }, "Int32", "UInt8"),
+        write_sample(
+            &Enc {
+                fmt: Fmt::AppRaw,
+                comp: Comp::Zlib,
+                h64: true,
+                be: false,
+                block: 48,
+            },
+            "Int64",
+            "UInt8",
+        ),
+        write_sample(
+            &Enc {
+                fmt: Fmt::Binary,
+                comp: Comp::Lz4,
+                h64: false,
+                be: true,
+                block: 40,
+            },
+            "Int32",
+            "Int8",
+        ),
+        write_sample(
+            &Enc {
+                fmt: Fmt::AppB64,
+                comp: Comp::None,
+                h64: false,
+                be: false,
+                block: 64,
+            },
+            "Int32",
+            "UInt8",
+        ),
+        write_sample(
+            &Enc {
+                fmt: Fmt::Ascii,
+                comp: Comp::None,
+                h64: false,
+                be: false,
+                block: 64,
+            },
+            "Int32",
+            "UInt8",
+        ),
         POLY.as_bytes().to_vec(),
     ];
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
@@ -779,14 +1055,19 @@ fn mutations_never_panic() {
                 b.drain(i..j);
             }
         }
-        let r = std::panic::catch_unwind(|| xml::read_bytes(Path::new("mut.vtu"), &b, Format::XmlUnstructured));
+        let r = std::panic::catch_unwind(|| {
+            xml::read_bytes(Path::new("mut.vtu"), &b, Format::XmlUnstructured)
+        });
         match r {
             Ok(Ok(m)) => check_mesh(&m),
             Ok(Err(e)) => {
                 assert!(e.to_string().contains("mut.vtu"));
                 errors += 1;
             }
-            Err(_) => panic!("round {round} panicked; input: {:?}", String::from_utf8_lossy(&b)),
+            Err(_) => panic!(
+                "round {round} panicked; input: {:?}",
+                String::from_utf8_lossy(&b)
+            ),
         }
     }
     assert!(errors > total / 4, "mutations should mostly fail: {errors}");

@@ -11,10 +11,18 @@ use libfuzzer_sys::fuzz_target;
 use zoovr::io::{xml, Format};
 
 fuzz_target!(|data: &[u8]| {
-    for format in [Format::XmlUnstructured, Format::XmlStructured, Format::XmlImage] {
+    for format in [
+        Format::XmlUnstructured,
+        Format::XmlStructured,
+        Format::XmlImage,
+    ] {
         if let Ok(m) = xml::read_bytes(Path::new("fuzz.vtu"), data, format) {
             for c in 0..m.cells.len() {
-                assert!(m.cells.nodes(c).iter().all(|&p| (p as usize) < m.points.len()));
+                assert!(m
+                    .cells
+                    .nodes(c)
+                    .iter()
+                    .all(|&p| (p as usize) < m.points.len()));
             }
             for a in &m.point_data {
                 assert_eq!(a.tuples(), m.points.len());

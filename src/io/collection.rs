@@ -42,10 +42,18 @@ fn resolve(coll: &Path, name: &str, at: Location) -> Result<PathBuf, IoError> {
     }
     let file = coll.parent().unwrap_or(Path::new(".")).join(name);
     let canon = std::fs::canonicalize(&file).map_err(|e| {
-        IoError::parse(coll, at.clone(), format!("time step file {} cannot be opened: {e}", file.display()))
+        IoError::parse(
+            coll,
+            at.clone(),
+            format!("time step file {} cannot be opened: {e}", file.display()),
+        )
     })?;
     if std::fs::canonicalize(coll).ok().as_ref() == Some(&canon) {
-        return Err(IoError::parse(coll, at, format!("entry '{name}' refers to the collection itself")));
+        return Err(IoError::parse(
+            coll,
+            at,
+            format!("entry '{name}' refers to the collection itself"),
+        ));
     }
     let lower = name.to_ascii_lowercase();
     if lower.ends_with(".pvd") || lower.ends_with(".series") {
@@ -60,7 +68,11 @@ fn resolve(coll: &Path, name: &str, at: Location) -> Result<PathBuf, IoError> {
 
 fn finish(coll: &Path, mut steps: Vec<TimeStep>) -> Result<Vec<TimeStep>, IoError> {
     if steps.is_empty() {
-        return Err(IoError::parse(coll, Location::None, "the collection lists no time steps"));
+        return Err(IoError::parse(
+            coll,
+            Location::None,
+            "the collection lists no time steps",
+        ));
     }
     steps.sort_by(|a, b| a.time.total_cmp(&b.time));
     Ok(steps)
@@ -70,9 +82,10 @@ fn finish(coll: &Path, mut steps: Vec<TimeStep>) -> Result<Vec<TimeStep>, IoErro
 pub fn read_pvd(path: &Path) -> Result<Vec<TimeStep>, IoError> {
     let bytes = read_small(path)?;
     let doc = dom::parse(path, &bytes)?;
-    let coll = doc.root.child("Collection").ok_or_else(|| {
-        IoError::parse(path, doc.root.location(), "no <Collection> element")
-    })?;
+    let coll = doc
+        .root
+        .child("Collection")
+        .ok_or_else(|| IoError::parse(path, doc.root.location(), "no <Collection> element"))?;
     let mut first_part: Option<String> = None;
     let mut steps = Vec::new();
     for (i, ds) in coll.children_named("DataSet").enumerate() {
@@ -111,11 +124,19 @@ struct SeriesEntry {
 pub fn read_series_json(path: &Path) -> Result<Vec<TimeStep>, IoError> {
     let bytes = read_small(path)?;
     let s: SeriesFile = serde_json::from_slice(&bytes).map_err(|e| {
-        IoError::parse(path, Location::Line(e.line()), format!("bad .series JSON: {e}"))
+        IoError::parse(
+            path,
+            Location::Line(e.line()),
+            format!("bad .series JSON: {e}"),
+        )
     })?;
     if let Some(v) = &s.version {
         if !v.starts_with("1.") {
-            return Err(IoError::parse(path, Location::None, format!("unsupported file-series-version '{v}'")));
+            return Err(IoError::parse(
+                path,
+                Location::None,
+                format!("unsupported file-series-version '{v}'"),
+            ));
         }
     }
     let mut steps = Vec::with_capacity(s.files.len());

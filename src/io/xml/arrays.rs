@@ -73,9 +73,9 @@ pub fn read_points(src: &Source, piece: &Element, np: usize) -> Result<Vec<DVec3
         ));
     }
     let ty = scalar_type(src, arr)?;
-    let want = np.checked_mul(3).ok_or_else(|| {
-        IoError::parse(src.path, piece.location(), "point count overflows")
-    })?;
+    let want = np
+        .checked_mul(3)
+        .ok_or_else(|| IoError::parse(src.path, piece.location(), "point count overflows"))?;
     let xyz: Vec<f64> = src.decode(arr, ty, Some(want))?;
     let points = to_points(&xyz);
     check_finite(src, arr, &points)?;
@@ -123,9 +123,9 @@ pub fn read_arrays(
             continue;
         };
         let nc = components(src, arr)?;
-        let want = ntuples.checked_mul(nc).ok_or_else(|| {
-            IoError::parse(src.path, arr.location(), "array size overflows")
-        })?;
+        let want = ntuples
+            .checked_mul(nc)
+            .ok_or_else(|| IoError::parse(src.path, arr.location(), "array size overflows"))?;
         let data = match ty {
             Scalar::F32 => ArrayData::F32(src.decode(arr, ty, Some(want))?),
             Scalar::F64 => ArrayData::F64(src.decode(arr, ty, Some(want))?),
@@ -151,9 +151,27 @@ pub fn filter_tuples(arrays: &mut [DataArray], keep: &[bool]) {
         let nc = a.components;
         let pick = |i: usize| keep.get(i / nc).copied().unwrap_or(false);
         a.data = match &a.data {
-            ArrayData::F32(v) => ArrayData::F32(v.iter().enumerate().filter(|(i, _)| pick(*i)).map(|(_, x)| *x).collect()),
-            ArrayData::F64(v) => ArrayData::F64(v.iter().enumerate().filter(|(i, _)| pick(*i)).map(|(_, x)| *x).collect()),
-            ArrayData::Int(v) => ArrayData::Int(v.iter().enumerate().filter(|(i, _)| pick(*i)).map(|(_, x)| *x).collect()),
+            ArrayData::F32(v) => ArrayData::F32(
+                v.iter()
+                    .enumerate()
+                    .filter(|(i, _)| pick(*i))
+                    .map(|(_, x)| *x)
+                    .collect(),
+            ),
+            ArrayData::F64(v) => ArrayData::F64(
+                v.iter()
+                    .enumerate()
+                    .filter(|(i, _)| pick(*i))
+                    .map(|(_, x)| *x)
+                    .collect(),
+            ),
+            ArrayData::Int(v) => ArrayData::Int(
+                v.iter()
+                    .enumerate()
+                    .filter(|(i, _)| pick(*i))
+                    .map(|(_, x)| *x)
+                    .collect(),
+            ),
         };
     }
 }
@@ -163,11 +181,34 @@ pub fn filter_tuples(arrays: &mut [DataArray], keep: &[bool]) {
 fn concat(parts: &[&ArrayData]) -> ArrayData {
     let all = |f: fn(&ArrayData) -> bool| parts.iter().all(|p| f(p));
     if all(|p| matches!(p, ArrayData::F32(_))) {
-        ArrayData::F32(parts.iter().flat_map(|p| match p { ArrayData::F32(v) => v.as_slice(), _ => &[] }).copied().collect())
+        ArrayData::F32(
+            parts
+                .iter()
+                .flat_map(|p| match p {
+                    ArrayData::F32(v) => v.as_slice(),
+                    _ => &[],
+                })
+                .copied()
+                .collect(),
+        )
     } else if all(|p| matches!(p, ArrayData::Int(_))) {
-        ArrayData::Int(parts.iter().flat_map(|p| match p { ArrayData::Int(v) => v.as_slice(), _ => &[] }).copied().collect())
+        ArrayData::Int(
+            parts
+                .iter()
+                .flat_map(|p| match p {
+                    ArrayData::Int(v) => v.as_slice(),
+                    _ => &[],
+                })
+                .copied()
+                .collect(),
+        )
     } else {
-        ArrayData::F64(parts.iter().flat_map(|p| (0..p.len()).map(move |i| p.get(i))).collect())
+        ArrayData::F64(
+            parts
+                .iter()
+                .flat_map(|p| (0..p.len()).map(move |i| p.get(i)))
+                .collect(),
+        )
     }
 }
 
@@ -180,10 +221,16 @@ fn merge_arrays(sets: &[&[DataArray]], what: &str, notes: &mut Vec<String>) -> V
     for a in first.iter() {
         let parts: Vec<&DataArray> = sets
             .iter()
-            .filter_map(|s| s.iter().find(|b| b.name == a.name && b.components == a.components))
+            .filter_map(|s| {
+                s.iter()
+                    .find(|b| b.name == a.name && b.components == a.components)
+            })
             .collect();
         if parts.len() != sets.len() {
-            notes.push(format!("{what} array '{}' is missing from some pieces: dropped", a.name));
+            notes.push(format!(
+                "{what} array '{}' is missing from some pieces: dropped",
+                a.name
+            ));
             continue;
         }
         let same_type = parts.iter().all(|p| p.vtk_type == a.vtk_type);
@@ -195,7 +242,12 @@ fn merge_arrays(sets: &[&[DataArray]], what: &str, notes: &mut Vec<String>) -> V
         } else {
             "Int64".to_string()
         };
-        out.push(DataArray { name: a.name.clone(), components: a.components, data, vtk_type });
+        out.push(DataArray {
+            name: a.name.clone(),
+            components: a.components,
+            data,
+            vtk_type,
+        });
     }
     out
 }
@@ -217,7 +269,10 @@ pub fn merge(mut pieces: Vec<Mesh>) -> Mesh {
             m.cells.push(p.cells.kinds[c], &nodes);
         }
         for (&c, faces) in &p.cells.poly_faces {
-            let shifted = faces.iter().map(|f| f.iter().map(|&n| n + base).collect()).collect();
+            let shifted = faces
+                .iter()
+                .map(|f| f.iter().map(|&n| n + base).collect())
+                .collect();
             m.cells.poly_faces.insert(c + cbase, shifted);
         }
         for (k, v) in &p.source.cells_by_type {

@@ -65,7 +65,10 @@ impl Element {
     /// byte offset.
     pub fn location(&self) -> Location {
         match self.attr("Name") {
-            Some(n) => Location::Element(format!("<{} Name=\"{}\"> at byte {}", self.name, n, self.pos)),
+            Some(n) => Location::Element(format!(
+                "<{} Name=\"{}\"> at byte {}",
+                self.name, n, self.pos
+            )),
             None => Location::Element(format!("<{}> at byte {}", self.name, self.pos)),
         }
     }
@@ -113,7 +116,9 @@ fn start_element(path: &Path, e: &BytesStart<'_>, pos: usize) -> Result<Element,
             IoError::parse(
                 path,
                 Location::Element(format!("<{}> at byte {pos}, attribute {key}", el.name)),
-                format!("bad attribute value: {err} (only the predefined XML entities are accepted)"),
+                format!(
+                    "bad attribute value: {err} (only the predefined XML entities are accepted)"
+                ),
             )
         })?;
         el.attrs.push((key, value.into_owned()));
@@ -253,7 +258,8 @@ pub fn parse<'a>(path: &Path, bytes: &'a [u8]) -> Result<Document<'a>, IoError> 
     while let Some(el) = stack.pop() {
         attach(&mut stack, &mut root, el);
     }
-    let root = root.ok_or_else(|| IoError::parse(path, Location::Byte(0), "no XML element found"))?;
+    let root =
+        root.ok_or_else(|| IoError::parse(path, Location::Byte(0), "no XML element found"))?;
     if root.name != "VTKFile" {
         return Err(IoError::parse(
             path,
@@ -283,7 +289,8 @@ mod tests {
 
     #[test]
     fn entities_are_refused() {
-        let src = b"<?xml version=\"1.0\"?><!DOCTYPE lolz [<!ENTITY lol \"lol\">]><VTKFile a=\"&lol;\"/>";
+        let src =
+            b"<?xml version=\"1.0\"?><!DOCTYPE lolz [<!ENTITY lol \"lol\">]><VTKFile a=\"&lol;\"/>";
         let e = parse(Path::new("evil.vtu"), src).unwrap_err().to_string();
         assert!(e.contains("evil.vtu") && e.contains("entit"), "{e}");
         let src = b"<VTKFile a=\"&lol;\"/>";

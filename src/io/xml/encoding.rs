@@ -34,6 +34,8 @@ use base64::engine::{DecodePaddingMode, Engine, GeneralPurpose, GeneralPurposeCo
 use rayon::prelude::*;
 
 use super::dom::{Appended, AppendedEncoding, Element};
+use super::scalar::{convert_bytes, convert_par};
+pub use super::scalar::{Scalar, Target};
 use crate::io::IoError;
 
 /// Deflate's maximum compression ratio (a 258-byte match per 2 bits).
@@ -42,8 +44,6 @@ const ZLIB_MAX_RATIO: u64 = 1032;
 const LZ4_MAX_RATIO: u64 = 255;
 /// Slack per block on top of the ratio bound (stream headers, tiny blocks).
 const BLOCK_SLACK: u64 = 64;
-/// Values converted per parallel task.
-const CONVERT_CHUNK: usize = 1 << 16;
 /// Base64 characters decoded per parallel task (a multiple of 4).
 const B64_CHUNK: usize = 1 << 20;
 
@@ -53,66 +53,6 @@ const B64: GeneralPurpose = GeneralPurpose::new(
         .with_decode_padding_mode(DecodePaddingMode::Indifferent)
         .with_decode_allow_trailing_bits(true),
 );
-
-/// A VTK XML scalar type.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Scalar {
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    I64,
-    U64,
-    F32,
-    F64,
-}
-
-impl Scalar {
-    /// Parses a `type=` attribute (`Float32`, `Int64`, ...).
-    pub fn parse(s: &str) -> Option<Scalar> {
-        Some(match s {
-            "Int8" | "Char" => Scalar::I8,
-            "UInt8" | "UnsignedChar" => Scalar::U8,
-            "Int16" => Scalar::I16,
-            "UInt16" => Scalar::U16,
-            "Int32" => Scalar::I32,
-            "UInt32" => Scalar::U32,
-            "Int64" | "IdType" => Scalar::I64,
-            "UInt64" => Scalar::U64,
-            "Float32" => Scalar::F32,
-            "Float64" => Scalar::F64,
-            _ => return None,
-        })
-    }
-
-    /// Bytes per value.
-    pub fn size(self) -> usize {
-        match self {
-            Scalar::I8 | Scalar::U8 => 1,
-            Scalar::I16 | Scalar::U16 => 2,
-            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
-            Scalar::I64 | Scalar::U64 | Scalar::F64 => 8,
-        }
-    }
-
-    /// The VTK name (as [`crate::field::DataArray::vtk_type`] stores it).
-    pub fn name(self) -> &'static str {
-        match self {
-            Scalar::I8 => "Int8",
-            Scalar::U8 => "UInt8",
-            Scalar::I16 => "Int16",
-            Scalar::U16 => "UInt16",
-            Scalar::I32 => "Int32",
-            Scalar::U32 => "UInt32",
-            Scalar::I64 => "Int64",
-            Scalar::U64 => "UInt64",
-            Scalar::F32 => "Float32",
-            Scalar::F64 => "Float64",
-        }
-    }
-}
 
 /// The file's compressor.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -152,130 +92,6 @@ impl Codec {
             (false, true) => u32::from_be_bytes(b.try_into().ok()?) as u64,
         })
     }
-}
-
-/// A value type arrays are decoded into. Out-of-range integers map to a
-/// sentinel the caller rejects (`u32::MAX`, `u8::MAX`) rather than wrapping.
-pub trait Target: Copy + Default + Send + Sync {
-    fn from_i64(v: i64) -> Self;
-    fn from_u64(v: u64) -> Self;
-    fn from_f64(v: f64) -> Self;
-    fn from_f32(v: f32) -> Self {
-        Self::from_f64(v as f64)
-    }
-}
-
-impl Target for f64 {
-    fn from_i64(v: i64) -> Self {
-        v as f64
-    }
-    fn from_u64(v: u64) -> Self {
-        v as f64
-    }
-    fn from_f64(v: f64) -> Self {
-        v
-    }
-}
-
-impl Target for f32 {
-    fn from_i64(v: i64) -> Self {
-        v as f32
-    }
-    fn from_u64(v: u64) -> Self {
-        v as f32
-    }
-    fn from_f64(v: f64) -> Self {
-        v as f32
-    }
-    fn from_f32(v: f32) -> Self {
-        v
-    }
-}
-
-impl Target for i64 {
-    fn from_i64(v: i64) -> Self {
-        v
-    }
-    fn from_u64(v: u64) -> Self {
-        i64::try_from(v).unwrap_or(i64::MAX)
-    }
-    fn from_f64(v: f64) -> Self {
-        v as i64
-    }
-}
-
-impl Target for u32 {
-    fn from_i64(v: i64) -> Self {
-        u32::try_from(v).unwrap_or(u32::MAX)
-    }
-    fn from_u64(v: u64) -> Self {
-        u32::try_from(v).unwrap_or(u32::MAX)
-    }
-    fn from_f64(v: f64) -> Self {
-        if v.fract() == 0.0 && (0.0..u32::MAX as f64).contains(&v) {
-            v as u32
-        } else {
-            u32::MAX
-        }
-    }
-}
-
-impl Target for u8 {
-    fn from_i64(v: i64) -> Self {
-        u8::try_from(v).unwrap_or(u8::MAX)
-    }
-    fn from_u64(v: u64) -> Self {
-        u8::try_from(v).unwrap_or(u8::MAX)
-    }
-    fn from_f64(v: f64) -> Self {
-        if v.fract() == 0.0 && (0.0..255.0).contains(&v) {
-            v as u8
-        } else {
-            u8::MAX
-        }
-    }
-}
-
-macro_rules! convert_as {
-    ($src:expr, $out:expr, $be:expr, $t:ty, $f:ident) => {{
-        const S: usize = std::mem::size_of::<$t>();
-        for (o, c) in $out.iter_mut().zip($src.chunks_exact(S)) {
-            let mut a = [0u8; S];
-            a.copy_from_slice(c);
-            let v = if $be {
-                <$t>::from_be_bytes(a)
-            } else {
-                <$t>::from_le_bytes(a)
-            };
-            *o = T::$f(v.into());
-        }
-    }};
-}
-
-/// Converts `src` (values of `ty`, `src.len() == out.len() * ty.size()`).
-fn convert_bytes<T: Target>(src: &[u8], ty: Scalar, be: bool, out: &mut [T]) {
-    match ty {
-        Scalar::I8 => convert_as!(src, out, be, i8, from_i64),
-        Scalar::U8 => convert_as!(src, out, be, u8, from_u64),
-        Scalar::I16 => convert_as!(src, out, be, i16, from_i64),
-        Scalar::U16 => convert_as!(src, out, be, u16, from_u64),
-        Scalar::I32 => convert_as!(src, out, be, i32, from_i64),
-        Scalar::U32 => convert_as!(src, out, be, u32, from_u64),
-        Scalar::I64 => convert_as!(src, out, be, i64, from_i64),
-        Scalar::U64 => convert_as!(src, out, be, u64, from_u64),
-        Scalar::F32 => convert_as!(src, out, be, f32, from_f32),
-        Scalar::F64 => convert_as!(src, out, be, f64, from_f64),
-    }
-}
-
-/// [`convert_bytes`] in parallel chunks, into a new `Vec`.
-fn convert_par<T: Target>(src: &[u8], ty: Scalar, be: bool) -> Vec<T> {
-    let n = src.len() / ty.size();
-    let mut out = vec![T::default(); n];
-    out.par_chunks_mut(CONVERT_CHUNK)
-        .zip(src.par_chunks(CONVERT_CHUNK * ty.size()))
-        .for_each(|(o, s)| convert_bytes(s, ty, be, o));
-    out
 }
 
 /// Base64 length of `n` bytes (padded).
@@ -343,7 +159,12 @@ impl<'a> Source<'a> {
             "binary" => {
                 let text = self.text(el);
                 let compact: Cow<[u8]> = if text.iter().any(u8::is_ascii_whitespace) {
-                    Cow::Owned(text.iter().copied().filter(|b| !b.is_ascii_whitespace()).collect())
+                    Cow::Owned(
+                        text.iter()
+                            .copied()
+                            .filter(|b| !b.is_ascii_whitespace())
+                            .collect(),
+                    )
                 } else {
                     text
                 };
@@ -354,9 +175,9 @@ impl<'a> Source<'a> {
                     .attr("offset")
                     .and_then(|o| o.trim().parse().ok())
                     .ok_or_else(|| err("appended DataArray without a valid offset".into()))?;
-                let ap = self
-                    .appended
-                    .ok_or_else(|| err("format=\"appended\" but the file has no <AppendedData>".into()))?;
+                let ap = self.appended.ok_or_else(|| {
+                    err("format=\"appended\" but the file has no <AppendedData>".into())
+                })?;
                 let data = ap.data.get(off..).ok_or_else(|| {
                     err(format!(
                         "appended offset {off} is beyond the appended data ({} bytes from byte {})",
@@ -395,7 +216,12 @@ impl<'a> Source<'a> {
     }
 
     /// A raw (appended) payload starting at `data[0]`.
-    fn raw<T: Target>(&self, data: &[u8], ty: Scalar, expected: Option<usize>) -> Result<Vec<T>, String> {
+    fn raw<T: Target>(
+        &self,
+        data: &[u8],
+        ty: Scalar,
+        expected: Option<usize>,
+    ) -> Result<Vec<T>, String> {
         let c = self.codec;
         if c.compressor == Compressor::None {
             let size = c.word(data, 0).ok_or("truncated: no size header")?;
@@ -415,7 +241,12 @@ impl<'a> Source<'a> {
     }
 
     /// A base64 payload (inline text, or appended text from the offset on).
-    fn base64<T: Target>(&self, text: &[u8], ty: Scalar, expected: Option<usize>) -> Result<Vec<T>, String> {
+    fn base64<T: Target>(
+        &self,
+        text: &[u8],
+        ty: Scalar,
+        expected: Option<usize>,
+    ) -> Result<Vec<T>, String> {
         let c = self.codec;
         let hs = c.hsize();
         let hc = enc_len(hs);
@@ -430,7 +261,12 @@ impl<'a> Source<'a> {
                     format!("header claims {size} bytes but the base64 text is shorter")
                 })?;
                 let body = b64_decode(t)?;
-                return uncompressed(body.get(..size as usize).ok_or("base64 text too short")?, ty, c.big_endian, expected);
+                return uncompressed(
+                    body.get(..size as usize).ok_or("base64 text too short")?,
+                    ty,
+                    c.big_endian,
+                    expected,
+                );
             }
             let h = b64_decode(&text[..hc.min(text.len())])?;
             let size = c.word(&h, 0).ok_or("bad size header")?;
@@ -446,7 +282,9 @@ impl<'a> Source<'a> {
             return uncompressed(body, ty, c.big_endian, expected);
         }
         // Compressed: [nblocks, bs, last] tells the header length.
-        let first = text.get(..enc_len(3 * hs)).ok_or("truncated compression header")?;
+        let first = text
+            .get(..enc_len(3 * hs))
+            .ok_or("truncated compression header")?;
         let h3 = b64_decode(first)?;
         let nb = c.word(&h3, 0).ok_or("bad compression header")?;
         let hdr_len = header_len(nb, hs, text.len() / 4 * 3)?;
@@ -476,7 +314,9 @@ impl<'a> Source<'a> {
             return Err("compression header: block size 0".into());
         }
         if last > bs {
-            return Err(format!("compression header: last block size {last} > block size {bs}"));
+            return Err(format!(
+                "compression header: last block size {last} > block size {bs}"
+            ));
         }
         let mut usizes = vec![bs; nb];
         if let Some(l) = usizes.last_mut() {
@@ -527,12 +367,17 @@ impl<'a> Source<'a> {
         let total = hdr.total();
         let es = ty.size() as u64;
         if total % es != 0 {
-            return Err(format!("{total} decompressed bytes is not a whole number of {} values", ty.name()));
+            return Err(format!(
+                "{total} decompressed bytes is not a whole number of {} values",
+                ty.name()
+            ));
         }
         let n = (total / es) as usize;
         if let Some(want) = expected {
             if want != n {
-                return Err(format!("compression header gives {n} values, expected {want}"));
+                return Err(format!(
+                    "compression header gives {n} values, expected {want}"
+                ));
             }
         }
         let comp = c.compressor;
@@ -553,7 +398,8 @@ impl<'a> Source<'a> {
                             return Err(format!("compressed block {i}: inconsistent block sizes"));
                         }
                         scratch.resize(us, 0u8);
-                        inflate_block(comp, src, scratch, dec).map_err(|m| format!("compressed block {i}: {m}"))?;
+                        inflate_block(comp, src, scratch, dec)
+                            .map_err(|m| format!("compressed block {i}: {m}"))?;
                         convert_bytes(scratch, ty, be, o);
                         Ok(())
                     },
@@ -569,7 +415,8 @@ impl<'a> Source<'a> {
                         if us != o.len() {
                             return Err(format!("compressed block {i}: inconsistent block sizes"));
                         }
-                        inflate_block(comp, src, o, dec).map_err(|m| format!("compressed block {i}: {m}"))
+                        inflate_block(comp, src, o, dec)
+                            .map_err(|m| format!("compressed block {i}: {m}"))
                     },
                 )?;
             out = convert_par(&raw, ty, be);
@@ -584,7 +431,9 @@ fn header_len(nb: u64, hs: usize, avail: usize) -> Result<usize, String> {
         .checked_add(3)
         .and_then(|w| w.checked_mul(hs as u64))
         .filter(|&l| l <= avail as u64)
-        .ok_or_else(|| format!("compression header claims {nb} blocks but only {avail} bytes remain"))?;
+        .ok_or_else(|| {
+            format!("compression header claims {nb} blocks but only {avail} bytes remain")
+        })?;
     Ok(len as usize)
 }
 
@@ -613,9 +462,13 @@ fn inflate_block(
             Ok(())
         }
         Compressor::Lz4 => {
-            let n = lz4_flex::block::decompress_into(src, dst).map_err(|e| format!("corrupt LZ4 block: {e}"))?;
+            let n = lz4_flex::block::decompress_into(src, dst)
+                .map_err(|e| format!("corrupt LZ4 block: {e}"))?;
             if n != dst.len() {
-                return Err(format!("LZ4 block gives {n} bytes, header says {}", dst.len()));
+                return Err(format!(
+                    "LZ4 block gives {n} bytes, header says {}",
+                    dst.len()
+                ));
             }
             Ok(())
         }
@@ -624,9 +477,18 @@ fn inflate_block(
 }
 
 /// Converts an uncompressed payload, checking its size.
-fn uncompressed<T: Target>(body: &[u8], ty: Scalar, be: bool, expected: Option<usize>) -> Result<Vec<T>, String> {
+fn uncompressed<T: Target>(
+    body: &[u8],
+    ty: Scalar,
+    be: bool,
+    expected: Option<usize>,
+) -> Result<Vec<T>, String> {
     if body.len() % ty.size() != 0 {
-        return Err(format!("{} bytes is not a whole number of {} values", body.len(), ty.name()));
+        return Err(format!(
+            "{} bytes is not a whole number of {} values",
+            body.len(),
+            ty.name()
+        ));
     }
     let n = body.len() / ty.size();
     if let Some(want) = expected {
@@ -651,11 +513,19 @@ fn ascii<T: Target>(text: &[u8], ty: Scalar, expected: Option<usize>) -> Result<
     }
     let mut out = Vec::with_capacity(expected.unwrap_or(0));
     for (i, tok) in s.split_ascii_whitespace().enumerate() {
-        let bad = || format!("bad {} value '{}' at index {i}", ty.name(), tok.chars().take(32).collect::<String>());
+        let bad = || {
+            format!(
+                "bad {} value '{}' at index {i}",
+                ty.name(),
+                tok.chars().take(32).collect::<String>()
+            )
+        };
         let v = match ty {
             Scalar::F32 => T::from_f32(tok.parse::<f32>().map_err(|_| bad())?),
             Scalar::F64 => T::from_f64(tok.parse::<f64>().map_err(|_| bad())?),
-            Scalar::U8 | Scalar::U16 | Scalar::U32 | Scalar::U64 => T::from_u64(tok.parse::<u64>().map_err(|_| bad())?),
+            Scalar::U8 | Scalar::U16 | Scalar::U32 | Scalar::U64 => {
+                T::from_u64(tok.parse::<u64>().map_err(|_| bad())?)
+            }
             _ => T::from_i64(tok.parse::<i64>().map_err(|_| bad())?),
         };
         out.push(v);
@@ -673,21 +543,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn conversion_is_exact_and_saturates() {
-        let src: Vec<u8> = [-1i64, 7, 1 << 40].iter().flat_map(|v| v.to_be_bytes()).collect();
-        let mut out = [0u32; 3];
-        convert_bytes(&src, Scalar::I64, true, &mut out);
-        assert_eq!(out, [u32::MAX, 7, u32::MAX]);
-        let f = 0.1f32;
-        let mut o = [0f32; 1];
-        convert_bytes(&f.to_le_bytes(), Scalar::F32, false, &mut o);
-        assert_eq!(o[0].to_bits(), f.to_bits());
-    }
-
-    #[test]
     fn base64_parallel_matches_serial() {
         use base64::engine::general_purpose::STANDARD;
-        let data: Vec<u8> = (0..3_000_001u32).map(|i| (i.wrapping_mul(2654435761) >> 13) as u8).collect();
+        let data: Vec<u8> = (0..3_000_001u32)
+            .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
+            .collect();
         let text = STANDARD.encode(&data);
         assert_eq!(b64_decode(text.as_bytes()).unwrap(), data);
         assert!(b64_decode(b"ab!d").is_err());

@@ -23,6 +23,7 @@ mod arrays;
 pub(crate) mod dom;
 mod encoding;
 mod parallel;
+mod scalar;
 mod structured;
 mod unstructured;
 
@@ -68,7 +69,11 @@ fn read_nested(path: &Path, bytes: &[u8], format: Format, depth: usize) -> Resul
         appended: doc.appended,
     };
     let grid = root.child(&kind).ok_or_else(|| {
-        IoError::parse(path, root.location(), format!("<VTKFile type=\"{kind}\"> has no <{kind}> element"))
+        IoError::parse(
+            path,
+            root.location(),
+            format!("<VTKFile type=\"{kind}\"> has no <{kind}> element"),
+        )
     })?;
     let pieces = match kind.as_str() {
         "UnstructuredGrid" => grid
@@ -97,14 +102,20 @@ fn read_nested(path: &Path, bytes: &[u8], format: Format, depth: usize) -> Resul
 fn merge_checked(path: &Path, grid: &dom::Element, pieces: Vec<Mesh>) -> Result<Mesh, IoError> {
     let total: u64 = pieces.iter().map(|p| p.points.len() as u64).sum();
     if total > unstructured::MAX_COUNT {
-        return Err(IoError::parse(path, grid.location(), format!("{total} points in all pieces: too many")));
+        return Err(IoError::parse(
+            path,
+            grid.location(),
+            format!("{total} points in all pieces: too many"),
+        ));
     }
     Ok(arrays::merge(pieces))
 }
 
 /// The encoding settings of `<VTKFile>`.
 fn codec(path: &Path, root: &dom::Element) -> Result<Codec, IoError> {
-    let bad = |key: &str, v: &str| IoError::parse(path, root.location(), format!("unsupported {key} '{v}'"));
+    let bad = |key: &str, v: &str| {
+        IoError::parse(path, root.location(), format!("unsupported {key} '{v}'"))
+    };
     let big_endian = match root.attr("byte_order").unwrap_or("LittleEndian") {
         "LittleEndian" => false,
         "BigEndian" => true,

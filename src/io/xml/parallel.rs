@@ -34,7 +34,11 @@ pub fn read(path: &Path, grid: &Element, depth: usize) -> Result<Mesh, IoError> 
         .map(|(i, p)| {
             let s = p.attr("Source").unwrap_or("");
             if s.trim().is_empty() {
-                return Err(IoError::parse(path, p.location(), format!("piece {i} has no Source")));
+                return Err(IoError::parse(
+                    path,
+                    p.location(),
+                    format!("piece {i} has no Source"),
+                ));
             }
             Ok((i, p, dir.join(s.trim())))
         })
@@ -45,18 +49,40 @@ pub fn read(path: &Path, grid: &Element, depth: usize) -> Result<Mesh, IoError> 
     let meshes = pieces
         .par_iter()
         .map(|(i, p, file)| {
-            let at = || Location::Element(format!("piece {i} (Source=\"{}\") at byte {}", p.attr("Source").unwrap_or(""), p.pos));
+            let at = || {
+                Location::Element(format!(
+                    "piece {i} (Source=\"{}\") at byte {}",
+                    p.attr("Source").unwrap_or(""),
+                    p.pos
+                ))
+            };
             let canon = std::fs::canonicalize(file).map_err(|e| {
-                IoError::parse(path, at(), format!("piece file {} cannot be opened: {e}", file.display()))
+                IoError::parse(
+                    path,
+                    at(),
+                    format!("piece file {} cannot be opened: {e}", file.display()),
+                )
             })?;
             if Some(&canon) == me.as_ref() {
-                return Err(IoError::parse(path, at(), "the piece is the .pvtu file itself"));
+                return Err(IoError::parse(
+                    path,
+                    at(),
+                    "the piece is the .pvtu file itself",
+                ));
             }
             if !canon.is_file() {
-                return Err(IoError::parse(path, at(), format!("piece {} is not a regular file", file.display())));
+                return Err(IoError::parse(
+                    path,
+                    at(),
+                    format!("piece {} is not a regular file", file.display()),
+                ));
             }
             let bytes = std::fs::read(file).map_err(|e| {
-                IoError::parse(path, at(), format!("piece file {} cannot be read: {e}", file.display()))
+                IoError::parse(
+                    path,
+                    at(),
+                    format!("piece file {} cannot be read: {e}", file.display()),
+                )
             })?;
             super::read_nested(file, &bytes, Format::XmlUnstructured, depth + 1)
                 .map_err(|e| IoError::parse(path, at(), format!("piece failed: {e}")))
@@ -64,10 +90,14 @@ pub fn read(path: &Path, grid: &Element, depth: usize) -> Result<Mesh, IoError> 
         .collect::<Result<Vec<Mesh>, IoError>>()?;
     let mut mesh = super::merge_checked(path, grid, meshes)?;
     let active = |el: Option<&Element>| el.and_then(|e| e.attr("Scalars")).map(str::to_string);
-    if let Some(s) = active(grid.child("PPointData")).filter(|s| mesh.point_data.iter().any(|a| &a.name == s)) {
+    if let Some(s) =
+        active(grid.child("PPointData")).filter(|s| mesh.point_data.iter().any(|a| &a.name == s))
+    {
         mesh.active_point_scalars = Some(s);
     }
-    if let Some(s) = active(grid.child("PCellData")).filter(|s| mesh.cell_data.iter().any(|a| &a.name == s)) {
+    if let Some(s) =
+        active(grid.child("PCellData")).filter(|s| mesh.cell_data.iter().any(|a| &a.name == s))
+    {
         mesh.active_cell_scalars = Some(s);
     }
     Ok(mesh)

@@ -34,53 +34,92 @@ pub enum Lattice {
 /// bytes present instead.
 const MAX_GENERATED_POINTS: u64 = 1 << 26;
 
-fn parse_numbers<const N: usize>(src: &Source, el: &Element, key: &str) -> Result<Option<[f64; N]>, IoError> {
+fn parse_numbers<const N: usize>(
+    src: &Source,
+    el: &Element,
+    key: &str,
+) -> Result<Option<[f64; N]>, IoError> {
     let Some(s) = el.attr(key) else {
         return Ok(None);
     };
-    let v: Vec<f64> = s.split_ascii_whitespace().filter_map(|t| t.parse().ok()).collect();
+    let v: Vec<f64> = s
+        .split_ascii_whitespace()
+        .filter_map(|t| t.parse().ok())
+        .collect();
     if v.len() != N || v.iter().any(|x| !x.is_finite()) {
-        return Err(IoError::parse(src.path, el.location(), format!("bad {key} '{s}': expected {N} numbers")));
+        return Err(IoError::parse(
+            src.path,
+            el.location(),
+            format!("bad {key} '{s}': expected {N} numbers"),
+        ));
     }
     Ok(Some(std::array::from_fn(|i| v[i])))
 }
 
 /// The piece's extent as point counts per axis and the first index.
-fn extent(src: &Source, grid: &Element, piece: &Element) -> Result<([usize; 3], [i64; 3]), IoError> {
-    let s = piece.attr("Extent").or_else(|| grid.attr("WholeExtent")).unwrap_or("");
-    let v: Vec<i64> = s.split_ascii_whitespace().filter_map(|t| t.parse().ok()).collect();
+fn extent(
+    src: &Source,
+    grid: &Element,
+    piece: &Element,
+) -> Result<([usize; 3], [i64; 3]), IoError> {
+    let s = piece
+        .attr("Extent")
+        .or_else(|| grid.attr("WholeExtent"))
+        .unwrap_or("");
+    let v: Vec<i64> = s
+        .split_ascii_whitespace()
+        .filter_map(|t| t.parse().ok())
+        .collect();
     let bad = || IoError::parse(src.path, piece.location(), format!("bad Extent '{s}'"));
     if v.len() != 6 {
         return Err(bad());
     }
     let mut dims = [0usize; 3];
     for a in 0..3 {
-        let n = v[2 * a + 1].checked_sub(v[2 * a]).and_then(|d| d.checked_add(1)).ok_or_else(bad)?;
+        let n = v[2 * a + 1]
+            .checked_sub(v[2 * a])
+            .and_then(|d| d.checked_add(1))
+            .ok_or_else(bad)?;
         if n < 1 || n > u32::MAX as i64 {
             return Err(bad());
         }
         dims[a] = n as usize;
     }
-    let np = dims.iter().try_fold(1u64, |acc, &d| acc.checked_mul(d as u64));
+    let np = dims
+        .iter()
+        .try_fold(1u64, |acc, &d| acc.checked_mul(d as u64));
     match np {
         Some(n) if n <= super::unstructured::MAX_COUNT => Ok((dims, [v[0], v[2], v[4]])),
-        _ => Err(IoError::parse(src.path, piece.location(), format!("Extent '{s}' gives too many points"))),
+        _ => Err(IoError::parse(
+            src.path,
+            piece.location(),
+            format!("Extent '{s}' gives too many points"),
+        )),
     }
 }
 
 /// Reads every piece of a lattice dataset.
 pub fn read(src: &Source, grid: &Element, lattice: Lattice) -> Result<Vec<Mesh>, IoError> {
-    grid.children_named("Piece").map(|p| read_piece(src, grid, p, lattice)).collect()
+    grid.children_named("Piece")
+        .map(|p| read_piece(src, grid, p, lattice))
+        .collect()
 }
 
-fn read_piece(src: &Source, grid: &Element, piece: &Element, lattice: Lattice) -> Result<Mesh, IoError> {
+fn read_piece(
+    src: &Source,
+    grid: &Element,
+    piece: &Element,
+    lattice: Lattice,
+) -> Result<Mesh, IoError> {
     let (dims, first) = extent(src, grid, piece)?;
     let np = dims[0] * dims[1] * dims[2];
     if lattice != Lattice::Structured && np as u64 > MAX_GENERATED_POINTS {
         return Err(IoError::parse(
             src.path,
             piece.location(),
-            format!("extent gives {np} points, more than the {MAX_GENERATED_POINTS} zoovr generates"),
+            format!(
+                "extent gives {np} points, more than the {MAX_GENERATED_POINTS} zoovr generates"
+            ),
         ));
     }
     let points = match lattice {
@@ -99,7 +138,9 @@ fn read_piece(src: &Source, grid: &Element, piece: &Element, lattice: Lattice) -
     let (mut cd, ca) = read_arrays(src, piece.child("CellData"), file_cells, &mut notes)?;
     if solid {
         mesh.cells = hexes(dims);
-        mesh.source.cells_by_type.insert(CellKind::Hexahedron.vtk_name().to_string(), file_cells);
+        mesh.source
+            .cells_by_type
+            .insert(CellKind::Hexahedron.vtk_name().to_string(), file_cells);
     } else {
         mesh.source.ignored_cells = file_cells;
         super::arrays::filter_tuples(&mut cd, &[]);
@@ -142,22 +183,42 @@ fn hexes(dims: [usize; 3]) -> Cells {
     }
 }
 
-fn rectilinear_points(src: &Source, piece: &Element, dims: [usize; 3]) -> Result<Vec<DVec3>, IoError> {
+fn rectilinear_points(
+    src: &Source,
+    piece: &Element,
+    dims: [usize; 3],
+) -> Result<Vec<DVec3>, IoError> {
     let coords = piece.child("Coordinates").ok_or_else(|| {
-        IoError::parse(src.path, piece.location(), "RectilinearGrid piece without <Coordinates>")
+        IoError::parse(
+            src.path,
+            piece.location(),
+            "RectilinearGrid piece without <Coordinates>",
+        )
     })?;
     let arrays: Vec<&Element> = coords.children_named("DataArray").collect();
     if arrays.len() != 3 {
-        return Err(IoError::parse(src.path, coords.location(), "<Coordinates> needs 3 arrays"));
+        return Err(IoError::parse(
+            src.path,
+            coords.location(),
+            "<Coordinates> needs 3 arrays",
+        ));
     }
     let mut axes: [Vec<f64>; 3] = Default::default();
     for a in 0..3 {
         if components(src, arrays[a])? != 1 {
-            return Err(IoError::parse(src.path, arrays[a].location(), "coordinate arrays have 1 component"));
+            return Err(IoError::parse(
+                src.path,
+                arrays[a].location(),
+                "coordinate arrays have 1 component",
+            ));
         }
         axes[a] = src.decode(arrays[a], scalar_type(src, arrays[a])?, Some(dims[a]))?;
         if axes[a].iter().any(|v| !v.is_finite()) {
-            return Err(IoError::parse(src.path, arrays[a].location(), "non-finite coordinate"));
+            return Err(IoError::parse(
+                src.path,
+                arrays[a].location(),
+                "non-finite coordinate",
+            ));
         }
     }
     let mut pts = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
@@ -171,7 +232,12 @@ fn rectilinear_points(src: &Source, piece: &Element, dims: [usize; 3]) -> Result
     Ok(pts)
 }
 
-fn image_points(src: &Source, grid: &Element, dims: [usize; 3], first: [i64; 3]) -> Result<Vec<DVec3>, IoError> {
+fn image_points(
+    src: &Source,
+    grid: &Element,
+    dims: [usize; 3],
+    first: [i64; 3],
+) -> Result<Vec<DVec3>, IoError> {
     let origin = DVec3::from(parse_numbers::<3>(src, grid, "Origin")?.unwrap_or([0.0; 3]));
     let spacing = DVec3::from(parse_numbers::<3>(src, grid, "Spacing")?.unwrap_or([1.0; 3]));
     let dir = parse_numbers::<9>(src, grid, "Direction")?

@@ -42,8 +42,16 @@ struct Spec {
 
 fn spec(code: u8) -> Option<Spec> {
     use CellKind::*;
-    let s = |kind, counts| Spec { kind, counts, at_least: false };
-    let hi = |kind, counts| Spec { kind, counts, at_least: true };
+    let s = |kind, counts| Spec {
+        kind,
+        counts,
+        at_least: false,
+    };
+    let hi = |kind, counts| Spec {
+        kind,
+        counts,
+        at_least: true,
+    };
     Some(match code {
         10 => s(Tetra, &[4, 10]),
         11 => s(Hexahedron, &[8]),
@@ -87,9 +95,11 @@ fn lower_dim(code: u8) -> bool {
 /// A count attribute such as `NumberOfPoints` (`+11047` is accepted).
 pub fn count_attr(src: &Source, el: &Element, key: &str) -> Result<usize, IoError> {
     let raw = el.attr(key).unwrap_or("0").trim();
-    let v: u64 = raw.strip_prefix('+').unwrap_or(raw).parse().map_err(|_| {
-        IoError::parse(src.path, el.location(), format!("bad {key} '{raw}'"))
-    })?;
+    let v: u64 = raw
+        .strip_prefix('+')
+        .unwrap_or(raw)
+        .parse()
+        .map_err(|_| IoError::parse(src.path, el.location(), format!("bad {key} '{raw}'")))?;
     if v > MAX_COUNT {
         return Err(IoError::parse(
             src.path,
@@ -143,11 +153,19 @@ fn read_cells(
         return Ok(None);
     }
     let cells_el = piece.child("Cells").ok_or_else(|| {
-        IoError::parse(src.path, piece.location(), format!("{nc} cells declared but no <Cells>"))
+        IoError::parse(
+            src.path,
+            piece.location(),
+            format!("{nc} cells declared but no <Cells>"),
+        )
     })?;
     let need = |name: &str| {
         cells_array(cells_el, name).ok_or_else(|| {
-            IoError::parse(src.path, cells_el.location(), format!("<Cells> has no '{name}' array"))
+            IoError::parse(
+                src.path,
+                cells_el.location(),
+                format!("<Cells> has no '{name}' array"),
+            )
         })
     };
     let (types_el, offsets_el, conn_el) = (need("types")?, need("offsets")?, need("connectivity")?);
@@ -157,7 +175,10 @@ fn read_cells(
     let mut prev = 0u32;
     for (i, &o) in offsets.iter().enumerate() {
         if o == u32::MAX || o < prev {
-            return Err(bad(offsets_el, format!("offset {o} of cell {i} is out of range or decreasing (previous {prev})")));
+            return Err(bad(
+                offsets_el,
+                format!("offset {o} of cell {i} is out of range or decreasing (previous {prev})"),
+            ));
         }
         prev = o;
     }
@@ -168,7 +189,10 @@ fn read_cells(
             u32::MAX => "a negative or huge id".to_string(),
             v => format!("point {v}"),
         };
-        return Err(bad(conn_el, format!("cell {cell} refers to {id} but there are {np} points")));
+        return Err(bad(
+            conn_el,
+            format!("cell {cell} refers to {id} but there are {np} points"),
+        ));
     }
     let linear = |t: u8| matches!(t, 10 | 12 | 13 | 14 | 15 | 16);
     if types.iter().all(|&t| linear(t)) {
@@ -203,7 +227,11 @@ fn fast_path(
             return Err(IoError::parse(
                 src.path,
                 el.location(),
-                format!("cell {i} ({}) has {n} nodes, expected {}", type_name(t), kind.corner_count().unwrap_or(0)),
+                format!(
+                    "cell {i} ({}) has {n} nodes, expected {}",
+                    type_name(t),
+                    kind.corner_count().unwrap_or(0)
+                ),
             ));
         }
         kinds.push(kind);
@@ -221,7 +249,11 @@ fn fast_path(
     };
     for (t, &c) in counts.iter().enumerate() {
         if c > 0 {
-            *mesh.source.cells_by_type.entry(type_name(t as u8).to_string()).or_default() += c;
+            *mesh
+                .source
+                .cells_by_type
+                .entry(type_name(t as u8).to_string())
+                .or_default() += c;
         }
     }
     Ok(())
@@ -259,9 +291,18 @@ fn general_path(
         } else {
             let s = spec(t).ok_or_else(|| err(format!("unsupported VTK cell type {t}")))?;
             let corners = s.kind.corner_count().unwrap_or(0);
-            let ok = if s.at_least { nodes.len() >= corners } else { s.counts.contains(&nodes.len()) };
+            let ok = if s.at_least {
+                nodes.len() >= corners
+            } else {
+                s.counts.contains(&nodes.len())
+            };
             if !ok {
-                return Err(err(format!("{} with {} nodes (expected {:?})", type_name(t), nodes.len(), s.counts)));
+                return Err(err(format!(
+                    "{} with {} nodes (expected {:?})",
+                    type_name(t),
+                    nodes.len(),
+                    s.counts
+                )));
             }
             if !s.at_least && nodes.len() != s.counts[0] {
                 *relabelled.entry(t).or_default() += 1;
@@ -273,7 +314,11 @@ fn general_path(
                 mesh.cells.push(s.kind, &nodes[..corners]);
             }
         }
-        *mesh.source.cells_by_type.entry(type_name(t).to_string()).or_default() += 1;
+        *mesh
+            .source
+            .cells_by_type
+            .entry(type_name(t).to_string())
+            .or_default() += 1;
     }
     for (t, n) in relabelled {
         mesh.source.notes.push(format!(
@@ -294,13 +339,23 @@ fn read_faces(
 ) -> Result<Vec<Option<Vec<Vec<u32>>>>, IoError> {
     let need = |name: &str| {
         cells_array(cells_el, name).ok_or_else(|| {
-            IoError::parse(src.path, cells_el.location(), format!("polyhedra need a '{name}' array"))
+            IoError::parse(
+                src.path,
+                cells_el.location(),
+                format!("polyhedra need a '{name}' array"),
+            )
         })
     };
     let (faces_el, fo_el) = (need("faces")?, need("faceoffsets")?);
     let fo: Vec<i64> = src.decode(fo_el, scalar_type(src, fo_el)?, Some(nc))?;
     let faces: Vec<i64> = src.decode(faces_el, scalar_type(src, faces_el)?, None)?;
-    let err = |i: usize, msg: &str| IoError::parse(src.path, faces_el.location(), format!("polyhedron cell {i}: {msg}"));
+    let err = |i: usize, msg: &str| {
+        IoError::parse(
+            src.path,
+            faces_el.location(),
+            format!("polyhedron cell {i}: {msg}"),
+        )
+    };
     let mut out = Vec::with_capacity(nc);
     let mut start = 0usize;
     for (i, &end) in fo.iter().enumerate() {
@@ -309,7 +364,9 @@ fn read_faces(
             continue;
         }
         let end = end as usize;
-        let stream = faces.get(start..end).ok_or_else(|| err(i, "face offsets out of range"))?;
+        let stream = faces
+            .get(start..end)
+            .ok_or_else(|| err(i, "face offsets out of range"))?;
         start = end;
         let mut it = stream.iter().copied();
         let nf = it.next().ok_or_else(|| err(i, "empty face stream"))?;
@@ -358,10 +415,15 @@ fn read_faces_vtk94(
 ) -> Result<Vec<Option<Vec<Vec<u32>>>>, IoError> {
     let need = |name: &str| {
         cells_array(cells_el, name).ok_or_else(|| {
-            IoError::parse(src.path, cells_el.location(), format!("polyhedra need a '{name}' array"))
+            IoError::parse(
+                src.path,
+                cells_el.location(),
+                format!("polyhedra need a '{name}' array"),
+            )
         })
     };
-    let dec = |el: &Element| -> Result<Vec<i64>, IoError> { src.decode(el, scalar_type(src, el)?, None) };
+    let dec =
+        |el: &Element| -> Result<Vec<i64>, IoError> { src.decode(el, scalar_type(src, el)?, None) };
     let (fc_el, fo_el, p2f_el, po_el) = (
         need("face_connectivity")?,
         need("face_offsets")?,
@@ -373,13 +435,25 @@ fn read_faces_vtk94(
     let p2f = dec(p2f_el)?;
     let po = dec(po_el)?;
     if po.len() != nc && po.len() != nc + 1 {
-        return Err(IoError::parse(src.path, po_el.location(), format!("{} offsets for {nc} cells", po.len())));
+        return Err(IoError::parse(
+            src.path,
+            po_el.location(),
+            format!("{} offsets for {nc} cells", po.len()),
+        ));
     }
     let po = with_leading_zero(po, nc);
-    let nfaces = if fo.first() == Some(&0) { fo.len().saturating_sub(1) } else { fo.len() };
+    let nfaces = if fo.first() == Some(&0) {
+        fo.len().saturating_sub(1)
+    } else {
+        fo.len()
+    };
     let fo = with_leading_zero(fo, nfaces);
     let bad = |el: &Element, i: usize, what: &str| {
-        IoError::parse(src.path, el.location(), format!("polyhedron cell {i}: {what}"))
+        IoError::parse(
+            src.path,
+            el.location(),
+            format!("polyhedron cell {i}: {what}"),
+        )
     };
     let range = |v: &[i64], k: usize| -> Option<(usize, usize)> {
         let (a, b) = (*v.get(k)?, *v.get(k + 1)?);
@@ -388,7 +462,9 @@ fn read_faces_vtk94(
     let mut out = Vec::with_capacity(nc);
     for i in 0..nc {
         let (a, b) = range(&po, i).ok_or_else(|| bad(po_el, i, "bad polyhedron offsets"))?;
-        let ids = p2f.get(a..b).ok_or_else(|| bad(p2f_el, i, "face ids out of range"))?;
+        let ids = p2f
+            .get(a..b)
+            .ok_or_else(|| bad(p2f_el, i, "face ids out of range"))?;
         if ids.is_empty() {
             out.push(None);
             continue;
@@ -399,9 +475,15 @@ fn read_faces_vtk94(
                 .ok()
                 .and_then(|f| range(&fo, f))
                 .ok_or_else(|| bad(p2f_el, i, "face id out of range"))?;
-            let pts = fc.get(fa..fb).ok_or_else(|| bad(fo_el, i, "face offsets out of range"))?;
+            let pts = fc
+                .get(fa..fb)
+                .ok_or_else(|| bad(fo_el, i, "face offsets out of range"))?;
             if pts.len() < 3 || pts.iter().any(|&p| p < 0 || p as usize >= np) {
-                return Err(bad(fc_el, i, "face with fewer than 3 points or a point id out of range"));
+                return Err(bad(
+                    fc_el,
+                    i,
+                    "face with fewer than 3 points or a point id out of range",
+                ));
             }
             faces.push(pts.iter().map(|&p| p as u32).collect());
         }
