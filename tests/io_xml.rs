@@ -364,6 +364,8 @@ struct Enc {
     h64: bool,
     be: bool,
     block: usize,
+    /// Compressed base64 as one stream (header and blocks together).
+    joined: bool,
 }
 
 fn value_bytes(ty: &str, v: f64, be: bool) -> Vec<u8> {
@@ -436,7 +438,7 @@ impl Enc {
             .collect();
         let (h, b) = self.payload(&bytes);
         let b64 = |h: &[u8], b: &[u8]| {
-            if self.comp == Comp::None {
+            if self.comp == Comp::None || self.joined {
                 B64.encode([h, b].concat())
             } else {
                 B64.encode(h) + &B64.encode(b)
@@ -650,6 +652,7 @@ fn every_encoding_round_trips() {
                             h64,
                             be,
                             block,
+                            joined: block == 7,
                         };
                         let bytes = write_sample(&enc, int_ty, types_ty);
                         let what = format!("{enc:?} {int_ty} {types_ty}");
@@ -678,6 +681,7 @@ fn hostile_header_is_refused_before_allocating() {
         h64: true,
         be: false,
         block: 64,
+        joined: false,
     };
     let mut app = enc.word(1);
     app.extend(enc.word(1 << 40));
@@ -992,6 +996,7 @@ fn mutations_never_panic() {
                 h64: true,
                 be: false,
                 block: 48,
+                joined: false,
             },
             "Int64",
             "UInt8",
@@ -1003,6 +1008,7 @@ fn mutations_never_panic() {
                 h64: false,
                 be: true,
                 block: 40,
+                joined: false,
             },
             "Int32",
             "Int8",
@@ -1014,6 +1020,7 @@ fn mutations_never_panic() {
                 h64: false,
                 be: false,
                 block: 64,
+                joined: false,
             },
             "Int32",
             "UInt8",
@@ -1025,6 +1032,7 @@ fn mutations_never_panic() {
                 h64: false,
                 be: false,
                 block: 64,
+                joined: false,
             },
             "Int32",
             "UInt8",

@@ -291,7 +291,24 @@ impl<'a> Source<'a> {
         let hchars = enc_len(hdr_len);
         let htext = text.get(..hchars).ok_or("truncated compression header")?;
         let hdr = self.block_header(&b64_decode(htext)?)?;
-        let csum: u64 = hdr.csizes.iter().sum();
+        let csum = hdr
+            .csizes
+            .iter()
+            .try_fold(0u64, |a, &c| a.checked_add(c))
+            .ok_or("compressed sizes overflow")?;
+        if hdr_len % 3 != 0 && !htext.ends_with(b"=") {
+            // Header and blocks encoded as one base64 stream (not VTK's way,
+            // but seen in other writers).
+            let total = usize::try_from(csum)
+                .ok()
+                .and_then(|c| c.checked_add(hdr_len))
+                .ok_or("sizes overflow")?;
+            let t = text.get(..enc_len(total)).ok_or_else(|| {
+                format!("compressed blocks need {csum} bytes but the base64 text is shorter")
+            })?;
+            let all = b64_decode(t)?;
+            return self.inflate(&hdr, &all[hdr_len.min(all.len())..], ty, expected);
+        }
         let rest = &text[hchars..];
         let need = enc_len(usize::try_from(csum).map_err(|_| "sizes overflow")?);
         let dtext = rest.get(..need).ok_or_else(|| {
