@@ -1,0 +1,1083 @@
+//! VTK XML readers and time collections (issue 2).
+//!
+//! - Real files from `../shared/data` (skipped when absent): counts from the
+//!   data README, and every array's range checked against the
+//!   `RangeMin`/`RangeMax` that VTK wrote into the file (an independent
+//!   oracle: magnitude range for vectors, value range for scalars).
+//! - Round trips: a small mixed mesh is written by an encoder in this file
+//!   (independent of the reader) in every encoding (ascii, inline base64,
+//!   appended raw and base64; no compression, zlib, LZ4; UInt32/UInt64
+//!   headers; little/big endian; several integer widths) and read back.
+//! - Hand-written `.vti`, `.vtr`, `.vts`, polyhedron and multi-piece files.
+//! - Every `meshes/corrupt/xml_*` file fails with an error naming it, and a
+//!   seeded mutation test (byte flips, truncations) never panics.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use base64::engine::general_purpose::STANDARD as B64;
+use base64::Engine;
+use zoovr::field::ArrayData;
+use zoovr::io::{self, collection, xml, Format, ReadOptions};
+use zoovr::mesh::{CellKind, Mesh};
+use zoovr::testdata::shared_file;
+
+// ---------------------------------------------------------------- helpers
+
+/// Structural invariants every reader output must satisfy.
+fn check_mesh(m: &Mesh) {
+    let c = &m.cells;
+    if !c.is_empty() {
+        assert_eq!((c.offsets.len(), c.offsets[0]), (c.len() + 1, 0));
+    }
+    for i in 0..c.len() {
+        let n = c.nodes(i);
+        if let Some(k) = c.kinds[i].corner_count() {
+            assert_eq!(n.len(), k, "cell {i}");
+        }
+        assert!(
+            n.iter().all(|&p| (p as usize) < m.points.len()),
+            "cell {i} ids"
+        );
+    }
+    for a in &m.point_data {
+        assert_eq!(a.tuples(), m.points.len(), "point array {}", a.name);
+        assert_eq!(a.data.len() % a.components, 0);
+    }
+    for a in &m.cell_data {
+        assert_eq!(a.tuples(), c.len(), "cell array {}", a.name);
+    }
+    assert_eq!(m.source.cells_by_type.values().sum::<usize>(), c.len());
+    assert!(m.points.iter().all(|p| p.is_finite()));
+}
+
+fn load(rel: &str) -> Option<Mesh> {
+    let p = shared_file(rel)?;
+    let m = io::read(&p, &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    check_mesh(&m);
+    Some(m)
+}
+
+fn by_type(m: &Mesh, name: &str) -> usize {
+    m.source.cells_by_type.get(name).copied().unwrap_or(0)
+}
+
+fn array<'m>(m: &'m Mesh, name: &str) -> &'m zoovr::field::DataArray {
+    m.point_data
+        .iter()
+        .chain(&m.cell_data)
+        .find(|a| a.name == name)
+        .unwrap_or_else(|| panic!("no array {name}"))
+}
+
+/// `(name, components, RangeMin, RangeMax)` of the DataArrays in a VTK file's
+/// header, found by plain text search (not by the reader under test).
+fn file_ranges(path: &Path) -> Vec<(String, usize, f64, f64)> {
+    let bytes = std::fs::read(path).unwrap();
+    let end = find(&bytes, b"<AppendedData").unwrap_or(bytes.len());
+    let text = String::from_utf8_lossy(&bytes[..end]);
+    let attr = |tag: &str, key: &str| -> Option<String> {
+        let k = format!(" {key}=\"");
+        let i = tag.find(&k)? + k.len();
+        Some(tag[i..i + tag[i..].find('"')?].to_string())
+    };
+    let mut out = Vec::new();
+    for part in text.split("<DataArray").skip(1) {
+        let tag = &part[..part.find('>').unwrap_or(part.len())];
+        let (Some(name), Some(lo), Some(hi)) = (
+            attr(tag, "Name"),
+            attr(tag, "RangeMin"),
+            attr(tag, "RangeMax"),
+        ) else {
+            continue;
+        };
+        let (Ok(lo), Ok(hi)) = (lo.parse(), hi.parse()) else {
+            continue;
+        };
+        let nc = attr(tag, "NumberOfComponents")
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(1);
+        out.push((name, nc, lo, hi));
+    }
+    out
+}
+
+fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
+    hay.windows(needle.len()).position(|w| w == needle)
+}
+
+/// Every array with a recorded range matches it (scalars: values; vectors:
+/// magnitudes, as VTK records them). Returns how many were checked.
+fn check_ranges(m: &Mesh, path: &Path) -> usize {
+    let mut checked = 0;
+    for (name, nc, lo, hi) in file_ranges(path) {
+        let Some(a) = m
+            .point_data
+            .iter()
+            .chain(&m.cell_data)
+            .find(|a| a.name == name)
+        else {
+            continue;
+        };
+        if a.components != nc
+            || (lo == 0.0 && hi == 0.0 && a.range(None).is_some_and(|r| r.1 != 0.0))
+        {
+            continue;
+        }
+        let (l, h) = a.range(if nc == 1 { Some(0) } else { None }).unwrap();
+        let tol = 1e-6 * (hi.abs().max(lo.abs()).max(1e-30));
+        assert!(
+            (l - lo).abs() <= tol && (h - hi).abs() <= tol,
+            "{}: {name} range {l}..{h}, file says {lo}..{hi}",
+            path.display()
+        );
+        checked += 1;
+    }
+    checked
+}
+
+// ---------------------------------------------------------------- real data
+
+#[test]
+fn bluntfin_vts_appended_raw() {
+    let Some(m) = load("bluntfin/bluntfin_converted.vts") else {
+        return;
+    };
+    assert_eq!(m.cells.len(), 37_479);
+    assert_eq!(m.points.len(), 40_960);
+    assert_eq!(by_type(&m, "hexahedron"), 37_479);
+    let d = array(&m, "Density");
+    assert_eq!(d.vtk_type, "Float32");
+    let (lo, hi) = d.range(Some(0)).unwrap();
+    assert!(
+        (0.19..0.2).contains(&lo) && (4.97..4.98).contains(&hi),
+        "{lo} {hi}"
+    );
+    assert_eq!(m.active_point_scalars.as_deref(), Some("Density"));
+    assert!(check_ranges(&m, &shared_file("bluntfin/bluntfin_converted.vts").unwrap()) >= 7);
+    // Node order: cell 0 is (0,0,0)-(1,1,1) of a 40 x 32 x 32 lattice.
+    assert_eq!(m.cells.nodes(0), &[0, 1, 41, 40, 1280, 1281, 1321, 1320]);
+}
+
+#[test]
+fn fire_room_appended_base64_zlib() {
+    let Some(m) = load("fire_room/fire_ug.vtu") else {
+        return;
+    };
+    assert_eq!((m.cells.len(), m.points.len()), (10_462, 12_323));
+    assert_eq!(by_type(&m, "hexahedron"), 10_462);
+    let (lo, hi) = array(&m, "t").range(Some(0)).unwrap();
+    assert!(
+        (297.0..299.0).contains(&lo) && (691.0..693.0).contains(&hi),
+        "{lo} {hi}"
+    );
+    assert_eq!(array(&m, "uvw").components, 3);
+    assert_eq!(m.active_point_scalars.as_deref(), Some("t"));
+}
+
+#[test]
+fn can_crush_appended_raw_and_series() {
+    let Some(m) = load("can_crush/can.vtu") else {
+        return;
+    };
+    assert_eq!((m.cells.len(), m.points.len()), (4_800, 6_724));
+    assert_eq!(array(&m, "EQPS").tuples(), 4_800);
+    assert_eq!(array(&m, "DISPL").components, 3);
+    let g = array(&m, "GlobalNodeId");
+    assert!(matches!(g.data, ArrayData::Int(_)) && g.vtk_type == "Int64");
+    let p = shared_file("can_crush/can.vtu").unwrap();
+    assert!(check_ranges(&m, &p) >= 4);
+
+    let pvd = shared_file("can_crush/series/can_series.pvd").unwrap();
+    let steps = io::read_series(&pvd).unwrap();
+    assert_eq!(steps.len(), 3);
+    assert!(steps.windows(2).all(|w| w[0].time < w[1].time));
+    assert!((steps[1].time - 0.00209992984).abs() < 1e-15);
+    let mut moved = Vec::new();
+    for s in &steps {
+        let m = io::read(&s.path, &ReadOptions::default()).unwrap();
+        check_mesh(&m);
+        assert_eq!(m.cells.len(), 4_800);
+        check_ranges(&m, &s.path);
+        moved.push(m.points[0]);
+    }
+    assert_ne!(moved[0], moved[2], "the can deforms over time");
+}
+
+#[test]
+fn disk_out_ref_inline_zlib() {
+    let Some(m) = load("disk_out_ref/disk_out_ref_converted.vtu") else {
+        return;
+    };
+    assert_eq!((m.cells.len(), m.points.len()), (7_472, 8_499));
+    let (lo, hi) = array(&m, "Temp").range(Some(0)).unwrap();
+    assert!((293.0..293.2).contains(&lo) && (913.0..913.2).contains(&hi));
+    assert!(
+        check_ranges(
+            &m,
+            &shared_file("disk_out_ref/disk_out_ref_converted.vtu").unwrap()
+        ) >= 7
+    );
+}
+
+#[test]
+fn notch_quadratic_cells_keep_corners() {
+    let Some(m) = load("notch/notch_disp.vtu") else {
+        return;
+    };
+    assert_eq!(m.cells.len(), 2_192);
+    assert_eq!(m.points.len(), 12_717);
+    let hex = m
+        .cells
+        .kinds
+        .iter()
+        .filter(|k| **k == CellKind::Hexahedron)
+        .count();
+    let wedge = m
+        .cells
+        .kinds
+        .iter()
+        .filter(|k| **k == CellKind::Wedge)
+        .count();
+    assert_eq!((hex, wedge), (2_188, 4));
+    let a = array(&m, "Nodal Displacement");
+    assert_eq!(a.components, 3);
+    assert_eq!(
+        m.active_point_scalars.as_deref(),
+        Some("Nodal Displacement")
+    );
+}
+
+#[test]
+fn fea_bracket_quadratic_tets_cell_data_only() {
+    let Some(m) = load("fea_bracket_qtet/kiefer_bracket.vtu") else {
+        return;
+    };
+    assert_eq!(m.cells.len(), 56_786);
+    assert_eq!(by_type(&m, "quadratic_tetra"), 56_786);
+    assert_eq!(m.points.len(), 102_578);
+    assert!(m.point_data.is_empty());
+    let s = array(&m, "Equivalent (von-Mises) Stress (psi)");
+    assert_eq!(s.tuples(), 56_786);
+    assert_eq!(
+        m.active_cell_scalars.as_deref(),
+        Some("Equivalent (von-Mises) Stress (psi)")
+    );
+    assert_eq!(
+        check_ranges(
+            &m,
+            &shared_file("fea_bracket_qtet/kiefer_bracket.vtu").unwrap()
+        ),
+        1
+    );
+}
+
+#[test]
+fn su2_sphere_hybrid_mixed_cells() {
+    let Some(m) = load("su2_sphere_hybrid/sphere_hybrid_converted.vtu") else {
+        return;
+    };
+    assert_eq!(by_type(&m, "tetra"), 312);
+    assert_eq!(by_type(&m, "wedge"), 7_950);
+    assert_eq!(by_type(&m, "pyramid"), 318);
+    assert_eq!(m.points.len(), 5_750);
+    let (lo, hi) = array(&m, "Pressure").range(Some(0)).unwrap();
+    assert!(
+        (-3.3..-3.1).contains(&lo) && (3.9..4.1).contains(&hi),
+        "{lo} {hi}"
+    );
+    assert_eq!(m.active_point_scalars.as_deref(), Some("Pressure"));
+    assert!(
+        check_ranges(
+            &m,
+            &shared_file("su2_sphere_hybrid/sphere_hybrid_converted.vtu").unwrap()
+        ) >= 10
+    );
+}
+
+#[test]
+fn blood_vessels_pvtu_voxels_int8_types() {
+    let Some(m) = load("blood_vessels_pvtu/blood_vessels/T0000000500.pvtu") else {
+        return;
+    };
+    assert_eq!(m.cells.len(), 39_353);
+    assert_eq!(by_type(&m, "voxel"), 39_353);
+    assert_eq!(m.points.len(), 48_823);
+    assert!(m.cells.kinds.iter().all(|k| *k == CellKind::Hexahedron));
+    for name in ["node_value", "simerr_type"] {
+        assert!(m
+            .point_data
+            .iter()
+            .any(|a| a.name == name && a.vtk_type == "Int32"));
+    }
+    for name in ["density", "velocity", "shearstress"] {
+        assert!(m.cell_data.iter().any(|a| a.name == name));
+    }
+    // Voxels reordered to hexahedron order: the quad 0-1-2-3 is a cycle, so
+    // nodes 0 and 2 are diagonal opposites (differ in two coordinates).
+    let n = m.cells.nodes(0);
+    let (p0, p1, p2) = (
+        m.points[n[0] as usize],
+        m.points[n[1] as usize],
+        m.points[n[2] as usize],
+    );
+    let diff = |a: glam::DVec3, b: glam::DVec3| {
+        [(a.x != b.x), (a.y != b.y), (a.z != b.z)]
+            .iter()
+            .filter(|&&d| d)
+            .count()
+    };
+    assert_eq!((diff(p0, p1), diff(p0, p2)), (1, 2));
+}
+
+#[test]
+fn hex_shell_synthetic_zlib() {
+    let Some(m) = load("synthetic/hex_shell_zlib.vtu") else {
+        return;
+    };
+    assert_eq!((m.cells.len(), m.points.len()), (250_047, 262_144));
+    let (lo, hi) = array(&m, "f").range(Some(0)).unwrap();
+    assert!(lo >= 0.0 && hi <= 1.0 && hi - lo > 0.99, "{lo} {hi}");
+}
+
+// ---------------------------------------------------------------- encoder
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Fmt {
+    Ascii,
+    Binary,
+    AppRaw,
+    AppB64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Comp {
+    None,
+    Zlib,
+    Lz4,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Enc {
+    fmt: Fmt,
+    comp: Comp,
+    h64: bool,
+    be: bool,
+    block: usize,
+    /// Compressed base64 as one stream (header and blocks together).
+    joined: bool,
+}
+
+fn value_bytes(ty: &str, v: f64, be: bool) -> Vec<u8> {
+    macro_rules! b {
+        ($t:ty) => {{
+            let x = v as $t;
+            if be {
+                x.to_be_bytes().to_vec()
+            } else {
+                x.to_le_bytes().to_vec()
+            }
+        }};
+    }
+    match ty {
+        "Int8" => b!(i8),
+        "UInt8" => b!(u8),
+        "Int16" => b!(i16),
+        "UInt16" => b!(u16),
+        "Int32" => b!(i32),
+        "UInt32" => b!(u32),
+        "Int64" => b!(i64),
+        "UInt64" => b!(u64),
+        "Float32" => b!(f32),
+        _ => b!(f64),
+    }
+}
+
+impl Enc {
+    fn word(&self, v: usize) -> Vec<u8> {
+        match (self.h64, self.be) {
+            (true, true) => (v as u64).to_be_bytes().to_vec(),
+            (true, false) => (v as u64).to_le_bytes().to_vec(),
+            (false, true) => (v as u32).to_be_bytes().to_vec(),
+            (false, false) => (v as u32).to_le_bytes().to_vec(),
+        }
+    }
+
+    /// (header, body) of a binary payload.
+    fn payload(&self, data: &[u8]) -> (Vec<u8>, Vec<u8>) {
+        if self.comp == Comp::None {
+            return (self.word(data.len()), data.to_vec());
+        }
+        let blocks: Vec<&[u8]> = data.chunks(self.block).collect();
+        let mut hdr = self.word(blocks.len());
+        hdr.extend(self.word(self.block));
+        let last = data.len() % self.block;
+        hdr.extend(self.word(last));
+        let mut body = Vec::new();
+        for b in &blocks {
+            let c = match self.comp {
+                Comp::Zlib => {
+                    let mut e =
+                        flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+                    e.write_all(b).unwrap();
+                    e.finish().unwrap()
+                }
+                _ => lz4_flex::block::compress(b),
+            };
+            hdr.extend(self.word(c.len()));
+            body.extend(c);
+        }
+        (hdr, body)
+    }
+
+    fn array(&self, name: &str, ty: &str, nc: usize, vals: &[f64], app: &mut Vec<u8>) -> String {
+        let head = format!("<DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{nc}\"");
+        let bytes: Vec<u8> = vals
+            .iter()
+            .flat_map(|&v| value_bytes(ty, v, self.be))
+            .collect();
+        let (h, b) = self.payload(&bytes);
+        let b64 = |h: &[u8], b: &[u8]| {
+            if self.comp == Comp::None || self.joined {
+                B64.encode([h, b].concat())
+            } else {
+                B64.encode(h) + &B64.encode(b)
+            }
+        };
+        match self.fmt {
+            Fmt::Ascii => {
+                let t: Vec<String> = vals
+                    .iter()
+                    .map(|v| {
+                        if ty.starts_with("Float32") {
+                            format!("{}", *v as f32)
+                        } else {
+                            format!("{v}")
+                        }
+                    })
+                    .collect();
+                format!("{head} format=\"ascii\">\n{}\n</DataArray>\n", t.join(" "))
+            }
+            Fmt::Binary => format!(
+                "{head} format=\"binary\">\n  {}\n</DataArray>\n",
+                b64(&h, &b)
+            ),
+            Fmt::AppRaw => {
+                let off = app.len();
+                app.extend(h);
+                app.extend(b);
+                format!("{head} format=\"appended\" offset=\"{off}\"/>\n")
+            }
+            Fmt::AppB64 => {
+                let off = app.len();
+                app.extend(b64(&h, &b).into_bytes());
+                format!("{head} format=\"appended\" offset=\"{off}\"/>\n")
+            }
+        }
+    }
+
+    fn file(&self, body: &str, app: &[u8]) -> Vec<u8> {
+        let mut f = format!(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"{}\" header_type=\"{}\"{}>\n<UnstructuredGrid>\n{body}</UnstructuredGrid>\n",
+            if self.be { "BigEndian" } else { "LittleEndian" },
+            if self.h64 { "UInt64" } else { "UInt32" },
+            match self.comp {
+                Comp::None => "",
+                Comp::Zlib => " compressor=\"vtkZLibDataCompressor\"",
+                Comp::Lz4 => " compressor=\"vtkLZ4DataCompressor\"",
+            }
+        )
+        .into_bytes();
+        if matches!(self.fmt, Fmt::AppRaw | Fmt::AppB64) {
+            let enc = if self.fmt == Fmt::AppRaw {
+                "raw"
+            } else {
+                "base64"
+            };
+            f.extend(format!("<AppendedData encoding=\"{enc}\">\n   _").into_bytes());
+            f.extend(app);
+            f.extend(b"\n</AppendedData>\n");
+        }
+        f.extend(b"</VTKFile>\n");
+        f
+    }
+}
+
+/// The test mesh: a 3 x 2 x 2 lattice plus 7 extra points; cells: hex,
+/// voxel, triangle (dropped), tet, quadratic tet, wedge.
+struct Sample {
+    points: Vec<f64>,
+    conn: Vec<f64>,
+    offsets: Vec<f64>,
+    types: Vec<f64>,
+}
+
+fn sample() -> Sample {
+    let mut points = Vec::new();
+    for k in 0..2 {
+        for j in 0..2 {
+            for i in 0..3 {
+                points.extend([i as f64 * 0.5, j as f64 + 0.25, k as f64 * 0.1]);
+            }
+        }
+    }
+    for e in 0..7 {
+        points.extend([-1.0 - e as f64, 0.125 * e as f64, -0.3]);
+    }
+    let cells: Vec<(u8, Vec<u32>)> = vec![
+        (12, vec![0, 1, 4, 3, 6, 7, 10, 9]),
+        (11, vec![1, 2, 4, 5, 7, 8, 10, 11]),
+        (5, vec![0, 1, 3]),
+        (10, vec![0, 1, 3, 12]),
+        (24, vec![0, 1, 3, 12, 13, 14, 15, 16, 17, 18]),
+        (13, vec![0, 1, 3, 6, 7, 9]),
+    ];
+    let mut conn = Vec::new();
+    let mut offsets = Vec::new();
+    let mut types = Vec::new();
+    for (t, n) in cells {
+        conn.extend(n.iter().map(|&x| x as f64));
+        offsets.push(conn.len() as f64);
+        types.push(t as f64);
+    }
+    Sample {
+        points,
+        conn,
+        offsets,
+        types,
+    }
+}
+
+fn write_sample(enc: &Enc, int_ty: &str, types_ty: &str) -> Vec<u8> {
+    let s = sample();
+    let mut app = Vec::new();
+    let np = s.points.len() / 3;
+    let temp: Vec<f64> = (0..np).map(|i| (i as f32 * 0.1f32) as f64).collect();
+    let vel: Vec<f64> = (0..np * 3).map(|i| i as f64 / 3.0).collect();
+    let cid: Vec<f64> = (0..6).map(|i| (i * 10) as f64 - 20.0).collect();
+    let mut body = format!(
+        "<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"6\">\n<PointData Scalars=\"temp\">\n"
+    );
+    body += &enc.array("temp", "Float32", 1, &temp, &mut app);
+    body += &enc.array("vel", "Float64", 3, &vel, &mut app);
+    body += "</PointData>\n<CellData Scalars=\"cid\">\n";
+    body += &enc.array("cid", "Int16", 1, &cid, &mut app);
+    body += "</CellData>\n<Points>\n";
+    body += &enc.array("Points", "Float64", 3, &s.points, &mut app);
+    body += "</Points>\n<Cells>\n";
+    body += &enc.array("connectivity", int_ty, 1, &s.conn, &mut app);
+    body += &enc.array("offsets", int_ty, 1, &s.offsets, &mut app);
+    body += &enc.array("types", types_ty, 1, &s.types, &mut app);
+    body += "</Cells>\n</Piece>\n";
+    enc.file(&body, &app)
+}
+
+fn check_sample(m: &Mesh, what: &str) {
+    check_mesh(m);
+    let s = sample();
+    assert_eq!(m.points.len(), 19, "{what}");
+    assert_eq!(m.points[5].to_array(), [1.0, 1.25, 0.0], "{what}");
+    assert_eq!(m.cells.len(), 5, "{what}");
+    assert_eq!(m.source.ignored_cells, 1, "{what}");
+    assert_eq!(m.cells.nodes(0), &[0, 1, 4, 3, 6, 7, 10, 9], "{what}");
+    assert_eq!(
+        m.cells.nodes(1),
+        &[1, 2, 5, 4, 7, 8, 11, 10],
+        "{what}: voxel to hex order"
+    );
+    assert_eq!(
+        m.cells.nodes(3),
+        &[0, 1, 3, 12],
+        "{what}: quadratic tet corners"
+    );
+    assert_eq!(
+        m.cells.kinds,
+        vec![
+            CellKind::Hexahedron,
+            CellKind::Hexahedron,
+            CellKind::Tetra,
+            CellKind::Tetra,
+            CellKind::Wedge
+        ]
+    );
+    for (name, n) in [
+        ("hexahedron", 1),
+        ("voxel", 1),
+        ("tetra", 1),
+        ("quadratic_tetra", 1),
+        ("wedge", 1),
+    ] {
+        assert_eq!(by_type(m, name), n, "{what}: {name}");
+    }
+    let t = array(m, "temp");
+    assert_eq!(t.vtk_type, "Float32");
+    match &t.data {
+        ArrayData::F32(v) => assert!(
+            v.iter()
+                .enumerate()
+                .all(|(i, x)| x.to_bits() == (i as f32 * 0.1f32).to_bits()),
+            "{what}"
+        ),
+        other => panic!("{what}: temp is {other:?}"),
+    }
+    assert_eq!(array(m, "vel").component(4, 2), 14.0 / 3.0, "{what}");
+    match &array(m, "cid").data {
+        ArrayData::Int(v) => assert_eq!(v, &[-20, -10, 10, 20, 30], "{what}: cell data filtered"),
+        other => panic!("{what}: cid is {other:?}"),
+    }
+    assert_eq!(m.active_point_scalars.as_deref(), Some("temp"));
+    assert_eq!(m.active_cell_scalars.as_deref(), Some("cid"));
+    assert_eq!(s.types.len(), 6);
+}
+
+#[test]
+fn every_encoding_round_trips() {
+    let mut n = 0;
+    for fmt in [Fmt::Ascii, Fmt::Binary, Fmt::AppRaw, Fmt::AppB64] {
+        for comp in [Comp::None, Comp::Zlib, Comp::Lz4] {
+            if fmt == Fmt::Ascii && comp != Comp::None {
+                continue;
+            }
+            for h64 in [false, true] {
+                for be in [false, true] {
+                    for (int_ty, types_ty, block) in [
+                        ("Int32", "UInt8", 64),
+                        ("Int64", "Int8", 40),
+                        ("UInt16", "Int32", 7),
+                        ("Int8", "Int64", 1 << 15),
+                    ] {
+                        let enc = Enc {
+                            fmt,
+                            comp,
+                            h64,
+                            be,
+                            block,
+                            joined: block == 7,
+                        };
+                        let bytes = write_sample(&enc, int_ty, types_ty);
+                        let what = format!("{enc:?} {int_ty} {types_ty}");
+                        let m = xml::read_bytes(
+                            Path::new("sample.vtu"),
+                            &bytes,
+                            Format::XmlUnstructured,
+                        )
+                        .unwrap_or_else(|e| panic!("{what}: {e}"));
+                        check_sample(&m, &what);
+                        n += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(n, 16 + 3 * 3 * 2 * 2 * 4);
+}
+
+#[test]
+fn hostile_header_is_refused_before_allocating() {
+    // A zlib header claiming 2^40-byte blocks and 10^12 points.
+    let enc = Enc {
+        fmt: Fmt::AppRaw,
+        comp: Comp::Zlib,
+        h64: true,
+        be: false,
+        block: 64,
+        joined: false,
+    };
+    let mut app = enc.word(1);
+    app.extend(enc.word(1 << 40));
+    app.extend(enc.word(0));
+    app.extend(enc.word(16));
+    app.extend([0u8; 16]);
+    let body = "<Piece NumberOfPoints=\"1000000000000\" NumberOfCells=\"0\"><Points>\
+        <DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points></Piece>";
+    let e = xml::read_bytes(
+        Path::new("huge.vtu"),
+        &enc.file(body, &app),
+        Format::XmlUnstructured,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("huge.vtu"), "{e}");
+    let body = "<Piece NumberOfPoints=\"300000000\" NumberOfCells=\"0\"><Points>\
+        <DataArray type=\"Float32\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points></Piece>";
+    let e = xml::read_bytes(
+        Path::new("huge.vtu"),
+        &enc.file(body, &app),
+        Format::XmlUnstructured,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("huge.vtu") && e.contains("Points") && e.contains("ratio"),
+        "{e}"
+    );
+}
+
+// ---------------------------------------------------------------- hand-written files
+
+fn read_str(name: &str, text: &str, format: Format) -> Result<Mesh, String> {
+    xml::read_bytes(Path::new(name), text.as_bytes(), format).map_err(|e| e.to_string())
+}
+
+#[test]
+fn image_data_as_hexahedra() {
+    let m = read_str(
+        "img.vti",
+        r#"<VTKFile type="ImageData" version="1.0"><ImageData WholeExtent="0 2 0 1 0 1" Origin="1 2 3" Spacing="0.5 1 2">
+        <Piece Extent="0 2 0 1 0 1"><PointData Scalars="s"><DataArray type="Float64" Name="s" format="ascii">0 1 2 3 4 5 6 7 8 9 10 11</DataArray></PointData>
+        <CellData><DataArray type="Int32" Name="c" format="ascii">7 8</DataArray></CellData></Piece></ImageData></VTKFile>"#,
+        Format::XmlImage,
+    )
+    .unwrap();
+    check_mesh(&m);
+    assert_eq!(m.cells.len(), 2);
+    assert_eq!(m.cells.nodes(1), &[1, 2, 5, 4, 7, 8, 11, 10]);
+    assert_eq!(m.points[11].to_array(), [2.0, 3.0, 5.0]);
+    assert_eq!(m.bounds(), [1.0, 2.0, 2.0, 3.0, 3.0, 5.0]);
+    assert_eq!(array(&m, "c").component(1, 0), 8.0);
+    assert_eq!(by_type(&m, "hexahedron"), 2);
+}
+
+#[test]
+fn rectilinear_and_structured_grids() {
+    let m = read_str(
+        "r.vtr",
+        r#"<VTKFile type="RectilinearGrid"><RectilinearGrid WholeExtent="0 2 0 1 0 1"><Piece Extent="0 2 0 1 0 1">
+        <Coordinates><DataArray type="Float32" format="ascii">0 1 3</DataArray><DataArray type="Float64" format="ascii">0 2</DataArray>
+        <DataArray type="Float64" format="ascii">-1 1</DataArray></Coordinates></Piece></RectilinearGrid></VTKFile>"#,
+        Format::XmlRectilinear,
+    )
+    .unwrap();
+    check_mesh(&m);
+    assert_eq!(m.cells.len(), 2);
+    assert_eq!(m.points[5].to_array(), [3.0, 2.0, -1.0]);
+    assert_eq!(m.bounds(), [0.0, 3.0, 0.0, 2.0, -1.0, 1.0]);
+
+    let m = read_str(
+        "s.vts",
+        r#"<VTKFile type="StructuredGrid"><StructuredGrid WholeExtent="0 1 0 1 0 1"><Piece Extent="0 1 0 1 0 1">
+        <Points><DataArray type="Float64" NumberOfComponents="3" format="ascii">0 0 0 1 0 0 0 1 0 1 1 0 0 0 1 1 0 1 0 1 1 1 1 1.5</DataArray></Points>
+        </Piece></StructuredGrid></VTKFile>"#,
+        Format::XmlStructured,
+    )
+    .unwrap();
+    assert_eq!(m.cells.nodes(0), &[0, 1, 3, 2, 4, 5, 7, 6]);
+    assert_eq!(m.points[7].z, 1.5);
+
+    // A flat lattice has only 2D cells: none kept, all counted.
+    let m = read_str(
+        "flat.vti",
+        r#"<VTKFile type="ImageData"><ImageData WholeExtent="0 3 0 2 0 0"><Piece Extent="0 3 0 2 0 0">
+        <CellData><DataArray type="Float32" Name="c" format="ascii">1 2 3 4 5 6</DataArray></CellData></Piece></ImageData></VTKFile>"#,
+        Format::XmlImage,
+    )
+    .unwrap();
+    assert_eq!((m.cells.len(), m.source.ignored_cells), (0, 6));
+    assert_eq!(array(&m, "c").tuples(), 0);
+}
+
+const POLY: &str = r#"<VTKFile type="UnstructuredGrid" version="0.1"><UnstructuredGrid><Piece NumberOfPoints="9" NumberOfCells="2">
+<Points><DataArray type="Float64" NumberOfComponents="3" format="ascii">
+-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1  1 1 1  -1 1 1  0 0 3</DataArray></Points>
+<Cells>
+<DataArray type="Int64" Name="connectivity" format="ascii">0 1 2 3 4 5 6 7  4 5 6 8</DataArray>
+<DataArray type="Int64" Name="offsets" format="ascii">8 12</DataArray>
+<DataArray type="UInt8" Name="types" format="ascii">42 10</DataArray>
+<DataArray type="Int64" Name="faces" format="ascii">6 4 0 3 2 1 4 0 4 7 3 4 4 5 6 7 4 5 1 2 6 4 0 1 5 4 4 2 3 7 6</DataArray>
+<DataArray type="Int64" Name="faceoffsets" format="ascii">31 -1</DataArray>
+</Cells></Piece></UnstructuredGrid></VTKFile>"#;
+
+#[test]
+fn polyhedron_from_faces() {
+    let m = read_str("poly.vtu", POLY, Format::XmlUnstructured).unwrap();
+    check_mesh(&m);
+    assert_eq!(m.cells.kinds, vec![CellKind::Polyhedron, CellKind::Tetra]);
+    assert_eq!(m.cells.face_count(0), 6);
+    assert_eq!(m.cells.nodes(0), &[0, 1, 2, 3, 4, 5, 6, 7]);
+    assert_eq!(m.cells.poly_faces[&0][2], vec![4, 5, 6, 7]);
+    assert_eq!(by_type(&m, "polyhedron"), 1);
+    // The VTK 9.4 layout: faces shared through face ids.
+    let v94 = POLY
+        .replace(
+            r#"<DataArray type="Int64" Name="faces" format="ascii">6 4 0 3 2 1 4 0 4 7 3 4 4 5 6 7 4 5 1 2 6 4 0 1 5 4 4 2 3 7 6</DataArray>"#,
+            r#"<DataArray type="Int32" Name="face_connectivity" format="ascii">0 3 2 1 0 4 7 3 4 5 6 7 5 1 2 6 0 1 5 4 2 3 7 6</DataArray>
+            <DataArray type="Int32" Name="face_offsets" format="ascii">4 8 12 16 20 24</DataArray>
+            <DataArray type="Int32" Name="polyhedron_to_faces" format="ascii">0 1 2 3 4 5</DataArray>"#,
+        )
+        .replace(
+            r#"<DataArray type="Int64" Name="faceoffsets" format="ascii">31 -1</DataArray>"#,
+            r#"<DataArray type="Int64" Name="polyhedron_offsets" format="ascii">0 6 6</DataArray>"#,
+        );
+    let m2 = read_str("poly94.vtu", &v94, Format::XmlUnstructured).unwrap();
+    check_mesh(&m2);
+    assert_eq!(m2.cells.poly_faces, m.cells.poly_faces);
+    // A face stream pointing outside the points is refused.
+    let bad = POLY.replace("4 4 5 6 7 4 5", "4 4 5 6 70 4 5");
+    let e = read_str("poly.vtu", &bad, Format::XmlUnstructured).unwrap_err();
+    assert!(e.contains("poly.vtu") && e.contains("faces"), "{e}");
+}
+
+#[test]
+fn several_pieces_are_merged() {
+    let piece = |x: f64| {
+        format!(
+            r#"<Piece NumberOfPoints="4" NumberOfCells="1"><PointData><DataArray type="Int32" Name="id" format="ascii">1 2 3 4</DataArray></PointData>
+            <Points><DataArray type="Float32" NumberOfComponents="3" format="ascii">{x} 0 0 {} 0 0 {x} 1 0 {x} 0 1</DataArray></Points>
+            <Cells><DataArray type="Int32" Name="connectivity" format="ascii">0 1 2 3</DataArray>
+            <DataArray type="Int32" Name="offsets" format="ascii">4</DataArray><DataArray type="UInt8" Name="types" format="ascii">10</DataArray></Cells></Piece>"#,
+            x + 1.0
+        )
+    };
+    let text = format!(
+        r#"<VTKFile type="UnstructuredGrid"><UnstructuredGrid>{}{}</UnstructuredGrid></VTKFile>"#,
+        piece(0.0),
+        piece(5.0)
+    );
+    let m = read_str("two.vtu", &text, Format::XmlUnstructured).unwrap();
+    check_mesh(&m);
+    assert_eq!(m.cells.nodes(1), &[4, 5, 6, 7]);
+    assert_eq!(m.points[4].x, 5.0);
+    assert_eq!(array(&m, "id").tuples(), 8);
+    assert_eq!(by_type(&m, "tetra"), 2);
+}
+
+// ---------------------------------------------------------------- collections
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn pvd_and_series_resolve_sort_and_refuse() {
+    let d = tmp();
+    std::fs::create_dir(d.path().join("sub")).unwrap();
+    write(&d.path().join("sub"), "a.vtu", POLY);
+    write(d.path(), "b.vtu", POLY);
+    let pvd = write(
+        d.path(),
+        "c.pvd",
+        r#"<VTKFile type="Collection"><Collection>
+        <DataSet timestep="2.5" part="0" file="b.vtu"/><DataSet timestep="2.5" part="1" file="nope.vtu"/>
+        <DataSet timestep="1" part="0" file="sub/a.vtu"/></Collection></VTKFile>"#,
+    );
+    let steps = collection::read_pvd(&pvd).unwrap();
+    assert_eq!(steps.len(), 2);
+    assert_eq!(steps[0].time, 1.0);
+    assert!(steps[0].path.ends_with("sub/a.vtu"));
+    let m = io::read(&pvd, &ReadOptions::default()).unwrap();
+    assert_eq!(m.cells.len(), 2);
+
+    let series = write(
+        d.path(),
+        "c.vtu.series",
+        r#"{"file-series-version": "1.0", "files": [{"name": "b.vtu", "time": 3}, {"name": "sub/a.vtu", "time": 0.5}]}"#,
+    );
+    let steps = io::read_series(&series).unwrap();
+    assert_eq!(
+        steps.iter().map(|s| s.time).collect::<Vec<_>>(),
+        vec![0.5, 3.0]
+    );
+
+    let missing = write(
+        d.path(),
+        "m.series",
+        r#"{"file-series-version": "1.0", "files": [{"name": "gone.vtu", "time": 0}]}"#,
+    );
+    let e = io::read_series(&missing).unwrap_err().to_string();
+    assert!(
+        e.contains("m.series") && e.contains("files[0]") && e.contains("gone.vtu"),
+        "{e}"
+    );
+    let selfref = write(
+        d.path(),
+        "s.pvd",
+        r#"<VTKFile type="Collection"><Collection><DataSet timestep="0" file="s.pvd"/></Collection></VTKFile>"#,
+    );
+    let e = io::read(&selfref, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("s.pvd") && e.contains("itself"), "{e}");
+}
+
+#[test]
+fn pvtu_missing_and_self_pieces() {
+    let d = tmp();
+    let p = write(
+        d.path(),
+        "p.pvtu",
+        r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="p.pvtu"/></PUnstructuredGrid></VTKFile>"#,
+    );
+    let e = io::read(&p, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("p.pvtu") && e.contains("itself"), "{e}");
+    let q = write(
+        d.path(),
+        "q.pvtu",
+        r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="a.vtu"/><Piece Source="gone.vtu"/></PUnstructuredGrid></VTKFile>"#,
+    );
+    write(d.path(), "a.vtu", POLY);
+    let e = io::read(&q, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("q.pvtu") && e.contains("piece 1") && e.contains("gone.vtu"),
+        "{e}"
+    );
+    // A piece that is itself a .pvtu pointing back.
+    let r = write(
+        d.path(),
+        "r.pvtu",
+        r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="p.pvtu"/></PUnstructuredGrid></VTKFile>"#,
+    );
+    assert!(io::read(&r, &ReadOptions::default()).is_err());
+}
+
+// ---------------------------------------------------------------- corrupt files
+
+#[test]
+fn every_corrupt_xml_file_fails_naming_the_file() {
+    let dir = zoovr::testdata::mesh_file("corrupt");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if !name.starts_with("xml_") {
+            continue;
+        }
+        let t = std::time::Instant::now();
+        let r = io::read(&path, &ReadOptions::default());
+        let e = match r {
+            Ok(_) => panic!("{name} was read without error"),
+            Err(e) => e.to_string(),
+        };
+        eprintln!("{e}");
+        assert!(
+            e.contains(&name),
+            "{name}: error does not name the file: {e}"
+        );
+        assert!(
+            t.elapsed().as_secs_f64() < 2.0,
+            "{name} took {:?}",
+            t.elapsed()
+        );
+        n += 1;
+    }
+    assert!(n >= 8, "only {n} corrupt xml files");
+}
+
+/// xorshift64*: a fixed-seed generator, so failures reproduce.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+#[test]
+fn mutations_never_panic() {
+    let seeds: Vec<Vec<u8>> = vec![
+        write_sample(
+            &Enc {
+                fmt: Fmt::AppRaw,
+                comp: Comp::Zlib,
+                h64: true,
+                be: false,
+                block: 48,
+                joined: false,
+            },
+            "Int64",
+            "UInt8",
+        ),
+        write_sample(
+            &Enc {
+                fmt: Fmt::Binary,
+                comp: Comp::Lz4,
+                h64: false,
+                be: true,
+                block: 40,
+                joined: false,
+            },
+            "Int32",
+            "Int8",
+        ),
+        write_sample(
+            &Enc {
+                fmt: Fmt::AppB64,
+                comp: Comp::None,
+                h64: false,
+                be: false,
+                block: 64,
+                joined: false,
+            },
+            "Int32",
+            "UInt8",
+        ),
+        write_sample(
+            &Enc {
+                fmt: Fmt::Ascii,
+                comp: Comp::None,
+                h64: false,
+                be: false,
+                block: 64,
+                joined: false,
+            },
+            "Int32",
+            "UInt8",
+        ),
+        POLY.as_bytes().to_vec(),
+    ];
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let start = std::time::Instant::now();
+    let mut errors = 0;
+    let total = 3000;
+    for round in 0..total {
+        let mut b = seeds[round % seeds.len()].clone();
+        match rng.below(4) {
+            0 => b.truncate(rng.below(b.len())),
+            1 => {
+                for _ in 0..1 + rng.below(4) {
+                    let i = rng.below(b.len());
+                    b[i] ^= 1 << rng.below(8);
+                }
+            }
+            2 => {
+                let i = rng.below(b.len());
+                b[i] = b"0123456789-+e<>\"= _"[rng.below(19)];
+            }
+            _ => {
+                let i = rng.below(b.len());
+                let j = (i + rng.below(64)).min(b.len());
+                b.drain(i..j);
+            }
+        }
+        let r = std::panic::catch_unwind(|| {
+            xml::read_bytes(Path::new("mut.vtu"), &b, Format::XmlUnstructured)
+        });
+        match r {
+            Ok(Ok(m)) => check_mesh(&m),
+            Ok(Err(e)) => {
+                assert!(e.to_string().contains("mut.vtu"));
+                errors += 1;
+            }
+            Err(_) => panic!(
+                "round {round} panicked; input: {:?}",
+                String::from_utf8_lossy(&b)
+            ),
+        }
+    }
+    assert!(errors > total / 4, "mutations should mostly fail: {errors}");
+    assert!(start.elapsed().as_secs() < 30, "{:?}", start.elapsed());
+}
