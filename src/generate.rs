@@ -312,6 +312,67 @@ fn pick<T: Copy>(v: &[T], keep: &[usize], nc: usize) -> Vec<T> {
         .collect()
 }
 
+/// One positively oriented, convex cell of `kind` (unit size) with the point
+/// scalar `f`. [`CellKind::Polyhedron`] gives a "house": a cube with a
+/// pyramid roof (5 quads, 4 triangles).
+pub fn single_cell(kind: CellKind) -> Mesh {
+    let ring = |n: usize, z: f64| -> Vec<DVec3> {
+        (0..n)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / n as f64;
+                DVec3::new(0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin(), z)
+            })
+            .collect()
+    };
+    let square = |z: f64| -> Vec<DVec3> {
+        [(0., 0.), (1., 0.), (1., 1.), (0., 1.)]
+            .iter()
+            .map(|&(x, y)| DVec3::new(x, y, z))
+            .collect()
+    };
+    let mut mesh = Mesh::default();
+    match kind {
+        CellKind::Tetra => {
+            mesh.points = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+        }
+        CellKind::Pyramid => {
+            mesh.points = square(0.0);
+            mesh.points.push(DVec3::new(0.5, 0.5, 1.0));
+        }
+        CellKind::Wedge => {
+            // VTK: the first triangle's normal points away from the second.
+            mesh.points = vec![DVec3::ZERO, DVec3::Y, DVec3::X];
+            mesh.points.extend([DVec3::Z, DVec3::new(0., 1., 1.), DVec3::new(1., 0., 1.)]);
+        }
+        CellKind::Hexahedron => {
+            mesh.points = square(0.0);
+            mesh.points.extend(square(1.0));
+        }
+        CellKind::PentagonalPrism | CellKind::HexagonalPrism => {
+            let n = if kind == CellKind::PentagonalPrism { 5 } else { 6 };
+            mesh.points = ring(n, 0.0);
+            mesh.points.extend(ring(n, 1.0));
+        }
+        CellKind::Polyhedron => {
+            mesh.points = square(0.0);
+            mesh.points.extend(square(1.0));
+            mesh.points.push(DVec3::new(0.5, 0.5, 1.6));
+            let mut faces: Vec<Vec<u32>> = CellKind::Hexahedron.faces()[..5]
+                .iter()
+                .map(|f| f.iter().map(|&l| l as u32).collect())
+                .collect();
+            for i in 0..4u32 {
+                faces.push(vec![4 + i, 4 + (i + 1) % 4, 8]);
+            }
+            mesh.cells.push_polyhedron(faces);
+            return finish(mesh, 0.0);
+        }
+    }
+    let nodes: Vec<u32> = (0..mesh.points.len() as u32).collect();
+    mesh.cells.push(kind, &nodes);
+    finish(mesh, 0.0)
+}
+
 /// `steps` time steps `(time, mesh)` of an `n^3` warped grid: same geometry,
 /// `f` evaluated at `t = 0, 0.5, 1, ...`.
 pub fn time_series(n: usize, steps: usize) -> Vec<(f64, Mesh)> {
