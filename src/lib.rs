@@ -7,6 +7,7 @@
 
 pub mod camera;
 pub mod field;
+pub mod generate;
 pub mod gpu;
 pub mod image;
 pub mod integrate;

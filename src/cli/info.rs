@@ -1,4 +1,9 @@
-//! `zoovr info FILE [--json]`.
+//! `zoovr info FILE [--json]`: what a file holds (cells by kind, points,
+//! bounds, arrays with types and ranges, time steps) and the structure and
+//! quality facts of [`MeshReport`] (boundary faces, components, convexity,
+//! inverted / degenerate cells, nonplanar faces, inverted consistent tets).
+//! The JSON keys are a contract (DESIGN.md, Conventions); the text output
+//! prints the same values.
 
 use std::path::PathBuf;
 
@@ -7,6 +12,7 @@ use clap::Args;
 use serde_json::{json, Value};
 
 use zoovr::io::{self, ReadOptions};
+use zoovr::mesh::report::MeshReport;
 use zoovr::mesh::Mesh;
 
 #[derive(Args, Debug)]
@@ -57,7 +63,17 @@ fn arrays_json(mesh: &Mesh) -> Vec<Value> {
     out
 }
 
-fn describe(mesh: &Mesh, timesteps: usize) -> Value {
+/// Finite JSON number or `null`.
+fn num(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
+    }
+}
+
+pub(crate) fn describe(mesh: &Mesh, timesteps: usize) -> Value {
+    let r = MeshReport::compute(mesh);
     json!({
         "cells3d": mesh.cells.len(),
         "cells_by_type": mesh.source.cells_by_type,
@@ -66,6 +82,22 @@ fn describe(mesh: &Mesh, timesteps: usize) -> Value {
         "bounds": mesh.bounds(),
         "arrays": arrays_json(mesh),
         "timesteps": timesteps,
+        "faces": r.faces,
+        "boundary_faces": r.boundary_faces,
+        "nonmanifold_faces": r.nonmanifold_faces,
+        "components": r.components,
+        "volume": num(r.volume),
+        "hull_volume": num(r.hull_volume),
+        "convexity": r.convexity.map_or(Value::Null, num),
+        "inverted_cells": r.inverted_cells,
+        "degenerate_cells": r.degenerate_cells,
+        "repeated_index_cells": r.repeated_index_cells,
+        "nonplanar_faces": r.nonplanar_faces,
+        "max_nonplanarity": num(r.max_nonplanarity),
+        "tets": r.tets,
+        "inverted_tets": r.inverted_tets,
+        "flat_tets": r.flat_tets,
+        "coincident_points": r.coincident_points,
     })
 }
 
@@ -80,6 +112,29 @@ fn print_text(file: &std::path::Path, v: &Value) {
     println!("points:      {}", v["points"]);
     println!("bounds:      {}", v["bounds"]);
     println!("time steps:  {}", v["timesteps"]);
+    println!(
+        "faces:       {} ({} boundary, {} non-manifold)",
+        v["faces"], v["boundary_faces"], v["nonmanifold_faces"]
+    );
+    println!("components:  {}", v["components"]);
+    println!(
+        "convexity:   {} (volume {} / hull volume {})",
+        v["convexity"], v["volume"], v["hull_volume"]
+    );
+    println!(
+        "cells:       {} inverted, {} degenerate, {} with a repeated point",
+        v["inverted_cells"], v["degenerate_cells"], v["repeated_index_cells"]
+    );
+    println!(
+        "quad faces:  {} nonplanar (> 1e-3 of the diagonal; max {})",
+        v["nonplanar_faces"], v["max_nonplanarity"]
+    );
+    println!(
+        "tets:        {} consistent, {} inverted after repair, {} flat",
+        v["tets"], v["inverted_tets"], v["flat_tets"]
+    );
+    println!("ignored:     {} 0D-2D cells", v["ignored_cells"]);
+    println!("coincident:  {} points", v["coincident_points"]);
     if let Some(arrs) = v["arrays"].as_array() {
         println!("arrays:");
         for a in arrs {
@@ -92,5 +147,57 @@ fn print_text(file: &std::path::Path, v: &Value) {
                 a["range"]
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoovr::generate::{ring_grid, warped_hex_grid, zoo_grid, Warp};
+
+    #[test]
+    fn json_of_a_generated_grid() {
+        let m = warped_hex_grid(3, &Warp::default());
+        let v = describe(&m, 1);
+        assert_eq!(v["cells3d"], 27);
+        assert_eq!(v["cells_by_type"]["hexahedron"], 27);
+        assert_eq!(v["points"], 64);
+        assert_eq!(v["boundary_faces"], 54);
+        assert_eq!(v["faces"], 108);
+        assert_eq!(v["components"], 1);
+        assert_eq!(v["inverted_cells"], 0);
+        assert_eq!(v["degenerate_cells"], 0);
+        assert_eq!(v["inverted_tets"], 0);
+        assert_eq!(v["nonmanifold_faces"], 0);
+        assert_eq!(v["timesteps"], 1);
+        assert!(v["nonplanar_faces"].as_u64().unwrap() > 0);
+        let c = v["convexity"].as_f64().unwrap();
+        // the warp bulges the boundary in and out: not convex
+        assert!(c > 0.7 && c < 0.99, "{c}");
+        let straight = describe(&warped_hex_grid(3, &Warp { amplitude: 0.0, seed: 1 }), 1);
+        let c = straight["convexity"].as_f64().unwrap();
+        assert!((c - 1.0).abs() < 1e-12, "{c}");
+        assert_eq!(straight["nonplanar_faces"], 0);
+        let arr = &v["arrays"][0];
+        assert_eq!(arr["name"], "f");
+        assert_eq!(arr["association"], "point");
+        assert_eq!(arr["type"], "Float32");
+        let b = v["bounds"].as_array().unwrap();
+        assert_eq!(b.len(), 6);
+    }
+
+    #[test]
+    fn json_of_a_ring_and_a_zoo() {
+        let v = describe(&ring_grid(6, &Warp { amplitude: 0.0, seed: 1 }), 1);
+        // 6x6x2 minus the 2x2x2 hole
+        assert_eq!(v["cells3d"], 64);
+        let c = v["convexity"].as_f64().unwrap();
+        assert!((c - 32.0 / 36.0).abs() < 1e-12, "{c}");
+        let z = describe(&zoo_grid(3, &Warp::default()), 1);
+        for k in ["hexahedron", "wedge", "pyramid", "tetra"] {
+            assert!(z["cells_by_type"][k].as_u64().unwrap() > 0, "{k}");
+        }
+        assert_eq!(z["components"], 1);
+        assert_eq!(z["inverted_tets"], 0);
     }
 }

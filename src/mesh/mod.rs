@@ -7,9 +7,18 @@
 //! in [`SourceInfo::ignored_cells`], and cell arrays are filtered to match.
 //!
 //! Topology (unique faces, adjacency) lives in [`topology`]; consistent
-//! tetrahedralisation in [`tetra`].
+//! tetrahedralisation in [`tetra`]; connected components in [`components`];
+//! cell volumes, orientation, degeneracy and nonplanarity in [`quality`];
+//! orientation repair in [`orient`]; coincident-point merging in [`merge`];
+//! the convex hull in [`hull`]; everything `info` prints in [`report`].
 
 pub mod cell;
+pub mod components;
+pub mod hull;
+pub mod merge;
+pub mod orient;
+pub mod quality;
+pub mod report;
 pub mod tetra;
 pub mod topology;
 

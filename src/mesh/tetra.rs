@@ -17,7 +17,84 @@
 //! (positive volume for a positively oriented convex cell); distorted cells
 //! can yield inverted or flat tets, which callers must accept.
 
-use super::{CellKind, Cells};
+use std::collections::HashMap;
+
+use thiserror::Error;
+
+use super::topology::Topology;
+use super::{CellKind, Cells, NONE};
+
+/// A broken invariant of a tetrahedralisation, found by
+/// [`check_tetrahedralisation`].
+#[derive(Debug, Error, PartialEq, Eq)]
+#[error("tetrahedralisation invariant broken: {0}")]
+pub struct TetError(pub String);
+
+/// The consistent tetrahedra of all cells, with `offsets[c]..offsets[c + 1]`
+/// indexing the tets of cell `c`.
+pub fn tetrahedralize(cells: &Cells) -> (Vec<[u32; 4]>, Vec<u32>) {
+    let mut tets = Vec::with_capacity(cells.len() * 5);
+    let mut offsets = Vec::with_capacity(cells.len() + 1);
+    offsets.push(0);
+    for c in 0..cells.len() {
+        tetrahedralize_cell(cells, c, &mut tets);
+        offsets.push(tets.len() as u32);
+    }
+    (tets, offsets)
+}
+
+fn sorted3(mut t: [u32; 3]) -> [u32; 3] {
+    t.sort_unstable();
+    t
+}
+
+/// Checks that `tets` (from [`tetrahedralize`]) is a conforming
+/// tetrahedralisation of the faces in `topo`: every triangle of a tet is
+/// used by at most two tets; triangles used once are exactly the triangles
+/// of the boundary faces split by [`triangulate_face`]; every triangle of an
+/// interior face is used by exactly two tets (so shared quads got the same
+/// diagonal from both sides); no tet repeats a vertex.
+pub fn check_tetrahedralisation(topo: &Topology, tets: &[[u32; 4]]) -> Result<(), TetError> {
+    let mut uses: HashMap<[u32; 3], u32> = HashMap::with_capacity(tets.len() * 2);
+    for (i, t) in tets.iter().enumerate() {
+        let mut s = *t;
+        s.sort_unstable();
+        if s.windows(2).any(|w| w[0] == w[1]) {
+            return Err(TetError(format!("tet {i} {t:?} repeats a vertex")));
+        }
+        for tri in [[t[0], t[1], t[2]], [t[0], t[1], t[3]], [t[0], t[2], t[3]], [t[1], t[2], t[3]]] {
+            *uses.entry(sorted3(tri)).or_insert(0) += 1;
+        }
+    }
+    let mut boundary = 0usize;
+    for f in 0..topo.face_count() {
+        let interior = topo.face_cells[f][1] != NONE;
+        let mut bad = None;
+        triangulate_face(topo.face(f), |tri| {
+            let n = uses.get(&sorted3(tri)).copied().unwrap_or(0);
+            let want = if interior { 2 } else { 1 };
+            if n != want && bad.is_none() {
+                bad = Some(format!("face {f} triangle {tri:?} used by {n} tets, want {want}"));
+            }
+            boundary += (!interior) as usize;
+        });
+        if let Some(b) = bad {
+            return Err(TetError(b));
+        }
+    }
+    for (tri, &n) in &uses {
+        if n > 2 {
+            return Err(TetError(format!("triangle {tri:?} used by {n} tets")));
+        }
+    }
+    let once = uses.values().filter(|&&n| n == 1).count();
+    if once != boundary {
+        return Err(TetError(format!(
+            "{once} triangles used once but the boundary has {boundary}"
+        )));
+    }
+    Ok(())
+}
 
 /// Splits a face into triangles by the smallest-vertex rule, calling `f` with
 /// each triangle (same winding as the face).

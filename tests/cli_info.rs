@@ -1,0 +1,191 @@
+//! `zoovr info` run as a real binary on the project's own meshes.
+//!
+//! The files in `meshes/` are written by `examples/gen_mesh.rs --meshes
+//! meshes` from `zoovr::generate`; every expected value here is computed
+//! independently in memory from the same generator (or by hand for the
+//! degenerate cells), so these tests check the readers and `info` together.
+//! They need the legacy and XML readers (issue 2).
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use zoovr::generate::{ring_grid, single_cell, warped_hex_grid, zoo_grid, Warp};
+use zoovr::mesh::report::MeshReport;
+use zoovr::mesh::{CellKind, Mesh};
+use zoovr::testdata::mesh_file;
+
+fn zoovr(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_zoovr"))
+        .args(args)
+        .output()
+        .expect("run zoovr")
+}
+
+fn info_json(file: &Path) -> Value {
+    let out = zoovr(&["info", file.to_str().unwrap(), "--json"]);
+    assert!(
+        out.status.success(),
+        "{}: {}",
+        file.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object")
+}
+
+/// Asserts the JSON of `file` agrees with the in-memory `mesh`.
+fn assert_agrees(file: &str, mesh: &Mesh) {
+    let v = info_json(&mesh_file(file));
+    let r = MeshReport::compute(mesh);
+    assert_eq!(v["cells3d"], mesh.cells.len(), "{file}");
+    assert_eq!(v["points"], mesh.points.len(), "{file}");
+    let b = mesh.bounds();
+    for k in 0..6 {
+        assert_eq!(v["bounds"][k].as_f64(), Some(b[k]), "{file} bounds[{k}]");
+    }
+    for (key, want) in [
+        ("boundary_faces", r.boundary_faces),
+        ("components", r.components),
+        ("inverted_cells", r.inverted_cells),
+        ("degenerate_cells", r.degenerate_cells),
+        ("nonplanar_faces", r.nonplanar_faces),
+        ("inverted_tets", r.inverted_tets),
+        ("nonmanifold_faces", r.nonmanifold_faces),
+        ("ignored_cells", 0),
+    ] {
+        assert_eq!(v[key], want, "{file}: {key}");
+    }
+    match r.convexity {
+        Some(c) => {
+            let got = v["convexity"].as_f64().unwrap();
+            assert!((got - c).abs() < 1e-9, "{file}: convexity {got} vs {c}");
+        }
+        None => assert!(v["convexity"].is_null()),
+    }
+    assert_eq!(v["timesteps"], 1, "{file}");
+    let f = v["arrays"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["name"] == "f")
+        .unwrap_or_else(|| panic!("{file}: no array f"));
+    assert_eq!(f["association"], "point");
+    assert_eq!(f["components"], 1);
+    assert_eq!(f["type"], "Float32");
+    let range = mesh.point_data[0].range(Some(0)).unwrap();
+    assert_eq!(f["range"][0].as_f64(), Some(range.0));
+    assert_eq!(f["range"][1].as_f64(), Some(range.1));
+}
+
+#[test]
+fn one_file_per_cell_kind() {
+    for (name, kind) in [
+        ("tetra", CellKind::Tetra),
+        ("pyramid", CellKind::Pyramid),
+        ("wedge", CellKind::Wedge),
+        ("hexahedron", CellKind::Hexahedron),
+        ("pentagonal_prism", CellKind::PentagonalPrism),
+        ("hexagonal_prism", CellKind::HexagonalPrism),
+        ("polyhedron", CellKind::Polyhedron),
+    ] {
+        let mesh = single_cell(kind);
+        for ext in ["vtk", "vtu"] {
+            let file = format!("{name}.{ext}");
+            assert_agrees(&file, &mesh);
+            let v = info_json(&mesh_file(&file));
+            assert_eq!(v["cells_by_type"][name], 1, "{file}");
+            assert_eq!(v["convexity"].as_f64().map(|c| (c - 1.0).abs() < 1e-12), Some(true));
+        }
+    }
+}
+
+#[test]
+fn voxel_is_read_in_voxel_order() {
+    let v = info_json(&mesh_file("voxel.vtk"));
+    assert_eq!(v["cells3d"], 1);
+    assert_eq!(v["cells_by_type"]["voxel"], 1);
+    // as a hexahedron with the voxel order converted: a positive unit cube
+    assert_eq!(v["inverted_cells"], 0);
+    assert_eq!(v["degenerate_cells"], 0);
+    assert_eq!(v["boundary_faces"], 6);
+    assert!((v["convexity"].as_f64().unwrap() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn grids_ring_and_zoo() {
+    let w = Warp::default();
+    let curv = warped_hex_grid(4, &w);
+    assert_agrees("curvilinear_4x4x4.vtk", &curv);
+    assert_agrees("curvilinear_4x4x4.vtu", &curv);
+    let v = info_json(&mesh_file("curvilinear_4x4x4.vtu"));
+    assert_eq!(v["boundary_faces"], 96);
+    assert!(v["nonplanar_faces"].as_u64().unwrap() > 0);
+    let ring = ring_grid(6, &w);
+    assert_agrees("ring_hole.vtk", &ring);
+    assert_agrees("ring_hole.vtu", &ring);
+    let v = info_json(&mesh_file("ring_hole.vtu"));
+    assert!(v["convexity"].as_f64().unwrap() < 0.95);
+    assert_eq!(v["components"], 1);
+    let zoo = zoo_grid(3, &w);
+    assert_agrees("zoo_3x3x3.vtu", &zoo);
+}
+
+#[test]
+fn degenerate_cells_are_counted() {
+    for file in ["degenerate.vtk", "degenerate.vtu"] {
+        let v = info_json(&mesh_file(file));
+        assert_eq!(v["cells3d"], 5, "{file}");
+        assert_eq!(v["cells_by_type"]["hexahedron"], 3);
+        assert_eq!(v["cells_by_type"]["wedge"], 1);
+        assert_eq!(v["cells_by_type"]["tetra"], 1);
+        assert_eq!(v["inverted_cells"], 2, "{file}");
+        assert_eq!(v["degenerate_cells"], 2, "{file}");
+        assert_eq!(v["repeated_index_cells"], 1, "{file}");
+        assert_eq!(v["inverted_tets"], 0, "{file}");
+        assert_eq!(v["components"], 5, "{file}");
+    }
+}
+
+#[test]
+fn time_series_collections() {
+    for file in ["series/series.pvd", "series/series.vtu.series"] {
+        let v = info_json(&mesh_file(file));
+        assert_eq!(v["timesteps"], 3, "{file}");
+        assert_eq!(v["cells3d"], 27, "{file}");
+    }
+}
+
+#[test]
+fn text_output_shows_the_same_facts() {
+    let out = zoovr(&["info", mesh_file("degenerate.vtk").to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("2 inverted, 2 degenerate, 1 with a repeated point"), "{text}");
+    assert!(text.contains("components:  5"), "{text}");
+}
+
+#[test]
+fn errors_name_the_file_and_exit_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("no_such_mesh.vtk");
+    let bad = dir.path().join("truncated_mesh.vtu");
+    std::fs::write(
+        &bad,
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"8\"",
+    )
+    .unwrap();
+    for f in [&missing, &bad] {
+        let out = zoovr(&["info", f.to_str().unwrap(), "--json"]);
+        assert_eq!(out.status.code(), Some(1), "{}", f.display());
+        let err = String::from_utf8_lossy(&out.stderr);
+        let name = f.file_name().unwrap().to_str().unwrap();
+        assert!(err.contains(name), "{err}");
+        assert!(out.stdout.is_empty());
+    }
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    assert_eq!(zoovr(&["info"]).status.code(), Some(2));
+    assert_eq!(zoovr(&["info", "x.vtk", "--bogus"]).status.code(), Some(2));
+}
