@@ -202,12 +202,14 @@ fn tets_small() {
 /// Same points, cells and first point array as `vtkio` where it reads the file.
 #[test]
 fn agrees_with_vtkio() {
-    use vtkio::model::{DataSet, Piece};
+    use vtkio::model::{DataSet, Piece, VertexNumbers};
     for rel in [
         "angular_sector/AngularSector.vtk",
         "su2_sphere_hybrid/sphere_hybrid_converted_legacy42_ascii.vtk",
         "prisms_zoo/hexa.vtk",
         "tets_small/CylinderLinear.vtk",
+        "disk_out_ref/disk_out_ref_converted_legacy51_binary.vtk",
+        "synthetic/mixed.vtk",
     ] {
         let Some(p) = shared_file(rel) else { continue };
         let ours = read(&p).unwrap();
@@ -227,21 +229,80 @@ fn agrees_with_vtkio() {
                 "{rel}"
             );
         }
-        let (_, verts) = piece.cells.cell_verts.clone().into_legacy();
-        let mut k = 0;
+        // Cell node lists from either of vtkio's layouts (5.x offsets may
+        // start with a leading zero).
+        let lists: Vec<Vec<u64>> = match piece.cells.cell_verts.clone() {
+            VertexNumbers::Legacy { vertices, .. } => {
+                let mut v = Vec::new();
+                let mut k = 0;
+                while k < vertices.len() {
+                    let n = vertices[k] as usize;
+                    v.push(
+                        vertices[k + 1..k + 1 + n]
+                            .iter()
+                            .map(|&x| x as u64)
+                            .collect(),
+                    );
+                    k += 1 + n;
+                }
+                v
+            }
+            VertexNumbers::XML {
+                connectivity,
+                offsets,
+            } => {
+                let mut ends = offsets;
+                if ends.len() == piece.cells.types.len() + 1 {
+                    ends.remove(0);
+                }
+                let mut start = 0;
+                ends.iter()
+                    .map(|&e| {
+                        let l = connectivity[start..e as usize].to_vec();
+                        start = e as usize;
+                        l
+                    })
+                    .collect()
+            }
+        };
+        assert_eq!(lists.len(), piece.cells.types.len(), "{rel}");
         let mut c = 0;
-        for t in &piece.cells.types {
-            let n = verts[k] as usize;
-            let ids = &verts[k + 1..k + 1 + n];
-            k += 1 + n;
+        for (t, ids) in piece.cells.types.iter().zip(&lists) {
             if (*t as u8) < 10 {
                 continue;
             }
-            let ours_ids = ours.cells.nodes(c);
-            assert_eq!(ours_ids, &ids[..ours_ids.len()], "{rel} cell {c}");
+            let ours_ids: Vec<u64> = ours.cells.nodes(c).iter().map(|&x| x as u64).collect();
+            assert_eq!(ours_ids, ids[..ours_ids.len()], "{rel} cell {c}");
             c += 1;
         }
         assert_eq!(c, ours.cells.len());
+        // Point arrays vtkio also exposes hold the same values.
+        let mut theirs_arrays: Vec<(String, Vec<f64>)> = Vec::new();
+        for a in &piece.data.point {
+            match a {
+                vtkio::model::Attribute::DataArray(d) => {
+                    theirs_arrays.push((d.name.clone(), d.data.cast_into().unwrap()))
+                }
+                vtkio::model::Attribute::Field { data_array, .. } => {
+                    for d in data_array {
+                        theirs_arrays.push((d.name.clone(), d.data.cast_into().unwrap()));
+                    }
+                }
+            }
+        }
+        let mut compared = 0;
+        for (name, vals) in theirs_arrays {
+            let Some(a) = ours.point_data.iter().find(|a| a.name == name) else {
+                continue;
+            };
+            assert_eq!(a.data.len(), vals.len(), "{rel} {name}");
+            assert!(
+                (0..vals.len()).all(|i| a.data.get(i) == vals[i]),
+                "{rel} {name}"
+            );
+            compared += 1;
+        }
+        assert!(compared > 0, "{rel}: no array compared");
     }
 }
 

@@ -332,3 +332,19 @@ fn seeded_mutations_never_panic() {
     }
     assert!(t.elapsed() < Duration::from_secs(10));
 }
+
+#[test]
+fn multi_grid_files_are_refused_clearly() {
+    let mut b = Vec::new();
+    for v in [2i32, 2, 2, 2, 3, 2, 2] {
+        b.extend_from_slice(&v.to_be_bytes());
+    }
+    b.extend(std::iter::repeat_n(0u8, 4 * 3 * (8 + 12)));
+    let e = read_bytes(Path::new("multi.xyz"), &b, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("multi.xyz") && e.contains("2 grids") && e.contains("byte 0"),
+        "{e}"
+    );
+}

@@ -252,6 +252,13 @@ fn detect(b: &[u8], q: bool, want: Option<[usize; 3]>) -> Option<Layout> {
 /// dimensions, where the data should start and how many bytes it needs.
 fn diagnose(path: &Path, b: &[u8], q: bool) -> IoError {
     let kind = if q { "q solution" } else { "grid" };
+    if let Some(nb) = grid_count(b) {
+        return IoError::parse(
+            path,
+            Location::Byte(0),
+            format!("PLOT3D {kind} with {nb} grids: only single-grid files are read"),
+        );
+    }
     for framing in Framing::ALL {
         let Some((d, off)) = framing.header(b) else {
             continue;
@@ -284,6 +291,27 @@ fn diagnose(path: &Path, b: &[u8], q: bool) -> IoError {
             b.len()
         ),
     )
+}
+
+/// The grid count of a multi-grid file (`nblocks > 1` followed by that many
+/// plausible dimension triples), in any framing.
+fn grid_count(b: &[u8]) -> Option<i64> {
+    Framing::ALL.iter().find_map(|f| {
+        let (nb, dims_at) = if f.markers {
+            (f.int(b, 0)? == 4 && f.int(b, 8)? == 4).then_some(())?;
+            (f.int(b, 4)?, 16)
+        } else {
+            (f.int(b, 0)?, 4)
+        };
+        if !(2..=1_000_000).contains(&nb) {
+            return None;
+        }
+        let plausible = (0..3 * nb.min(64) as usize).all(|i| {
+            f.int(b, dims_at + 4 * i)
+                .is_some_and(|d| (1..=1 << 24).contains(&d))
+        });
+        plausible.then_some(nb)
+    })
 }
 
 /// Whether the first bytes look like a PLOT3D grid header (used by format
