@@ -426,3 +426,38 @@ fn ensure_buffer(
     *slot = Some(b.clone());
     b
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniforms_match_wgsl_params() {
+        let module = naga::front::wgsl::parse_str(super::super::EXACT_WGSL).unwrap();
+        let (members, span) = module
+            .types
+            .iter()
+            .find_map(|(_, t)| match (&t.name, &t.inner) {
+                (Some(n), naga::TypeInner::Struct { members, span }) if n == "Params" => {
+                    Some((members.clone(), *span))
+                }
+                _ => None,
+            })
+            .expect("struct Params");
+        assert_eq!(span as usize, std::mem::size_of::<FrameUniforms>());
+        let offs: Vec<(String, u32)> = members
+            .iter()
+            .take(5)
+            .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+            .collect();
+        let want = [
+            ("inv_unit", std::mem::offset_of!(FrameUniforms, inv_unit)),
+            ("unit", std::mem::offset_of!(FrameUniforms, unit)),
+            ("scale", std::mem::offset_of!(FrameUniforms, scale)),
+            ("inv_log_range", std::mem::offset_of!(FrameUniforms, inv_log_range)),
+            ("n", std::mem::offset_of!(FrameUniforms, n)),
+        ];
+        let want: Vec<(String, u32)> = want.iter().map(|(n, o)| (n.to_string(), *o as u32)).collect();
+        assert_eq!(offs, want);
+    }
+}
