@@ -199,13 +199,17 @@ fn thousand_thin_layers_precision() {
              accumulation only {err_acc:.3e}",
             img.pixels[0][3]
         );
-        // Measured on lavapipe and llvmpipe: f16 loses ~2.4e-2 of 0.095
-        // (adds of 1e-4 to a value whose ulp is 6e-5 round badly); f32 ~1e-7.
-        let bound = match format {
-            AccumFormat::F32 => 1e-5,
-            _ => 4e-2,
+        // Measured on lavapipe (Vulkan) and llvmpipe (GL): f16 ends at alpha
+        // 0.0823 instead of 0.0952, an error of 1.29e-2 (adding 1e-4 to a
+        // value whose f16 ulp is 6.1e-5 rounds every step); f32: 8.3e-7 from
+        // accumulation, 1.3e-5 in all (the table's 1.3e-4 relative error of
+        // alpha = 1e-4, summed over the layers).
+        let (bound, bound_acc) = match format {
+            AccumFormat::F32 => (2e-5, 2e-6),
+            _ => (1.5e-2, 1.5e-2),
         };
         assert!(err_exact < bound, "{format}: {err_exact:.3e} > {bound:.0e}");
+        assert!(err_acc < bound_acc, "{format}: {err_acc:.3e} > {bound_acc:.0e}");
         assert!(img.pixels[0][3] > 0.0);
     }
 }
@@ -276,12 +280,17 @@ fn no_nan_on_triangles_crossing_the_edge_with_different_w() {
         let (w, h) = (32u32, 32u32);
         let m = ClipMapper::new(w, h, false);
         let mut verts = Vec::new();
-        // Fans reaching far outside every edge, with w from 0.01 to 1000.
-        let far = [(-500.0, 16.0), (16.0, -700.0), (900.0, 20.0), (10.0, 800.0)];
-        for (k, &(x, y)) in far.iter().enumerate() {
-            let zs = [0.01, 1000.0, 1.0 + k as f64];
-            let pts = [(16.0, 16.0), (x, y), (x * 0.5 + 20.0, y * 0.3 + 5.0)];
-            for (p, z) in pts.iter().zip(zs) {
+        // Triangles from a near centre vertex (w = 0.01) to vertices far
+        // outside every edge (w = 1000 and 0.5..5): large w differences across
+        // the clipped edges.
+        let far = [
+            ((-500.0, -400.0), (-300.0, 700.0), 3.0),
+            ((-100.0, -600.0), (700.0, -300.0), 2.0),
+            ((900.0, -200.0), (600.0, 900.0), 5.0),
+            ((400.0, 800.0), (-400.0, 500.0), 0.5),
+        ];
+        for &(a, b, zb) in &far {
+            for (p, z) in [((16.0, 16.0), 0.01), (a, 1000.0), (b, zb)] {
                 verts.push(ExactVertex::new(
                     m.clip(p.0, p.1, z).unwrap(),
                     1.0,
@@ -295,7 +304,29 @@ fn no_nan_on_triangles_crossing_the_edge_with_different_w() {
         let img = render(&ctx, &FrameOptions::new(w, h, format), &verts, &idx).unwrap();
         assert_eq!(img.count_non_finite(), 0, "{backend}: NaN in the image");
         assert!(img.pixels.iter().all(|p| p[3] >= 0.0 && p[3] <= 1.0));
-        assert!(img.pixels.iter().filter(|p| p[3] > 0.0).count() > 100);
+        // Constant l and tau: a pixel inside k triangles has 1 - (1 - a)^k.
+        let a = exact_alpha(1.0, 0.5);
+        let mut covered = 0;
+        for j in 0..h {
+            for i in 0..w {
+                let (x, y) = (i as f64 + 0.5, j as f64 + 0.5);
+                let mut k = 0;
+                let mut on_edge = false;
+                for &(pa, pb, _) in &far {
+                    let b = barycentric([(16.0, 16.0), pa, pb], x, y);
+                    on_edge |= b.iter().any(|v| v.abs() < 1e-4);
+                    k += b.iter().all(|&v| v > 0.0) as i32;
+                }
+                if on_edge {
+                    continue;
+                }
+                covered += (k > 0) as usize;
+                let want = 1.0 - (1.0 - a).powi(k);
+                let got = img.get(i, j)[3] as f64;
+                assert!((got - want).abs() < 2e-3, "{backend} ({i},{j}): {got} vs {want} (k {k})");
+            }
+        }
+        assert!(covered > 500, "{covered} pixels covered");
     }
 }
 
