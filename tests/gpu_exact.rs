@@ -134,8 +134,13 @@ fn alpha_follows_interpolated_thickness() {
                 ExactVertex::new(p, ls[k], tau, [1.0, 1.0, 1.0])
             })
             .collect();
-        let img = render(&ctx, &FrameOptions::new(w, h, AccumFormat::Auto), &verts, &[0, 1, 2])
-            .unwrap();
+        let img = render(
+            &ctx,
+            &FrameOptions::new(w, h, AccumFormat::Auto),
+            &verts,
+            &[0, 1, 2],
+        )
+        .unwrap();
         let mut worst = 0.0f64;
         for j in 0..h {
             for i in 0..w {
@@ -152,7 +157,10 @@ fn alpha_follows_interpolated_thickness() {
         }
         eprintln!("ortho {ortho}: max |alpha - exact| = {worst:.2e}");
         // Table error plus the rasteriser's f32 interpolation.
-        assert!(worst < EXP_TABLE_MAX_ABS_ERROR + 5e-5, "ortho {ortho}: {worst:.3e}");
+        assert!(
+            worst < EXP_TABLE_MAX_ABS_ERROR + 5e-5,
+            "ortho {ortho}: {worst:.3e}"
+        );
     }
 }
 
@@ -181,7 +189,9 @@ fn thousand_thin_layers_precision() {
         formats.push(AccumFormat::F32);
     }
     for format in formats {
-        let mut frame = ctx.begin_frame_with(&FrameOptions::new(w, h, format)).unwrap();
+        let mut frame = ctx
+            .begin_frame_with(&FrameOptions::new(w, h, format))
+            .unwrap();
         for _ in 0..n {
             frame.push_triangles(&quad, &[0, 1, 2, 2, 1, 3]).unwrap();
         }
@@ -209,7 +219,10 @@ fn thousand_thin_layers_precision() {
             _ => (1.5e-2, 1.5e-2),
         };
         assert!(err_exact < bound, "{format}: {err_exact:.3e} > {bound:.0e}");
-        assert!(err_acc < bound_acc, "{format}: {err_acc:.3e} > {bound_acc:.0e}");
+        assert!(
+            err_acc < bound_acc,
+            "{format}: {err_acc:.3e} > {bound_acc:.0e}"
+        );
         assert!(img.pixels[0][3] > 0.0);
     }
 }
@@ -243,7 +256,13 @@ fn many_small_batches_equal_one_batch() {
     let Some(ctx) = open(None) else { return };
     let (w, h) = (40u32, 30u32);
     let (verts, idx) = random_scene(7, 300, w, h);
-    let one = render(&ctx, &FrameOptions::new(w, h, AccumFormat::Auto), &verts, &idx).unwrap();
+    let one = render(
+        &ctx,
+        &FrameOptions::new(w, h, AccumFormat::Auto),
+        &verts,
+        &idx,
+    )
+    .unwrap();
     // One push per triangle, 2-3 triangles per batch.
     let small = FrameOptions {
         batch_vertices: 7,
@@ -267,7 +286,13 @@ fn many_small_batches_equal_one_batch() {
         .collect();
     let mut split_idx = idx.clone();
     split_idx.extend_from_slice(&shared);
-    let big = render(&ctx, &FrameOptions::new(w, h, AccumFormat::Auto), &verts, &split_idx).unwrap();
+    let big = render(
+        &ctx,
+        &FrameOptions::new(w, h, AccumFormat::Auto),
+        &verts,
+        &split_idx,
+    )
+    .unwrap();
     let split = render(&ctx, &small, &verts, &split_idx).unwrap();
     assert_eq!(big, split);
     assert_eq!(one.count_non_finite(), 0);
@@ -276,7 +301,9 @@ fn many_small_batches_equal_one_batch() {
 #[test]
 fn no_nan_on_triangles_crossing_the_edge_with_different_w() {
     for backend in [Backend::Vulkan, Backend::Gl] {
-        let Some(ctx) = open(Some(backend)) else { continue };
+        let Some(ctx) = open(Some(backend)) else {
+            continue;
+        };
         let (w, h) = (32u32, 32u32);
         let m = ClipMapper::new(w, h, false);
         let mut verts = Vec::new();
@@ -323,7 +350,10 @@ fn no_nan_on_triangles_crossing_the_edge_with_different_w() {
                 covered += (k > 0) as usize;
                 let want = 1.0 - (1.0 - a).powi(k);
                 let got = img.get(i, j)[3] as f64;
-                assert!((got - want).abs() < 2e-3, "{backend} ({i},{j}): {got} vs {want} (k {k})");
+                assert!(
+                    (got - want).abs() < 2e-3,
+                    "{backend} ({i},{j}): {got} vs {want} (k {k})"
+                );
             }
         }
         assert!(covered > 500, "{covered} pixels covered");
@@ -332,8 +362,12 @@ fn no_nan_on_triangles_crossing_the_edge_with_different_w() {
 
 #[test]
 fn vulkan_and_gl_agree_with_f16_forced() {
-    let Some(vk) = open(Some(Backend::Vulkan)) else { return };
-    let Some(gl) = open(Some(Backend::Gl)) else { return };
+    let Some(vk) = open(Some(Backend::Vulkan)) else {
+        return;
+    };
+    let Some(gl) = open(Some(Backend::Gl)) else {
+        return;
+    };
     let (w, h) = (64u32, 48u32);
     let (verts, idx) = random_scene(42, 400, w, h);
     let opts = FrameOptions::new(w, h, AccumFormat::F16);
@@ -341,7 +375,10 @@ fn vulkan_and_gl_agree_with_f16_forced() {
     let b = render(&gl, &opts, &verts, &idx).unwrap();
     assert_eq!(a.count_non_finite() + b.count_non_finite(), 0);
     let (d, _) = zoovr::image::compare_float(&a, &b).unwrap();
-    eprintln!("vulkan vs gl (f16): max {:.3e}, rms {:.3e}", d.max_abs, d.rms);
+    eprintln!(
+        "vulkan vs gl (f16): max {:.3e}, rms {:.3e}",
+        d.max_abs, d.rms
+    );
     // Same format, same blend maths: differences are f16 rounding of the
     // fragment values (a few ulps of f16 over the layers of a pixel).
     assert!(d.max_abs < 4e-3 && d.rms < 2e-4, "{d:?}");
@@ -362,7 +399,10 @@ fn bad_input_is_an_error_not_a_panic() {
         length_unit: f32::NAN,
         ..FrameOptions::new(4, 4, AccumFormat::Auto)
     };
-    assert!(matches!(ctx.begin_frame_with(&bad_unit), Err(GpuError::BadOption(_))));
+    assert!(matches!(
+        ctx.begin_frame_with(&bad_unit),
+        Err(GpuError::BadOption(_))
+    ));
     let mut frame = ctx.begin_frame(4, 4, AccumFormat::Auto).unwrap();
     let v = ExactVertex::new([0.0, 0.0, 0.5, 1.0], 1.0, 1.0, [1.0; 3]);
     assert!(matches!(
@@ -387,7 +427,9 @@ fn bad_input_is_an_error_not_a_panic() {
 
 #[test]
 fn gl_refuses_forced_f32_and_auto_is_f16() {
-    let Some(gl) = open(Some(Backend::Gl)) else { return };
+    let Some(gl) = open(Some(Backend::Gl)) else {
+        return;
+    };
     if gl.info().auto_format == AccumFormat::F16 {
         assert!(matches!(
             gl.begin_frame(4, 4, AccumFormat::F32),

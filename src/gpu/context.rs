@@ -136,7 +136,9 @@ impl Context {
             adapter: ai.name.clone(),
             backend: format!("{:?}", ai.backend),
             device_type: format!("{:?}", ai.device_type),
-            driver: format!("{} {}", ai.driver, ai.driver_info).trim().to_string(),
+            driver: format!("{} {}", ai.driver, ai.driver_info)
+                .trim()
+                .to_string(),
             auto_format: if f32_blendable {
                 AccumFormat::F32
             } else {
@@ -338,4 +340,35 @@ fn upload_table(device: &wgpu::Device, queue: &wgpu::Queue, table: &ExpTable) ->
         size,
     );
     texture.create_view(&wgpu::TextureViewDescriptor::default())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn destroyed_device_gives_errors_not_panics() {
+        let ctx = match Context::new(&GpuOptions::default()) {
+            Ok(c) => c,
+            Err(e @ GpuError::NoAdapter { .. }) => {
+                eprintln!("skipping: {e}");
+                return;
+            }
+            Err(e) => panic!("{e}"),
+        };
+        let mut frame = ctx.begin_frame(8, 8, AccumFormat::Auto).unwrap();
+        let v = ExactVertex::new([0.0, 0.0, 0.5, 1.0], 1.0, 1.0, [1.0; 3]);
+        let v2 = ExactVertex::new([1.0, 0.0, 0.5, 1.0], 1.0, 1.0, [1.0; 3]);
+        let v3 = ExactVertex::new([0.0, 1.0, 0.5, 1.0], 1.0, 1.0, [1.0; 3]);
+        frame.push_triangles(&[v, v2, v3], &[0, 1, 2]).unwrap();
+        ctx.device.destroy();
+        let r = frame.finish();
+        assert!(
+            matches!(r, Err(GpuError::DeviceLost(_) | GpuError::Wgpu(_))),
+            "{:?}",
+            r.map(|_| ())
+        );
+        assert!(ctx.check().is_err());
+        assert!(ctx.begin_frame(8, 8, AccumFormat::Auto).is_err());
+    }
 }

@@ -132,7 +132,9 @@ impl Context {
             });
         }
         if !(opts.length_unit > 0.0 && opts.length_unit.is_finite()) {
-            return Err(GpuError::BadOption("length_unit must be positive and finite"));
+            return Err(GpuError::BadOption(
+                "length_unit must be positive and finite",
+            ));
         }
         if opts.batch_vertices < 3 || opts.batch_indices < 3 {
             return Err(GpuError::BadOption("batches need room for one triangle"));
@@ -145,7 +147,9 @@ impl Context {
             .min(MAX_INDEX_VALUE + 1);
         let cap_indices = opts.batch_indices.min(max_buf / 4);
         if cap_vertices < 3 || cap_indices < 3 {
-            return Err(GpuError::BadOption("the adapter's buffer limit is too small"));
+            return Err(GpuError::BadOption(
+                "the adapter's buffer limit is too small",
+            ));
         }
 
         let target = self.device.create_texture(&wgpu::TextureDescriptor {
@@ -158,7 +162,9 @@ impl Context {
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: format.texture_format().unwrap_or(wgpu::TextureFormat::Rgba16Float),
+            format: format
+                .texture_format()
+                .unwrap_or(wgpu::TextureFormat::Rgba16Float),
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
@@ -271,7 +277,10 @@ impl Frame<'_> {
         let mut remap = vec![u32::MAX; vertices.len()];
         let mut touched: Vec<usize> = Vec::new();
         for tri in indices.chunks_exact(3) {
-            let new = tri.iter().filter(|&&i| remap[i as usize] == u32::MAX).count();
+            let new = tri
+                .iter()
+                .filter(|&&i| remap[i as usize] == u32::MAX)
+                .count();
             if !self.fits(new, 3) {
                 self.flush()?;
                 for t in touched.drain(..) {
@@ -381,12 +390,12 @@ impl Frame<'_> {
     pub fn finish_with_stats(mut self) -> Result<(Image, FrameStats), GpuError> {
         self.flush()?;
         if !self.cleared {
-            let mut encoder = self
-                .ctx
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("clear"),
-                });
+            let mut encoder =
+                self.ctx
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("clear"),
+                    });
             drop(self.begin_pass(&mut encoder));
             self.ctx.queue.submit([encoder.finish()]);
             self.cleared = true;
@@ -454,10 +463,16 @@ mod tests {
             ("inv_unit", std::mem::offset_of!(FrameUniforms, inv_unit)),
             ("unit", std::mem::offset_of!(FrameUniforms, unit)),
             ("scale", std::mem::offset_of!(FrameUniforms, scale)),
-            ("inv_log_range", std::mem::offset_of!(FrameUniforms, inv_log_range)),
+            (
+                "inv_log_range",
+                std::mem::offset_of!(FrameUniforms, inv_log_range),
+            ),
             ("n", std::mem::offset_of!(FrameUniforms, n)),
         ];
-        let want: Vec<(String, u32)> = want.iter().map(|(n, o)| (n.to_string(), *o as u32)).collect();
+        let want: Vec<(String, u32)> = want
+            .iter()
+            .map(|(n, o)| (n.to_string(), *o as u32))
+            .collect();
         assert_eq!(offs, want);
     }
 }

@@ -116,6 +116,13 @@ impl ClipMapper {
         out.iter().all(|v| v.is_finite()).then_some(out)
     }
 
+    /// Clip position of a camera-relative point (see
+    /// [`Camera::to_view`]); `None` behind the near plane.
+    pub fn clip_view(&self, camera: &Camera, view: glam::DVec3) -> Option<[f32; 4]> {
+        let (px, py, z) = camera.view_to_pixel(view)?;
+        self.clip(px, py, z)
+    }
+
     /// Inverse of [`Self::clip`]: continuous pixel coordinates of a clip
     /// position (after the perspective divide, as the rasteriser sees it).
     pub fn pixel_of(&self, pos: [f32; 4]) -> (f64, f64) {
@@ -176,5 +183,7 @@ mod tests {
         let (px, py, z) = cam.project(ray.origin + ray.dir * 4.0).unwrap();
         let (qx, qy) = m.pixel_of(m.clip(px, py, z).unwrap());
         assert!((qx - 5.5).abs() < 1e-4 && (qy - 7.5).abs() < 1e-4);
+        let v = cam.to_view(ray.origin + ray.dir * 4.0);
+        assert_eq!(m.clip_view(&cam, v), m.clip(px, py, z));
     }
 }
