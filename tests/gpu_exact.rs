@@ -168,7 +168,14 @@ fn alpha_follows_interpolated_thickness() {
 /// exact f64 composite, for each format the adapter offers.
 #[test]
 fn thousand_thin_layers_precision() {
-    let Some(ctx) = open(None) else { return };
+    for backend in [Backend::Vulkan, Backend::Gl] {
+        if let Some(ctx) = open(Some(backend)) {
+            thin_layers_on(&ctx, backend);
+        }
+    }
+}
+
+fn thin_layers_on(ctx: &Context, backend: Backend) {
     let (w, h) = (8u32, 8u32);
     let a = 1e-4f64;
     let tau = -(1.0 - a).ln();
@@ -205,7 +212,7 @@ fn thousand_thin_layers_precision() {
             }
         }
         eprintln!(
-            "{format}: alpha {:.6} (exact {exact_a:.6}); max error vs exact {err_exact:.3e}, \
+            "{backend} {format}: alpha {:.6} (exact {exact_a:.6}); max error vs exact {err_exact:.3e}, \
              accumulation only {err_acc:.3e}",
             img.pixels[0][3]
         );
@@ -438,5 +445,62 @@ fn gl_refuses_forced_f32_and_auto_is_f16() {
     }
     if let Some(vk) = open(Some(Backend::Vulkan)) {
         eprintln!("vulkan auto format: {}", vk.info().auto_format);
+    }
+}
+
+/// The GPU's table lookup over the whole range: one pixel per (l, tau) pair,
+/// log-spaced over [1e-8, 1e6] on both axes, against the CPU twin and the
+/// exact value.
+#[test]
+fn gpu_table_lookup_matches_twin_and_exact() {
+    let table = ExpTable::new(TABLE_N);
+    for backend in [Backend::Vulkan, Backend::Gl] {
+        let Some(ctx) = open(Some(backend)) else {
+            continue;
+        };
+        let n = 64u32;
+        let val = |k: u32| (1e-8f64 * 1e14f64.powf((k as f64 + 0.29) / n as f64)) as f32;
+        let m = ClipMapper::new(n, n, true);
+        let mut verts = Vec::new();
+        let mut idx = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let base = verts.len() as u32;
+                for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+                    let p = m.clip(i as f64 + dx, j as f64 + dy, 1.0).unwrap();
+                    verts.push(ExactVertex::new(p, val(i), val(j), [1.0; 3]));
+                }
+                idx.extend_from_slice(&[base, base + 1, base + 2, base + 2, base + 1, base + 3]);
+            }
+        }
+        let mut frame = ctx.begin_frame(n, n, AccumFormat::Auto).unwrap();
+        let fmt = frame.format();
+        frame.push_triangles(&verts, &idx).unwrap();
+        let img = frame.finish().unwrap();
+        let (mut vs_twin, mut vs_exact) = (0.0f64, 0.0f64);
+        for j in 0..n {
+            for i in 0..n {
+                let got = img.get(i, j)[3] as f64;
+                let twin = table.sample(val(i), val(j)) as f64;
+                // f16 storage: within 1 ulp (2^-10 relative); llvmpipe (GL)
+                // rounds towards zero (measured), lavapipe to nearest.
+                let store = if fmt == AccumFormat::F32 {
+                    0.0
+                } else {
+                    twin * 9.8e-4
+                };
+                vs_twin = vs_twin.max((got - twin).abs() - store);
+                vs_exact = vs_exact.max((got - exact_alpha(val(i) as f64, val(j) as f64)).abs());
+            }
+        }
+        eprintln!(
+            "{backend} ({fmt}): max |gpu - twin| {vs_twin:.2e}, |gpu - exact| {vs_exact:.2e}"
+        );
+        assert!(vs_twin < 3e-6, "{backend}: {vs_twin:.3e}");
+        let store = if fmt == AccumFormat::F32 { 0.0 } else { 9.8e-4 };
+        assert!(
+            vs_exact < EXP_TABLE_MAX_ABS_ERROR + store,
+            "{backend}: {vs_exact:.3e}"
+        );
     }
 }
