@@ -1,0 +1,189 @@
+//! The exact-mode vertex and the pixel -> clip-space mapping.
+//!
+//! [`ExactVertex`] mirrors `VertexIn` in `shaders/exact.wgsl` (keep in sync:
+//! field order, offsets and [`ExactVertex::LAYOUT`]'s formats).
+//!
+//! [`ClipMapper`] builds clip-space positions from continuous pixel
+//! coordinates `(px, py)` (row 0 at the top, pixel centres at `i + 0.5`, as in
+//! [`crate::camera::Camera::view_to_pixel`]) and the view depth `z`:
+//! `ndc = (2 px / W - 1, 1 - 2 py / H)`; wgpu's viewport maps NDC x = -1 to the
+//! left edge of column 0 and y = +1 to the top edge of row 0, and the
+//! rasteriser samples pixel centres, so the pixel whose centre is at `(px, py)`
+//! samples exactly that point. Perspective: `w = z` (and `x, y` scaled by
+//! `z`), so the hardware's perspective-correct interpolation makes every
+//! varying affine in view space on the triangle; orthographic: `w = 1`, i.e.
+//! affine in screen space. Clip z is `w / 2`: always inside the clip volume,
+//! no depth test.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::camera::Camera;
+
+/// One vertex of the exact mode.
+///
+/// Keep in sync with `VertexIn` in `shaders/exact.wgsl`.
+#[repr(C)]
+#[derive(Pod, Zeroable, Clone, Copy, Debug, Default, PartialEq)]
+pub struct ExactVertex {
+    /// Clip-space position (x, y, z, w); see [`ClipMapper`].
+    pub pos: [f32; 4],
+    /// `l`, the length of the ray through the piece at this vertex.
+    pub thickness: f32,
+    /// Mean extinction along that ray (optical depth / l).
+    pub tau: f32,
+    /// `C / alpha`: colour of the segment per unit opacity.
+    pub glow: [f32; 3],
+    pub _pad: f32,
+}
+
+impl ExactVertex {
+    /// Vertex attributes (`@location`s of `VertexIn`).
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 4] = wgpu::vertex_attr_array![
+        0 => Float32x4,
+        1 => Float32,
+        2 => Float32,
+        3 => Float32x3,
+    ];
+
+    /// The vertex buffer layout of the exact pipeline.
+    pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<ExactVertex>() as wgpu::BufferAddress,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &Self::ATTRIBUTES,
+    };
+
+    /// A vertex from a clip position and its optical values.
+    pub fn new(pos: [f32; 4], thickness: f32, tau: f32, glow: [f32; 3]) -> ExactVertex {
+        ExactVertex {
+            pos,
+            thickness,
+            tau,
+            glow,
+            _pad: 0.0,
+        }
+    }
+
+    /// Whether every value the shader reads is finite.
+    pub fn is_finite(&self) -> bool {
+        self.pos.iter().all(|v| v.is_finite())
+            && self.thickness.is_finite()
+            && self.tau.is_finite()
+            && self.glow.iter().all(|v| v.is_finite())
+    }
+}
+
+/// Maps continuous pixel coordinates and view depth to clip space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClipMapper {
+    pub width: u32,
+    pub height: u32,
+    pub ortho: bool,
+}
+
+impl ClipMapper {
+    /// For an image of `width x height`; `ortho` selects w = 1.
+    pub fn new(width: u32, height: u32, ortho: bool) -> ClipMapper {
+        ClipMapper {
+            width,
+            height,
+            ortho,
+        }
+    }
+
+    /// For the image and projection of `camera`.
+    pub fn for_camera(camera: &Camera) -> ClipMapper {
+        ClipMapper::new(camera.width, camera.height, camera.ortho)
+    }
+
+    /// Clip position of continuous pixel `(px, py)` at view depth `z`
+    /// (ignored for orthographic). `None` for a perspective point not in front
+    /// of the eye (`z <= 0`; clip such pieces at the near plane first), for
+    /// non-finite input or an empty image.
+    pub fn clip(&self, px: f64, py: f64, z: f64) -> Option<[f32; 4]> {
+        if self.width == 0 || self.height == 0 || !px.is_finite() || !py.is_finite() {
+            return None;
+        }
+        let nx = 2.0 * px / self.width as f64 - 1.0;
+        let ny = 1.0 - 2.0 * py / self.height as f64;
+        let w = if self.ortho {
+            1.0
+        } else if z > 0.0 && z.is_finite() {
+            z
+        } else {
+            return None;
+        };
+        let out = [(nx * w) as f32, (ny * w) as f32, (0.5 * w) as f32, w as f32];
+        out.iter().all(|v| v.is_finite()).then_some(out)
+    }
+
+    /// Clip position of a camera-relative point (see
+    /// [`Camera::to_view`]); `None` behind the near plane.
+    pub fn clip_view(&self, camera: &Camera, view: glam::DVec3) -> Option<[f32; 4]> {
+        let (px, py, z) = camera.view_to_pixel(view)?;
+        self.clip(px, py, z)
+    }
+
+    /// Inverse of [`Self::clip`]: continuous pixel coordinates of a clip
+    /// position (after the perspective divide, as the rasteriser sees it).
+    pub fn pixel_of(&self, pos: [f32; 4]) -> (f64, f64) {
+        let w = pos[3] as f64;
+        let nx = pos[0] as f64 / w;
+        let ny = pos[1] as f64 / w;
+        (
+            (nx + 1.0) * 0.5 * self.width as f64,
+            (1.0 - ny) * 0.5 * self.height as f64,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::CameraParams;
+
+    #[test]
+    fn layout_matches_struct() {
+        assert_eq!(std::mem::size_of::<ExactVertex>(), 40);
+        assert_eq!(std::mem::offset_of!(ExactVertex, thickness), 16);
+        assert_eq!(std::mem::offset_of!(ExactVertex, tau), 20);
+        assert_eq!(std::mem::offset_of!(ExactVertex, glow), 24);
+        let offs: Vec<u64> = ExactVertex::ATTRIBUTES.iter().map(|a| a.offset).collect();
+        assert_eq!(offs, vec![0, 16, 20, 24]);
+    }
+
+    #[test]
+    fn pixel_centres_round_trip() {
+        for ortho in [false, true] {
+            let m = ClipMapper::new(300, 200, ortho);
+            let p = m.clip(10.5, 199.5, 7.25).unwrap();
+            let (px, py) = m.pixel_of(p);
+            assert!((px - 10.5).abs() < 1e-4 && (py - 199.5).abs() < 1e-4);
+            assert_eq!(p[3], if ortho { 1.0 } else { 7.25 });
+            assert!(p[2] > 0.0 && p[2] < p[3]);
+        }
+        let m = ClipMapper::new(4, 4, false);
+        assert_eq!(m.clip(0.0, 0.0, 1.0), Some([-1.0, 1.0, 0.5, 1.0]));
+        assert!(m.clip(1.0, 1.0, 0.0).is_none());
+        assert!(m.clip(f64::NAN, 1.0, 1.0).is_none());
+    }
+
+    #[test]
+    fn matches_camera_projection() {
+        let p = CameraParams {
+            width: 64,
+            height: 48,
+            azimuth: 30.0,
+            ..Default::default()
+        };
+        let cam = Camera::fit([0.0, 1.0, 0.0, 2.0, 0.0, 3.0], &p);
+        let m = ClipMapper::for_camera(&cam);
+        // The ray through the centre of pixel (5, 7) hits a point projecting
+        // back to (5.5, 7.5).
+        let ray = cam.pixel_ray(5, 7);
+        let (px, py, z) = cam.project(ray.origin + ray.dir * 4.0).unwrap();
+        let (qx, qy) = m.pixel_of(m.clip(px, py, z).unwrap());
+        assert!((qx - 5.5).abs() < 1e-4 && (qy - 7.5).abs() < 1e-4);
+        let v = cam.to_view(ray.origin + ray.dir * 4.0);
+        assert_eq!(m.clip_view(&cam, v), m.clip(px, py, z));
+    }
+}

@@ -1,0 +1,110 @@
+//! Every WGSL shader parses and validates with naga, without any GPU, and the
+//! exact stage's vertex inputs match `ExactVertex::ATTRIBUTES` (the Rust
+//! mirror of `VertexIn`); no varying uses `@interpolate(linear)`.
+
+use naga::{Binding, Interpolation, ScalarKind, ShaderStage, TypeInner, VectorSize};
+use zoovr::gpu::{ExactVertex, SHADERS};
+
+fn parse(name: &str, src: &str) -> naga::Module {
+    naga::front::wgsl::parse_str(src)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)))
+}
+
+#[test]
+fn shaders_parse_and_validate() {
+    // Every file in shaders/ is listed in SHADERS (and so included in the binary).
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".wgsl"))
+        .collect();
+    on_disk.sort();
+    let mut listed: Vec<String> = SHADERS.iter().map(|(n, _)| n.to_string()).collect();
+    listed.sort();
+    assert_eq!(on_disk, listed);
+
+    for (name, src) in SHADERS {
+        assert_eq!(
+            *src,
+            std::fs::read_to_string(dir.join(name)).unwrap(),
+            "{name} differs from the embedded copy"
+        );
+        let module = parse(name, src);
+        let mut validator = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::empty(),
+        );
+        if let Err(e) = validator.validate(&module) {
+            panic!("{name}: {}", e.emit_to_string(src));
+        }
+    }
+}
+
+/// wgpu vertex format of a naga scalar/vector type.
+fn format_of(inner: &TypeInner) -> Option<wgpu::VertexFormat> {
+    match inner {
+        TypeInner::Scalar(s) if s.kind == ScalarKind::Float && s.width == 4 => {
+            Some(wgpu::VertexFormat::Float32)
+        }
+        TypeInner::Vector { size, scalar } if scalar.kind == ScalarKind::Float => {
+            Some(match size {
+                VectorSize::Bi => wgpu::VertexFormat::Float32x2,
+                VectorSize::Tri => wgpu::VertexFormat::Float32x3,
+                VectorSize::Quad => wgpu::VertexFormat::Float32x4,
+            })
+        }
+        _ => None,
+    }
+}
+
+#[test]
+fn exact_vertex_inputs_match_rust_layout() {
+    let (name, src) = SHADERS.iter().find(|(n, _)| *n == "exact.wgsl").unwrap();
+    let module = parse(name, src);
+    let vs = module
+        .entry_points
+        .iter()
+        .find(|e| e.stage == ShaderStage::Vertex)
+        .expect("vertex entry point");
+    let mut inputs = Vec::new();
+    for arg in &vs.function.arguments {
+        match &module.types[arg.ty].inner {
+            TypeInner::Struct { members, .. } => {
+                for m in members {
+                    if let Some(Binding::Location { location, .. }) = m.binding {
+                        inputs.push((location, format_of(&module.types[m.ty].inner)));
+                    }
+                }
+            }
+            inner => {
+                if let Some(Binding::Location { location, .. }) = arg.binding {
+                    inputs.push((location, format_of(inner)));
+                }
+            }
+        }
+    }
+    inputs.sort_by_key(|x| x.0);
+    let rust: Vec<_> = ExactVertex::ATTRIBUTES
+        .iter()
+        .map(|a| (a.shader_location, Some(a.format)))
+        .collect();
+    assert_eq!(inputs, rust);
+
+    // Varyings: perspective-correct (the Mesa NaN pitfall of `linear`).
+    for ep in &module.entry_points {
+        if ep.stage != ShaderStage::Fragment {
+            continue;
+        }
+        for arg in &ep.function.arguments {
+            if let TypeInner::Struct { members, .. } = &module.types[arg.ty].inner {
+                for m in members {
+                    if let Some(Binding::Location { interpolation, .. }) = m.binding {
+                        assert_eq!(interpolation, Some(Interpolation::Perspective));
+                    }
+                }
+            }
+        }
+    }
+}
