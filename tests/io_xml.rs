@@ -713,6 +713,39 @@ fn hostile_header_is_refused_before_allocating() {
     );
 }
 
+#[test]
+fn reused_offsets_cannot_amplify_memory() {
+    // 100 arrays all pointing at one zlib block of 1 MB of zeros: each is a
+    // valid array, but together they would decode to 100 MB from a ~30 KB file.
+    let enc = Enc {
+        fmt: Fmt::AppRaw,
+        comp: Comp::Zlib,
+        h64: false,
+        be: false,
+        block: 1 << 20,
+        joined: false,
+    };
+    let np = (1 << 20) / 12;
+    let (h, b) = enc.payload(&vec![0u8; np * 12]);
+    let app = [h, b].concat();
+    let file = |k: usize| {
+        let mut body = format!("<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"0\"><PointData>");
+        for i in 0..k {
+            body += &format!("<DataArray type=\"Float32\" Name=\"a{i}\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/>");
+        }
+        body += "</PointData><Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points></Piece>";
+        enc.file(&body, &app)
+    };
+    let m = xml::read_bytes(Path::new("amp.vtu"), &file(3), Format::XmlUnstructured).unwrap();
+    assert_eq!(m.point_data.len(), 3);
+    let big = file(100);
+    assert!(big.len() < 40_000, "{}", big.len());
+    let e = xml::read_bytes(Path::new("amp.vtu"), &big, Format::XmlUnstructured)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("amp.vtu") && e.contains("offsets reused"), "{e}");
+}
+
 // ---------------------------------------------------------------- hand-written files
 
 fn read_str(name: &str, text: &str, format: Format) -> Result<Mesh, String> {

@@ -28,6 +28,7 @@
 //! bytes.
 
 use std::borrow::Cow;
+use std::cell::Cell;
 use std::path::Path;
 
 use base64::engine::{DecodePaddingMode, Engine, GeneralPurpose, GeneralPurposeConfig};
@@ -142,9 +143,47 @@ pub struct Source<'a> {
     pub bytes: &'a [u8],
     pub codec: Codec,
     pub appended: Option<Appended<'a>>,
+    /// Binary bytes decoded so far (see [`Source::charge`]).
+    pub spent: Cell<u64>,
 }
 
 impl<'a> Source<'a> {
+    /// A source over a whole file's bytes.
+    pub fn new(
+        path: &'a Path,
+        bytes: &'a [u8],
+        codec: Codec,
+        appended: Option<Appended<'a>>,
+    ) -> Self {
+        Source {
+            path,
+            bytes,
+            codec,
+            appended,
+            spent: Cell::new(0),
+        }
+    }
+
+    /// Charges `n` decoded bytes against the file's budget: all arrays
+    /// together may not decode to more than the maximum compression ratio
+    /// times the file size. Without compression (or with distinct blocks per
+    /// array, as every writer does) this never triggers; it stops files whose
+    /// arrays share one highly compressed block through repeated offsets.
+    fn charge(&self, n: u64) -> Result<(), String> {
+        let total = self.spent.get().saturating_add(n);
+        let budget = (self.bytes.len() as u64)
+            .saturating_mul(ZLIB_MAX_RATIO)
+            .saturating_add(BLOCK_SLACK << 20);
+        if total > budget {
+            return Err(format!(
+                "the arrays decode to more than {budget} bytes from a {}-byte file (offsets reused?)",
+                self.bytes.len()
+            ));
+        }
+        self.spent.set(total);
+        Ok(())
+    }
+
     /// Decodes `el` (a `<DataArray>` of type `ty`). `expected`: the number of
     /// values (tuples x components) the array must hold, when known.
     pub fn decode<T: Target>(
@@ -232,6 +271,7 @@ impl<'a> Source<'a> {
                     body.len()
                 ));
             }
+            self.charge(size)?;
             return uncompressed(&body[..size as usize], ty, c.big_endian, expected);
         }
         let n0 = c.word(data, 0).ok_or("truncated compression header")?;
@@ -261,6 +301,7 @@ impl<'a> Source<'a> {
                     format!("header claims {size} bytes but the base64 text is shorter")
                 })?;
                 let body = b64_decode(t)?;
+                self.charge(size)?;
                 return uncompressed(
                     body.get(..size as usize).ok_or("base64 text too short")?,
                     ty,
@@ -279,6 +320,7 @@ impl<'a> Source<'a> {
             }
             let all = b64_decode(&text[..enc_len(total)])?;
             let body = all.get(hs..total).ok_or("base64 text too short")?;
+            self.charge(body.len() as u64)?;
             return uncompressed(body, ty, c.big_endian, expected);
         }
         // Compressed: [nblocks, bs, last] tells the header length.
@@ -399,6 +441,7 @@ impl<'a> Source<'a> {
         }
         let comp = c.compressor;
         let be = c.big_endian;
+        self.charge(total)?;
         let mut out = vec![T::default(); n];
         if n == 0 {
             return Ok(out);

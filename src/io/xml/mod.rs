@@ -62,12 +62,7 @@ fn read_nested(path: &Path, bytes: &[u8], format: Format, depth: usize) -> Resul
         }
         .to_string()
     });
-    let src = Source {
-        path,
-        bytes,
-        codec: codec(path, root)?,
-        appended: doc.appended,
-    };
+    let src = Source::new(path, bytes, codec(path, root)?, doc.appended);
     let grid = root.child(&kind).ok_or_else(|| {
         IoError::parse(
             path,
