@@ -100,7 +100,7 @@ impl Camera {
             bounds[5] - bounds[4],
         );
         let mut radius = 0.5 * diag.length();
-        if !(radius > 0.0) || !radius.is_finite() {
+        if radius.is_nan() || radius <= 0.0 || !radius.is_finite() {
             radius = 0.5;
         }
         let aspect = p.width.max(1) as f64 / p.height.max(1) as f64;

@@ -359,7 +359,8 @@ fn select_default(mesh: &Mesh) -> Result<Option<ScalarField>, FieldError> {
             return extract(a, Point, Component::Auto).map(Some);
         }
     }
-    let rules: [(&Vec<DataArray>, Association, fn(&DataArray) -> bool); 4] = [
+    type Rule<'a> = (&'a Vec<DataArray>, Association, fn(&DataArray) -> bool);
+    let rules: [Rule; 4] = [
         (pd, Point, |a| a.data.is_float() && a.components == 1),
         (cd, Cell, |a| a.data.is_float() && a.components == 1),
         (pd, Point, |a| a.data.is_float() && a.components > 1),
