@@ -76,9 +76,9 @@ impl Image {
         for p in &self.pixels {
             let a = p[3].clamp(0.0, 1.0);
             if alpha {
-                for k in 0..3 {
+                for c in &p[..3] {
                     out.push(if a > 0.0 {
-                        (p[k] / a).clamp(0.0, 1.0)
+                        (c / a).clamp(0.0, 1.0)
                     } else {
                         0.0
                     });
