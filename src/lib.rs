@@ -16,6 +16,7 @@ pub mod mesh;
 pub mod numeric;
 pub mod projection;
 pub mod raycast;
+pub mod render;
 #[doc(hidden)]
 pub mod testdata;
 pub mod tf;

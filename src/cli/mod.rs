@@ -1,7 +1,9 @@
 //! Command-line parsing and dispatch. Each command lives in its own file;
 //! `anyhow` is used only here, at the edge.
 
+mod args;
 mod info;
+mod render;
 
 use clap::{Parser, Subcommand};
 
@@ -18,6 +20,9 @@ enum Command {
     /// Print what a file holds: cells by kind, points, bounds, arrays, time
     /// steps, topology and cell-quality counts.
     Info(info::InfoArgs),
+    /// Render one image of a dataset (exact mode through wgpu, or the CPU
+    /// reference ray caster).
+    Render(render::RenderArgs),
 }
 
 /// Parses the arguments, runs the command and returns the exit code.
@@ -32,6 +37,7 @@ pub fn run() -> i32 {
     };
     let result = match cli.command {
         Command::Info(args) => info::run(&args),
+        Command::Render(args) => render::run(&args),
     };
     match result {
         Ok(()) => 0,

@@ -26,3 +26,15 @@ pub const MERGE_POINTS_REL: f64 = 1e-12;
 /// rounded up for points between samples (test `exptable_error_is_bounded`). Used as the tolerance of
 /// every comparison of compositor opacities with exact values.
 pub const EXP_TABLE_MAX_ABS_ERROR: f64 = 1.2e-4;
+
+/// Exact mode: a region edge is refined when (optical depth at its ends,
+/// capped at 1) x (largest glow-colour difference between its ends) exceeds
+/// this. Inside a region `C/alpha` is interpolated, which is exact only for
+/// constant glow colour; math README 8.1 measures errors up to ~7e-3 for
+/// depth <= 1 with colour spread 1, so refining spreads above 0.02 keeps the
+/// colour interpolation error near or below 1e-3 on PNG values.
+pub const COLOR_REFINE_TOL: f64 = 0.02;
+
+/// Exact mode: at most this many levels of midpoint refinement per region
+/// triangle for colour accuracy (each level splits a triangle in up to 4).
+pub const COLOR_REFINE_MAX_DEPTH: u32 = 3;

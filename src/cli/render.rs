@@ -1,0 +1,216 @@
+//! `zoovr render FILE -o out.png [...]`: one image of a dataset.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use anyhow::{bail, Context as _, Result};
+use clap::Args;
+
+use zoovr::camera::CameraParams;
+use zoovr::gpu::{AccumFormat, Backend, GpuOptions};
+use zoovr::io::{self, ReadOptions};
+use zoovr::raycast::FieldModel;
+use zoovr::render::{Mode, RenderOptions, RenderStats, Renderer, Scene, SceneSpec};
+
+use super::args::{parse_finite, parse_positive, parse_range, parse_rgb, parse_size};
+
+/// Options shared by `render` and `animate`: field, transfer function,
+/// camera, mode and output encoding.
+#[derive(Args, Debug, Clone)]
+pub struct ViewArgs {
+    /// Field to render: NAME, point:NAME or cell:NAME, with :mag, :x, :y, :z or
+    /// :N for vectors. Default: the DESIGN.md default-field rule.
+    #[arg(long)]
+    pub field: Option<String>,
+    /// Transfer-function file: zoovr JSON or a ParaView colour map (absolute
+    /// scalar values).
+    #[arg(long, conflicts_with = "preset")]
+    pub tf: Option<PathBuf>,
+    /// Colour-map preset normalised onto the range, opacity ramp 0 -> 1.
+    #[arg(long)]
+    pub preset: Option<String>,
+    /// Scalar range LO,HI for presets and the default transfer function.
+    #[arg(long, value_parser = parse_range, allow_hyphen_values = true)]
+    pub range: Option<(f64, f64)>,
+    /// Average cell data to points.
+    #[arg(long)]
+    pub cell_to_point: bool,
+    /// PLOT3D solution file for a PLOT3D grid.
+    #[arg(long)]
+    pub q: Option<PathBuf>,
+    /// Image size WxH.
+    #[arg(long, value_parser = parse_size, default_value = "512x512")]
+    pub size: (u32, u32),
+    /// Degrees about the view-up (vtkCamera::Azimuth).
+    #[arg(long, value_parser = parse_finite, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub azimuth: f64,
+    /// Degrees about the right axis (vtkCamera::Elevation).
+    #[arg(long, value_parser = parse_finite, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub elevation: f64,
+    /// Degrees about the view direction (vtkCamera::Roll).
+    #[arg(long, value_parser = parse_finite, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub roll: f64,
+    /// Zoom factor (> 1 is closer).
+    #[arg(long, value_parser = parse_positive, default_value_t = 1.0)]
+    pub zoom: f64,
+    /// Orthographic projection instead of perspective (30 degree view angle).
+    #[arg(long)]
+    pub ortho: bool,
+    /// Rendering mode: exact (projection + exact integrals, wgpu) or raycast
+    /// (CPU reference).
+    #[arg(long, default_value = "exact")]
+    pub mode: Mode,
+    /// Field model of the ray caster: faces, tets or native.
+    #[arg(long, default_value = "faces")]
+    pub model: FieldModel,
+    /// `--split all`: draw every cell as its consistent tetrahedra.
+    #[arg(long, value_parser = ["all"])]
+    pub split: Option<String>,
+    /// Background colour R,G,B in [0,1] for PNG output.
+    #[arg(long, value_parser = parse_rgb, default_value = "0,0,0")]
+    pub background: [f32; 3],
+    /// Write RGBA PNGs with straight alpha instead of compositing over the background.
+    #[arg(long)]
+    pub alpha: bool,
+    /// GPU backend (default: WGPU_BACKEND, else the best available).
+    #[arg(long)]
+    pub backend: Option<Backend>,
+    /// Force the software (CPU) adapter even where a GPU exists.
+    #[arg(long)]
+    pub cpu_adapter: bool,
+    /// Print timings and counts to stderr.
+    #[arg(long)]
+    pub stats: bool,
+}
+
+impl ViewArgs {
+    /// The scene specification.
+    pub fn scene_spec(&self) -> SceneSpec {
+        SceneSpec {
+            field: self.field.clone(),
+            tf_file: self.tf.clone(),
+            preset: self.preset.clone(),
+            range: self.range,
+            cell_to_point: self.cell_to_point,
+        }
+    }
+
+    /// The render options (camera from the flags).
+    pub fn render_options(&self) -> RenderOptions {
+        RenderOptions {
+            camera: CameraParams {
+                width: self.size.0,
+                height: self.size.1,
+                azimuth: self.azimuth,
+                elevation: self.elevation,
+                roll: self.roll,
+                zoom: self.zoom,
+                ortho: self.ortho,
+                ..Default::default()
+            },
+            mode: self.mode,
+            model: self.model,
+            split_all: self.split.is_some(),
+            gpu: GpuOptions {
+                backend: self.backend,
+                cpu_adapter: self.cpu_adapter,
+            },
+            accum: AccumFormat::Auto,
+        }
+    }
+
+    /// Reads the file and builds the scene.
+    pub fn load_scene(&self, file: &std::path::Path) -> Result<Scene> {
+        let mesh = io::read(
+            file,
+            &ReadOptions {
+                q_file: self.q.clone(),
+            },
+        )?;
+        Scene::build(mesh, &self.scene_spec()).with_context(|| format!("{}", file.display()))
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// The dataset (VTK legacy/XML, .pvd/.series: first step, PLOT3D grid).
+    pub file: PathBuf,
+    /// Output PNG (8-bit; see --background and --alpha).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Also write the linear premultiplied RGBA float image (OpenEXR).
+    #[arg(long)]
+    pub float: Option<PathBuf>,
+    #[command(flatten)]
+    pub view: ViewArgs,
+}
+
+/// A progress reporter on stderr when it is a terminal.
+pub fn progress_bar(label: &str) -> impl FnMut(usize, usize) {
+    let tty = std::io::stderr().is_terminal();
+    let bar = indicatif::ProgressBar::new(0);
+    if tty {
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta})")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar.set_message(label.to_string());
+    } else {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    move |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+        if done >= total {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// Prints the stats of a render to stderr.
+pub fn print_stats(stats: &RenderStats, load_s: f64) {
+    eprintln!("load+scene   {load_s:.3} s");
+    eprintln!("setup        {:.3} s", stats.setup_s);
+    if let Some(a) = &stats.gpu_adapter {
+        eprintln!("adapter      {a}");
+    }
+    if let Some(e) = &stats.exact {
+        eprintln!(
+            "sort         {:.3} s  ({} pieces, {} split cells, {} problem cells, {} cycles, {} cycle groups)",
+            e.sort_s, e.pieces, e.order.split_cells, e.order.problem_cells, e.order.cycles_found, e.order.cycle_groups
+        );
+        eprintln!(
+            "project      {:.3} s  ({} triangles, {} culled pieces, {} extra slabs, {} refined triangles)",
+            e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles
+        );
+        eprintln!(
+            "gpu          {:.3} s  (upload {:.3}, wait {:.3}, readback {:.3}, {} batches)",
+            e.gpu_total_s, e.gpu.upload_s, e.gpu.gpu_wait_s, e.gpu.readback_s, e.gpu.batches
+        );
+    }
+    eprintln!("render total {:.3} s", stats.total_s);
+}
+
+pub fn run(args: &RenderArgs) -> Result<()> {
+    if args.output.is_none() && args.float.is_none() {
+        bail!("nothing to write: give -o out.png and/or --float out.exr");
+    }
+    let t0 = std::time::Instant::now();
+    let scene = args.view.load_scene(&args.file)?;
+    let load_s = t0.elapsed().as_secs_f64();
+    let mut renderer = Renderer::new(&scene);
+    let opts = args.view.render_options();
+    let (image, stats) = renderer
+        .render(&opts, progress_bar("rendering"))
+        .with_context(|| format!("{}", args.file.display()))?;
+    if let Some(out) = &args.output {
+        image.write_png(out, args.view.background, args.view.alpha)?;
+    }
+    if let Some(out) = &args.float {
+        image.write_exr(out)?;
+    }
+    if args.view.stats {
+        print_stats(&stats, load_s);
+    }
+    Ok(())
+}

@@ -1,0 +1,275 @@
+//! The exact mode (MWS): visibility order -> projection -> exact integrals at
+//! region vertices -> wgpu compositing.
+//!
+//! Per view:
+//! 1. [`Sorter::order`] gives the drawable pieces back to front (whole cells;
+//!    consistent tets of problem cells and of cells whose nodal scalar range
+//!    holds a TF breakpoint; every cell's tets with `--split all`).
+//! 2. Pieces whose scalar range maps to zero extinction everywhere are skipped
+//!    (they neither emit nor absorb in the glow model).
+//! 3. Each piece becomes a view-space [`Polyhedron`]; a tet holding a
+//!    breakpoint is sliced into slabs (back to front, [`slice_tet`]); each is
+//!    projected into regions ([`Projector`]).
+//! 4. Region triangles whose vertices differ much in optical depth and glow
+//!    colour are refined (math README 8.1: `C/alpha` is interpolated inside a
+//!    region), see [`COLOR_REFINE_TOL`].
+//! 5. At every region vertex the closed-form integral gives the glow colour
+//!    `C/alpha` and the mean extinction; the GPU evaluates
+//!    `alpha = 1 - exp(-l tau)` per pixel from its exponential table and
+//!    composites back to front.
+//!
+//! Pieces are processed in parallel in windows of consecutive chunks; the
+//! chunks are pushed to the GPU in order, so memory stays bounded by the
+//! window, whatever the mesh size.
+//!
+//! Interpolation: region vertices are sent with `w = 1` (positions already
+//! divided), so the GPU interpolates linearly in screen space, which is the
+//! model the projection's perspective refinement bounds (projection docs).
+//!
+//! Unresolved visibility cycles ([`crate::visibility::Order::groups`]) are
+//! drawn in the sorter's order and counted in the stats.
+
+use std::time::Instant;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::camera::Camera;
+use crate::gpu::{AccumFormat, Context, ExactVertex, FrameOptions, FrameStats};
+use crate::image::Image;
+use crate::integrate::{vertex_values, RayMaterial};
+use crate::mesh::Mesh;
+use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL};
+use crate::projection::{refine, slice_tet, Polyhedron, Projected, Projector};
+use crate::tf::TransferFunction;
+use crate::visibility::{Piece, SplitPolicy, Sorter};
+
+use super::scene::{Scene, ScalarsRef};
+use super::RenderError;
+
+/// Pieces processed per parallel chunk.
+const CHUNK: usize = 2048;
+
+/// What the exact mode did, with times in seconds.
+#[derive(Clone, Debug, Default)]
+pub struct ExactStats {
+    pub pieces: usize,
+    pub culled_pieces: usize,
+    pub slabs: usize,
+    pub triangles: usize,
+    pub refined_triangles: usize,
+    pub sort_s: f64,
+    pub project_s: f64,
+    pub gpu: FrameStats,
+    pub gpu_total_s: f64,
+    pub order: crate::visibility::OrderStats,
+}
+
+/// Output of one chunk: vertices and triangles ready for the GPU.
+#[derive(Default)]
+struct ChunkOut {
+    vertices: Vec<ExactVertex>,
+    indices: Vec<u32>,
+    culled: usize,
+    slabs: usize,
+    refined: usize,
+    error: Option<String>,
+}
+
+struct Ctx<'a> {
+    mesh: &'a Mesh,
+    scalars: ScalarsRef<'a>,
+    tf: &'a TransferFunction,
+    camera: &'a Camera,
+    breakpoints: &'a [f64],
+}
+
+impl Ctx<'_> {
+    #[inline]
+    fn scalar(&self, cell: u32, point: u32) -> f64 {
+        match self.scalars {
+            ScalarsRef::Point(v) => v.get(point as usize).copied().unwrap_or(0.0),
+            ScalarsRef::Cell(v) => v.get(cell as usize).copied().unwrap_or(0.0),
+            ScalarsRef::Constant(c) => c,
+        }
+    }
+
+    /// Whether extinction is zero over the whole scalar interval.
+    fn invisible(&self, lo: f64, hi: f64) -> bool {
+        if !(lo.is_finite() && hi.is_finite()) {
+            return false;
+        }
+        if self.tf.tau_at(lo) > 0.0 || self.tf.tau_at(hi) > 0.0 {
+            return false;
+        }
+        for &b in self.breakpoints {
+            if b >= lo && b <= hi {
+                let left = self.tf.tau_at(b - b.abs().max(1e-300) * 1e-15);
+                if self.tf.tau_at(b) > 0.0 || left > 0.0 {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+}
+
+fn push_projected(ctx: &Ctx, proj: &mut Projected, out: &mut ChunkOut) {
+    if proj.triangles.is_empty() {
+        return;
+    }
+    let tf = ctx.tf;
+    let before = proj.triangles.len();
+    refine(proj, COLOR_REFINE_MAX_DEPTH, |a, b| {
+        let va = vertex_values(tf, a.l, a.s_front, a.s_back);
+        let vb = vertex_values(tf, b.l, b.s_front, b.s_back);
+        let depth = va.depth.max(vb.depth).min(1.0);
+        let spread = (0..3)
+            .map(|k| (va.glow[k] - vb.glow[k]).abs())
+            .fold(0.0, f64::max);
+        depth * spread > COLOR_REFINE_TOL
+    });
+    out.refined += proj.triangles.len().saturating_sub(before);
+    let (w, h) = (ctx.camera.width as f64, ctx.camera.height as f64);
+    let base = out.vertices.len() as u32;
+    for v in &proj.vertices {
+        let vv = vertex_values(tf, v.l, v.s_front, v.s_back);
+        let x = 2.0 * v.px / w - 1.0;
+        let y = 1.0 - 2.0 * v.py / h;
+        out.vertices.push(ExactVertex::new(
+            [x as f32, y as f32, 0.5, 1.0],
+            v.l as f32,
+            vv.tau_mean as f32,
+            [vv.glow[0] as f32, vv.glow[1] as f32, vv.glow[2] as f32],
+        ));
+    }
+    for t in &proj.triangles {
+        out.indices.extend(t.iter().map(|&i| base + i));
+    }
+}
+
+fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
+    let mut out = ChunkOut::default();
+    let mut projector = Projector::new();
+    let mut poly = Polyhedron::default();
+    let mut proj = Projected::default();
+    let pts = &ctx.mesh.points;
+    for piece in pieces {
+        let cell = piece.cell();
+        match *piece {
+            Piece::Cell(c) => {
+                let nodes = ctx.mesh.cells.nodes(c as usize);
+                let (lo, hi) = nodes.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &n| {
+                    let s = ctx.scalar(c, n);
+                    (lo.min(s), hi.max(s))
+                });
+                if ctx.invisible(lo, hi) {
+                    out.culled += 1;
+                    continue;
+                }
+                if let Err(e) = poly.set_cell(&ctx.mesh.cells, c as usize, pts, |n| ctx.scalar(c, n), ctx.camera) {
+                    out.error = Some(format!("cell {c}: {e}"));
+                    return out;
+                }
+                if let Err(e) = projector.project(&poly, ctx.camera, &mut proj) {
+                    out.error = Some(format!("cell {c}: {e}"));
+                    return out;
+                }
+                push_projected(ctx, &mut proj, &mut out);
+            }
+            Piece::Tet { tet, .. } => {
+                let p: [DVec3; 4] = tet.map(|n| ctx.camera.to_view(pts[n as usize]));
+                let s: [f64; 4] = tet.map(|n| ctx.scalar(cell, n));
+                let lo = s.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = s.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                if ctx.invisible(lo, hi) {
+                    out.culled += 1;
+                    continue;
+                }
+                if !ctx.breakpoints.iter().any(|&b| b > lo && b < hi) {
+                    poly.set_tet(p, s);
+                    if let Err(e) = projector.project(&poly, ctx.camera, &mut proj) {
+                        out.error = Some(format!("cell {cell}: {e}"));
+                        return out;
+                    }
+                    push_projected(ctx, &mut proj, &mut out);
+                    continue;
+                }
+                let slabs = slice_tet(p, s, ctx.breakpoints, ctx.camera);
+                out.slabs += slabs.len().saturating_sub(1);
+                for slab in &slabs {
+                    if let Err(e) = projector.project(slab, ctx.camera, &mut proj) {
+                        out.error = Some(format!("cell {cell}: {e}"));
+                        return out;
+                    }
+                    push_projected(ctx, &mut proj, &mut out);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Renders the scene in the exact mode through `ctx`.
+pub fn render_exact(
+    scene: &Scene,
+    sorter: &mut Sorter,
+    gpu: &Context,
+    camera: &Camera,
+    split_all: bool,
+    format: AccumFormat,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<(Image, ExactStats), RenderError> {
+    let mut stats = ExactStats::default();
+    let breakpoints = scene.tf.breakpoints().to_vec();
+    let point_scalars = match scene.scalars() {
+        ScalarsRef::Point(v) => Some(v),
+        _ => None,
+    };
+    let t0 = Instant::now();
+    let policy = SplitPolicy {
+        all: split_all,
+        breakpoints: &breakpoints,
+        point_scalars,
+    };
+    let order = sorter.order(camera, &policy)?;
+    stats.sort_s = t0.elapsed().as_secs_f64();
+    stats.pieces = order.pieces.len();
+    stats.order = order.stats.clone();
+
+    let ctx = Ctx {
+        mesh: &scene.mesh,
+        scalars: scene.scalars(),
+        tf: &scene.tf,
+        camera,
+        breakpoints: &breakpoints,
+    };
+    let mut opts = FrameOptions::new(camera.width, camera.height, format);
+    opts.length_unit = scene.unit_distance as f32;
+    let t_gpu = Instant::now();
+    let mut frame = gpu.begin_frame_with(&opts)?;
+    let window = CHUNK * rayon::current_num_threads().max(1) * 2;
+    let mut project_s = 0.0;
+    let total = order.pieces.len();
+    for (wi, win) in order.pieces.chunks(window).enumerate() {
+        let tp = Instant::now();
+        let outs: Vec<ChunkOut> = win.par_chunks(CHUNK).map(|c| process_chunk(&ctx, c)).collect();
+        project_s += tp.elapsed().as_secs_f64();
+        for out in outs {
+            if let Some(e) = out.error {
+                return Err(RenderError::Projection(e));
+            }
+            stats.culled_pieces += out.culled;
+            stats.slabs += out.slabs;
+            stats.refined_triangles += out.refined;
+            stats.triangles += out.indices.len() / 3;
+            frame.push_triangles(&out.vertices, &out.indices)?;
+        }
+        progress(((wi + 1) * window).min(total), total);
+    }
+    let (image, fstats) = frame.finish_with_stats()?;
+    stats.gpu = fstats;
+    stats.project_s = project_s;
+    stats.gpu_total_s = t_gpu.elapsed().as_secs_f64() - project_s;
+    Ok((image, stats))
+}

@@ -1,0 +1,203 @@
+//! Rendering a scene in one of the modes, the same way for every caller
+//! (CLI `render`, `animate`, `bench`, tests).
+//!
+//! [`Scene`] holds what does not depend on the view; [`Renderer`] holds what
+//! is reused between views of one scene (the visibility sorter with its
+//! planes and subdivisions, the GPU context); [`Renderer::render`] makes one
+//! image. Modes:
+//! - [`Mode::Exact`]: projection of convex pieces with exact vertex integrals,
+//!   composited by wgpu ([`exact`]);
+//! - [`Mode::Raycast`]: the CPU reference ray caster ([`crate::raycast`]).
+
+pub mod exact;
+pub mod scene;
+
+use std::time::Instant;
+
+use thiserror::Error;
+
+use crate::camera::{Camera, CameraParams};
+use crate::gpu::{AccumFormat, Context, GpuError, GpuOptions};
+use crate::image::Image;
+use crate::raycast::{self, FieldModel, RaycastOptions, Raycaster};
+use crate::visibility::{Sorter, VisibilityError};
+
+pub use exact::ExactStats;
+pub use scene::{Scene, SceneSpec, ScalarsRef};
+
+/// The rendering modes that exist.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    Exact,
+    Raycast,
+}
+
+impl Mode {
+    /// Names as the CLI spells them.
+    pub const NAMES: &'static [&'static str] = &["exact", "raycast"];
+
+    /// The CLI name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Exact => "exact",
+            Mode::Raycast => "raycast",
+        }
+    }
+}
+
+impl std::str::FromStr for Mode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Mode, String> {
+        match s {
+            "exact" => Ok(Mode::Exact),
+            "raycast" => Ok(Mode::Raycast),
+            _ => Err(format!("unknown mode '{s}' (available: {})", Mode::NAMES.join(", "))),
+        }
+    }
+}
+
+/// Errors of a render.
+#[derive(Debug, Error)]
+pub enum RenderError {
+    #[error("the mesh has no 3D cells to render")]
+    NoCells,
+    #[error(transparent)]
+    Field(#[from] crate::field::FieldError),
+    #[error("{path}: {msg}")]
+    Tf { path: String, msg: String },
+    #[error(transparent)]
+    Visibility(#[from] VisibilityError),
+    #[error("projection failed: {0}")]
+    Projection(String),
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    #[error(transparent)]
+    Raycast(#[from] raycast::RaycastError),
+}
+
+/// Per-render options (camera, mode, field model, GPU).
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    pub camera: CameraParams,
+    pub mode: Mode,
+    /// Field model of the ray caster.
+    pub model: FieldModel,
+    /// `--split all`: every cell drawn as its consistent tets.
+    pub split_all: bool,
+    pub gpu: GpuOptions,
+    pub accum: AccumFormat,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            camera: CameraParams::default(),
+            mode: Mode::Exact,
+            model: FieldModel::Faces,
+            split_all: false,
+            gpu: GpuOptions::default(),
+            accum: AccumFormat::Auto,
+        }
+    }
+}
+
+/// What one render did (seconds of wall time).
+#[derive(Clone, Debug, Default)]
+pub struct RenderStats {
+    pub mode: Option<Mode>,
+    pub total_s: f64,
+    pub setup_s: f64,
+    pub exact: Option<ExactStats>,
+    pub gpu_adapter: Option<String>,
+}
+
+/// Reusable state for rendering many views of one scene.
+pub struct Renderer<'s> {
+    scene: &'s Scene,
+    sorter: Option<Sorter>,
+    gpu: Option<Context>,
+    raycaster: Option<(FieldModel, Raycaster<'s>)>,
+}
+
+impl<'s> Renderer<'s> {
+    /// A renderer for `scene` (nothing is built until the first render).
+    pub fn new(scene: &'s Scene) -> Renderer<'s> {
+        Renderer {
+            scene,
+            sorter: None,
+            gpu: None,
+            raycaster: None,
+        }
+    }
+
+    /// Renders one image.
+    pub fn render(
+        &mut self,
+        opts: &RenderOptions,
+        progress: impl FnMut(usize, usize),
+    ) -> Result<(Image, RenderStats), RenderError> {
+        let t0 = Instant::now();
+        let scene = self.scene;
+        let camera = Camera::fit(scene.mesh.bounds(), &opts.camera);
+        let mut stats = RenderStats {
+            mode: Some(opts.mode),
+            ..Default::default()
+        };
+        let image = match opts.mode {
+            Mode::Exact => {
+                let gpu = match self.gpu.take() {
+                    Some(g) => g,
+                    None => Context::new(&opts.gpu)?,
+                };
+                let mut sorter = self
+                    .sorter
+                    .take()
+                    .unwrap_or_else(|| Sorter::new(&scene.mesh, &scene.topology));
+                stats.setup_s = t0.elapsed().as_secs_f64();
+                stats.gpu_adapter = Some(gpu.info().to_string());
+                let result = exact::render_exact(
+                    scene,
+                    &mut sorter,
+                    &gpu,
+                    &camera,
+                    opts.split_all,
+                    opts.accum,
+                    progress,
+                );
+                self.gpu = Some(gpu);
+                self.sorter = Some(sorter);
+                let (img, es) = result?;
+                stats.exact = Some(es);
+                img
+            }
+            Mode::Raycast => {
+                let rc = match self.raycaster.take() {
+                    Some((m, rc)) if m == opts.model => rc,
+                    _ => {
+                        let scalars = match scene.scalars() {
+                            ScalarsRef::Point(v) => raycast::Scalars::Point(v),
+                            ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
+                            ScalarsRef::Constant(c) => raycast::Scalars::Constant(c),
+                        };
+                        let rs = raycast::Scene {
+                            mesh: &scene.mesh,
+                            topology: &scene.topology,
+                            scalars,
+                        };
+                        Raycaster::new(rs, opts.model)?
+                    }
+                };
+                stats.setup_s = t0.elapsed().as_secs_f64();
+                let ro = RaycastOptions {
+                    model: opts.model,
+                    ..Default::default()
+                };
+                let img = rc.render(&scene.tf, &camera, &ro);
+                self.raycaster = Some((opts.model, rc));
+                img
+            }
+        };
+        stats.total_s = t0.elapsed().as_secs_f64();
+        Ok((image, stats))
+    }
+}

@@ -1,0 +1,138 @@
+//! A scene ready to render: mesh, topology, scalar field and transfer function.
+//!
+//! [`Scene::build`] applies the conventions of DESIGN.md in one place, so every
+//! mode renders the same thing:
+//! - coincident points are merged (a merged point keeps the smallest original
+//!   index, so the smallest-vertex diagonals are unchanged where points were
+//!   already shared) and face adjacency is built;
+//! - the field is `--field`, else the TF file's `scalar` key, else the
+//!   default-field rule ([`crate::field::select_field`]); `--cell-to-point`
+//!   averages cell data to points;
+//! - the range is `--range`, else the field's min..max;
+//! - the TF is the file (absolute scalar values), else the preset normalised
+//!   onto the range, else the default (viridis, opacity ramp, unit distance =
+//!   bounds diagonal / 10, glow).
+
+use std::path::PathBuf;
+
+use crate::field::{self, Association, FieldSpec, ScalarField};
+use crate::mesh::merge::merge_coincident_points;
+use crate::mesh::topology::Topology;
+use crate::mesh::Mesh;
+use crate::tf::presets::Opacity;
+use crate::tf::{presets, TransferFunction};
+
+use super::RenderError;
+
+/// How to pick the field and transfer function.
+#[derive(Clone, Debug, Default)]
+pub struct SceneSpec {
+    /// `--field`.
+    pub field: Option<String>,
+    /// `--tf FILE` (project JSON or ParaView colour map).
+    pub tf_file: Option<PathBuf>,
+    /// `--preset NAME`.
+    pub preset: Option<String>,
+    /// `--range LO,HI`.
+    pub range: Option<(f64, f64)>,
+    /// `--cell-to-point`.
+    pub cell_to_point: bool,
+}
+
+/// The scalar values a renderer integrates.
+#[derive(Clone, Copy, Debug)]
+pub enum ScalarsRef<'a> {
+    Point(&'a [f64]),
+    Cell(&'a [f64]),
+    Constant(f64),
+}
+
+/// Everything a render needs that does not depend on the view.
+#[derive(Debug)]
+pub struct Scene {
+    pub mesh: Mesh,
+    pub topology: Topology,
+    /// The field integrated (`None`: constant scalar 0).
+    pub field: Option<ScalarField>,
+    /// Scalar range the TF was mapped onto.
+    pub range: (f64, f64),
+    pub tf: TransferFunction,
+    /// Opacity unit distance in world units (length scale of the scene).
+    pub unit_distance: f64,
+    /// Points merged when building the scene.
+    pub merged_points: usize,
+}
+
+impl Scene {
+    /// Builds the scene from a freshly read mesh.
+    pub fn build(mut mesh: Mesh, spec: &SceneSpec) -> Result<Scene, RenderError> {
+        if mesh.cells.is_empty() {
+            return Err(RenderError::NoCells);
+        }
+        let merged_points = merge_coincident_points(&mut mesh);
+        let topology = Topology::build(&mesh.cells);
+        let diagonal = mesh.diagonal();
+        let default_unit = if diagonal.is_finite() && diagonal > 0.0 {
+            diagonal / 10.0
+        } else {
+            1.0
+        };
+        let file_tf = match &spec.tf_file {
+            Some(p) => Some(TransferFunction::from_json_file(p, default_unit).map_err(|e| {
+                RenderError::Tf {
+                    path: p.display().to_string(),
+                    msg: e.to_string(),
+                }
+            })?),
+            None => None,
+        };
+        let field_name = spec
+            .field
+            .clone()
+            .or_else(|| file_tf.as_ref().and_then(|t| t.scalar.clone()));
+        let field_spec = match &field_name {
+            Some(s) => Some(FieldSpec::parse(s)?),
+            None => None,
+        };
+        let mut field = field::select_field(&mesh, field_spec.as_ref())?;
+        if spec.cell_to_point {
+            if let Some(f) = &field {
+                if f.association == Association::Cell {
+                    field = Some(field::cell_to_point(&mesh, f));
+                }
+            }
+        }
+        let range = match spec.range {
+            Some(r) => r,
+            None => field.as_ref().map(|f| f.range).unwrap_or((0.0, 0.0)),
+        };
+        let tf = match (file_tf, &spec.preset) {
+            (Some(tf), _) => tf,
+            (None, Some(name)) => presets::preset(name, range, default_unit, Opacity::Ramp)
+                .map_err(|e| RenderError::Tf {
+                    path: format!("preset '{name}'"),
+                    msg: e.to_string(),
+                })?,
+            (None, None) => TransferFunction::default_for(range, diagonal),
+        };
+        let unit_distance = tf.unit_distance.unwrap_or(default_unit);
+        Ok(Scene {
+            mesh,
+            topology,
+            field,
+            range,
+            tf,
+            unit_distance,
+            merged_points,
+        })
+    }
+
+    /// The scalars as the renderers take them.
+    pub fn scalars(&self) -> ScalarsRef<'_> {
+        match &self.field {
+            Some(f) if f.association == Association::Point => ScalarsRef::Point(&f.values),
+            Some(f) => ScalarsRef::Cell(&f.values),
+            None => ScalarsRef::Constant(0.0),
+        }
+    }
+}
