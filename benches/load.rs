@@ -18,9 +18,13 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("load");
     g.sample_size(10).measurement_time(Duration::from_secs(20));
     let mesh = warped_hex_grid(100, &Warp::default());
-    g.bench_function("topology_1m_hex", |b| b.iter(|| Topology::build(&mesh.cells)));
+    g.bench_function("topology_1m_hex", |b| {
+        b.iter(|| Topology::build(&mesh.cells))
+    });
     let topo = Topology::build(&mesh.cells);
-    g.bench_function("report_1m_hex", |b| b.iter(|| MeshReport::compute_with(&mesh, &topo)));
+    g.bench_function("report_1m_hex", |b| {
+        b.iter(|| MeshReport::compute_with(&mesh, &topo))
+    });
     drop(topo);
     let dir = tempfile::tempdir().expect("temp dir");
     let path = dir.path().join("hex1m.vtu");

@@ -86,7 +86,10 @@ fn connect_and_report(hexes: Option<usize>, input: Option<&Path>) -> Result<()> 
         Some(p) => zoovr::io::read(p, &zoovr::io::ReadOptions::default())?,
         None => {
             let n = hexes.context("--hexes N or -i FILE")?;
-            warped_hex_grid((n as f64).cbrt().round().max(1.0) as usize, &Warp::default())
+            warped_hex_grid(
+                (n as f64).cbrt().round().max(1.0) as usize,
+                &Warp::default(),
+            )
         }
     };
     let t1 = std::time::Instant::now();
@@ -134,7 +137,11 @@ fn write_meshes(dir: &Path) -> Result<()> {
     write_legacy_ascii(&dir.join("curvilinear_4x4x4.vtk"), &curv, "warped 4x4x4")?;
     write_vtu(&dir.join("curvilinear_4x4x4.vtu"), &curv, Compression::Zlib)?;
     both(dir, "ring_hole", &ring_grid(6, &w))?;
-    write_vtu(&dir.join("zoo_3x3x3.vtu"), &zoo_grid(3, &w), Compression::Zlib)?;
+    write_vtu(
+        &dir.join("zoo_3x3x3.vtu"),
+        &zoo_grid(3, &w),
+        Compression::Zlib,
+    )?;
     let sdir = dir.join("series");
     std::fs::create_dir_all(&sdir)?;
     let mut steps = Vec::new();
@@ -192,7 +199,11 @@ fn degenerate() -> Mesh {
         DVec3::new(4., 1., 1.),
     ]);
     let flat = add(&[square(0.0, 6.0), square(0.0, 6.0)].concat());
-    let tet = add(&[DVec3::new(8., 0., 0.), DVec3::new(9., 0., 0.), DVec3::new(8., 1., 0.)]);
+    let tet = add(&[
+        DVec3::new(8., 0., 0.),
+        DVec3::new(9., 0., 0.),
+        DVec3::new(8., 1., 0.),
+    ]);
     let mut cells = zoovr::mesh::Cells::default();
     cells.push(CellKind::Hexahedron, &good);
     cells.push(CellKind::Hexahedron, &inv);
@@ -200,7 +211,11 @@ fn degenerate() -> Mesh {
     cells.push(CellKind::Hexahedron, &flat);
     cells.push(CellKind::Tetra, &[tet[0], tet[1], tet[1], tet[2]]);
     m.cells = cells;
-    let f: Vec<f32> = m.points.iter().map(|&p| zoovr::generate::scalar_f(p, 0.0) as f32).collect();
+    let f: Vec<f32> = m
+        .points
+        .iter()
+        .map(|&p| zoovr::generate::scalar_f(p, 0.0) as f32)
+        .collect();
     m.point_data.push(zoovr::field::DataArray {
         name: "f".into(),
         components: 1,

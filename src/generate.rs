@@ -220,7 +220,8 @@ pub fn zoo_grid(n: usize, warp: &Warp) -> Mesh {
                             (i as isize, j, k.wrapping_sub(1)),
                             (i as isize, j, k + 1),
                         ];
-                        for (lf, &(ai, aj, ak)) in CellKind::Hexahedron.faces().iter().zip(&across) {
+                        for (lf, &(ai, aj, ak)) in CellKind::Hexahedron.faces().iter().zip(&across)
+                        {
                             let f: Vec<u32> = lf.iter().map(|&l| c[l as usize]).collect();
                             // Split where the base is not shared with a hexahedron or wedge.
                             let split = !(aj < n && ak < n)
@@ -342,14 +343,19 @@ pub fn single_cell(kind: CellKind) -> Mesh {
         CellKind::Wedge => {
             // VTK: the first triangle's normal points away from the second.
             mesh.points = vec![DVec3::ZERO, DVec3::Y, DVec3::X];
-            mesh.points.extend([DVec3::Z, DVec3::new(0., 1., 1.), DVec3::new(1., 0., 1.)]);
+            mesh.points
+                .extend([DVec3::Z, DVec3::new(0., 1., 1.), DVec3::new(1., 0., 1.)]);
         }
         CellKind::Hexahedron => {
             mesh.points = square(0.0);
             mesh.points.extend(square(1.0));
         }
         CellKind::PentagonalPrism | CellKind::HexagonalPrism => {
-            let n = if kind == CellKind::PentagonalPrism { 5 } else { 6 };
+            let n = if kind == CellKind::PentagonalPrism {
+                5
+            } else {
+                6
+            };
             mesh.points = ring(n, 0.0);
             mesh.points.extend(ring(n, 1.0));
         }

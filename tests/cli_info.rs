@@ -94,7 +94,10 @@ fn one_file_per_cell_kind() {
             assert_agrees(&file, &mesh);
             let v = info_json(&mesh_file(&file));
             assert_eq!(v["cells_by_type"][name], 1, "{file}");
-            assert_eq!(v["convexity"].as_f64().map(|c| (c - 1.0).abs() < 1e-12), Some(true));
+            assert_eq!(
+                v["convexity"].as_f64().map(|c| (c - 1.0).abs() < 1e-12),
+                Some(true)
+            );
         }
     }
 }
@@ -158,9 +161,16 @@ fn time_series_collections() {
 #[test]
 fn text_output_shows_the_same_facts() {
     let out = zoovr(&["info", mesh_file("degenerate.vtk").to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("2 inverted, 2 degenerate, 1 with a repeated point"), "{text}");
+    assert!(
+        text.contains("2 inverted, 2 degenerate, 1 with a repeated point"),
+        "{text}"
+    );
     assert!(text.contains("components:  5"), "{text}");
 }
 

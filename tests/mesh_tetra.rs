@@ -72,8 +72,11 @@ fn ngon_prism(n: usize) -> Vec<DVec3> {
     p
 }
 
-/// One convex cell of every kind: (kind, points, polyhedron faces).
-fn zoo_cells() -> Vec<(CellKind, Vec<DVec3>, Option<Vec<Vec<u32>>>)> {
+/// A test cell: kind, points, and the faces of a general polyhedron.
+type TestCell = (CellKind, Vec<DVec3>, Option<Vec<Vec<u32>>>);
+
+/// One convex cell of every kind.
+fn zoo_cells() -> Vec<TestCell> {
     let cube: Vec<DVec3> = (0..8)
         .map(|i| {
             let (x, y) = [(0., 0.), (1., 0.), (1., 1.), (0., 1.)][i % 4];
@@ -168,7 +171,10 @@ fn every_kind_and_labelling_sums_to_the_cell_volume_with_positive_tets() {
             tetrahedralize_cell(&cells, 0, &mut tets);
             counts.insert(tets.len());
             let sum: f64 = tets.iter().map(|&t| tet_volume(&p, t)).sum();
-            assert!((sum - vol).abs() < 1e-12 * vol.max(1.0), "{kind:?}: {sum} vs {vol}");
+            assert!(
+                (sum - vol).abs() < 1e-12 * vol.max(1.0),
+                "{kind:?}: {sum} vs {vol}"
+            );
             for &t in &tets {
                 assert!(tet_volume(&p, t) > 1e-9, "{kind:?}: tet {t:?} of {perm:?}");
             }
@@ -198,9 +204,15 @@ fn assert_conforming_and_positive(mesh: &Mesh, what: &str) {
         let v = cell_volume(&mesh.cells, &mesh.points, c);
         let ts = &tets[offs[c] as usize..offs[c + 1] as usize];
         let sum: f64 = ts.iter().map(|&t| tet_volume(&mesh.points, t)).sum();
-        assert!((sum - v).abs() < 1e-12 * v.abs().max(1e-3), "{what} cell {c}: {sum} vs {v}");
+        assert!(
+            (sum - v).abs() < 1e-12 * v.abs().max(1e-3),
+            "{what} cell {c}: {sum} vs {v}"
+        );
         for &t in ts {
-            assert!(tet_volume(&mesh.points, t) > 0.0, "{what} cell {c}: tet {t:?}");
+            assert!(
+                tet_volume(&mesh.points, t) > 0.0,
+                "{what} cell {c}: tet {t:?}"
+            );
         }
     }
     let r = MeshReport::compute_with(mesh, &topo);
@@ -244,9 +256,7 @@ fn prisms_and_polyhedra_share_faces_consistently() {
                 }
             }
             for z in 0..3u32 {
-                let nodes: Vec<u32> = (0..2 * n as u32)
-                    .map(|k| base + z * n as u32 + k)
-                    .collect();
+                let nodes: Vec<u32> = (0..2 * n as u32).map(|k| base + z * n as u32 + k).collect();
                 m.cells.push(kind, &nodes);
             }
         }
@@ -255,7 +265,8 @@ fn prisms_and_polyhedra_share_faces_consistently() {
         for z in 0..2 {
             for y in 0..2 {
                 for x in 0..3 {
-                    m.points.push(DVec3::new(9.0 + x as f64, y as f64, z as f64));
+                    m.points
+                        .push(DVec3::new(9.0 + x as f64, y as f64, z as f64));
                 }
             }
         }
@@ -334,7 +345,13 @@ fn repair_makes_inverted_cells_positive_and_flips_their_tets() {
 fn distorted_cells_yield_counted_inverted_tets_without_failing() {
     // A hexahedron with one corner pushed through the opposite face: its
     // face volume is still positive but some consistent tets are inverted.
-    let mut m = warped_hex_grid(1, &Warp { amplitude: 0.0, seed: 0 });
+    let mut m = warped_hex_grid(
+        1,
+        &Warp {
+            amplitude: 0.0,
+            seed: 0,
+        },
+    );
     m.points[6] = DVec3::new(0.2, 0.2, 0.1);
     let r = MeshReport::compute(&m);
     assert_eq!(r.cells, 1);

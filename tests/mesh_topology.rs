@@ -5,7 +5,9 @@
 use std::collections::HashMap;
 
 use glam::DVec3;
-use zoovr::generate::{ring_grid, single_cell, warped_hex_grid, warped_hex_grid_dims, zoo_grid, Warp};
+use zoovr::generate::{
+    ring_grid, single_cell, warped_hex_grid, warped_hex_grid_dims, zoo_grid, Warp,
+};
 use zoovr::mesh::components::connected_components;
 use zoovr::mesh::hull::convex_hull_volume;
 use zoovr::mesh::merge::merge_coincident_points;
@@ -67,7 +69,11 @@ fn grid_face_counts_match_closed_forms() {
         // neighbour across +x face of cell (i, j, k) is (i + 1, j, k)
         for c in 0..m.cells.len() {
             let f = t.faces_of(c)[1] as usize;
-            let want = if (c % nx) + 1 < nx { (c + 1) as u32 } else { NONE };
+            let want = if (c % nx) + 1 < nx {
+                (c + 1) as u32
+            } else {
+                NONE
+            };
             assert_eq!(t.neighbour(f, c as u32), want);
         }
     }
@@ -141,8 +147,14 @@ fn volumes_orientation_and_nonplanarity() {
         (CellKind::Wedge, 0.5),
         (CellKind::Hexahedron, 1.0),
         // regular n-gon of radius 0.5: n/2 r^2 sin(2pi/n)
-        (CellKind::PentagonalPrism, 2.5 * 0.25 * (std::f64::consts::TAU / 5.0).sin()),
-        (CellKind::HexagonalPrism, 3.0 * 0.25 * (std::f64::consts::TAU / 6.0).sin()),
+        (
+            CellKind::PentagonalPrism,
+            2.5 * 0.25 * (std::f64::consts::TAU / 5.0).sin(),
+        ),
+        (
+            CellKind::HexagonalPrism,
+            3.0 * 0.25 * (std::f64::consts::TAU / 6.0).sin(),
+        ),
         (CellKind::Polyhedron, 1.0 + 0.6 / 3.0),
     ];
     for (kind, vol) in want {

@@ -118,14 +118,16 @@ fn vtu_round_trips_through_an_independent_parser() {
         let ArrayData::F32(fv) = &mesh.point_data[0].data else {
             panic!()
         };
-        let got: Vec<f32> = f
-            .3
-            .chunks(4)
-            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
-            .collect();
+        let got: Vec<f32> =
+            f.3.chunks(4)
+                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                .collect();
         assert_eq!(&got, fv);
         let id = get("id &amp; &lt;name&gt;"); // XML-escaped in the file
-        assert_eq!(ints(&id.0, &id.3), (0..mesh.cells.len() as i64).collect::<Vec<_>>());
+        assert_eq!(
+            ints(&id.0, &id.3),
+            (0..mesh.cells.len() as i64).collect::<Vec<_>>()
+        );
     }
 }
 
@@ -185,7 +187,10 @@ fn legacy_ascii_layout() {
     assert_eq!(lines[16], "SCALARS Nodal%20Stress%25 float 1");
     // shortest round-trip floats parse back exactly
     for (i, p) in mesh.points.iter().enumerate() {
-        let v: Vec<f64> = lines[5 + i].split(' ').map(|s| s.parse().unwrap()).collect();
+        let v: Vec<f64> = lines[5 + i]
+            .split(' ')
+            .map(|s| s.parse().unwrap())
+            .collect();
         assert_eq!(v, p.to_array());
     }
     assert_eq!(legacy_encode_name("a b"), "a%20b");

@@ -174,7 +174,16 @@ mod tests {
         let c = v["convexity"].as_f64().unwrap();
         // the warp bulges the boundary in and out: not convex
         assert!(c > 0.7 && c < 0.99, "{c}");
-        let straight = describe(&warped_hex_grid(3, &Warp { amplitude: 0.0, seed: 1 }), 1);
+        let straight = describe(
+            &warped_hex_grid(
+                3,
+                &Warp {
+                    amplitude: 0.0,
+                    seed: 1,
+                },
+            ),
+            1,
+        );
         let c = straight["convexity"].as_f64().unwrap();
         assert!((c - 1.0).abs() < 1e-12, "{c}");
         assert_eq!(straight["nonplanar_faces"], 0);
@@ -188,7 +197,16 @@ mod tests {
 
     #[test]
     fn json_of_a_ring_and_a_zoo() {
-        let v = describe(&ring_grid(6, &Warp { amplitude: 0.0, seed: 1 }), 1);
+        let v = describe(
+            &ring_grid(
+                6,
+                &Warp {
+                    amplitude: 0.0,
+                    seed: 1,
+                },
+            ),
+            1,
+        );
         // 6x6x2 minus the 2x2x2 hole
         assert_eq!(v["cells3d"], 64);
         let c = v["convexity"].as_f64().unwrap();

@@ -174,10 +174,20 @@ pub fn write_vtu(path: &Path, mesh: &Mesh, compression: Compression) -> Result<(
     // (section, name, components, block)
     let mut arrays: Vec<(&str, Option<String>, usize, Block)> = Vec::new();
     for a in &mesh.point_data {
-        arrays.push(("PointData", Some(a.name.clone()), a.components, array_block(a)));
+        arrays.push((
+            "PointData",
+            Some(a.name.clone()),
+            a.components,
+            array_block(a),
+        ));
     }
     for a in &mesh.cell_data {
-        arrays.push(("CellData", Some(a.name.clone()), a.components, array_block(a)));
+        arrays.push((
+            "CellData",
+            Some(a.name.clone()),
+            a.components,
+            array_block(a),
+        ));
     }
     arrays.push((
         "Points",
@@ -203,7 +213,12 @@ pub fn write_vtu(path: &Path, mesh: &Mesh, compression: Compression) -> Result<(
         let (faces, faceoffsets) = face_streams(mesh);
         arrays.push(("Cells", Some("faces".into()), 1, index_block(&faces)));
         let fo: Vec<i64> = faceoffsets;
-        arrays.push(("Cells", Some("faceoffsets".into()), 1, int_block(&fo, "Int64")));
+        arrays.push((
+            "Cells",
+            Some("faceoffsets".into()),
+            1,
+            int_block(&fo, "Int64"),
+        ));
     }
 
     let mut appended: Vec<u8> = Vec::new();
@@ -366,7 +381,13 @@ fn push_arrays(s: &mut String, arrays: &[DataArray], active: Option<&String>) {
         let _ = writeln!(s, "FIELD FieldData {}", field.len());
         for a in field {
             let name = legacy_encode_name(&a.name);
-            let _ = writeln!(s, "{name} {} {} {}", a.components, a.tuples(), legacy_type(a));
+            let _ = writeln!(
+                s,
+                "{name} {} {} {}",
+                a.components,
+                a.tuples(),
+                legacy_type(a)
+            );
             push_values(s, a);
         }
     }
@@ -377,7 +398,10 @@ pub fn write_legacy_ascii(path: &Path, mesh: &Mesh, title: &str) -> Result<(), W
     let cells = &mesh.cells;
     let mut s = String::new();
     let title: String = title.chars().filter(|c| *c != '\n').take(255).collect();
-    let _ = writeln!(s, "# vtk DataFile Version 4.2\n{title}\nASCII\nDATASET UNSTRUCTURED_GRID");
+    let _ = writeln!(
+        s,
+        "# vtk DataFile Version 4.2\n{title}\nASCII\nDATASET UNSTRUCTURED_GRID"
+    );
     let _ = writeln!(s, "POINTS {} double", mesh.points.len());
     for p in &mesh.points {
         let _ = writeln!(s, "{} {} {}", p.x, p.y, p.z);

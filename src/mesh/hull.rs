@@ -10,6 +10,7 @@
 //!    the seen faces by the triangles (horizon edge, `p`), linking neighbours;
 //!    hand the seen faces' outside points to the new faces they lie strictly
 //!    above, dropping the rest (they are inside).
+//!
 //! "Strictly above" is decided by the exact predicate
 //! [`crate::numeric::predicates::orient3d`], so coplanar points (whole faces
 //! of a structured grid) are never added and the loop cannot cycle; only the
@@ -195,13 +196,11 @@ fn initial_simplex(p: &[DVec3], idx: &[u32]) -> Option<[u32; 4]> {
         }
     }
     let ab = pt(b) - pt(a);
-    let c = *idx
-        .iter()
-        .max_by(|&&x, &&y| {
-            let dx = ab.cross(pt(x) - pt(a)).length_squared();
-            let dy = ab.cross(pt(y) - pt(a)).length_squared();
-            dx.total_cmp(&dy)
-        })?;
+    let c = *idx.iter().max_by(|&&x, &&y| {
+        let dx = ab.cross(pt(x) - pt(a)).length_squared();
+        let dy = ab.cross(pt(y) - pt(a)).length_squared();
+        dx.total_cmp(&dy)
+    })?;
     if ab.cross(pt(c) - pt(a)).length_squared() == 0.0 {
         return None;
     }
@@ -239,8 +238,12 @@ pub fn convex_hull(points: &[DVec3], subset: Option<&[u32]>) -> Option<Hull> {
         faces: Vec::new(),
     };
     // Outward faces of the start tetrahedron.
-    let (b, c) = if orient3d(points[a as usize], points[b as usize], points[c as usize], points[d as usize])
-        == Side::Positive
+    let (b, c) = if orient3d(
+        points[a as usize],
+        points[b as usize],
+        points[c as usize],
+        points[d as usize],
+    ) == Side::Positive
     {
         (c, b)
     } else {
@@ -284,12 +287,7 @@ pub fn convex_hull(points: &[DVec3], subset: Option<&[u32]>) -> Option<Hull> {
         bld.add_point(fi, q, iter, &mut stack);
     }
     Some(Hull {
-        faces: bld
-            .faces
-            .iter()
-            .filter(|f| f.alive)
-            .map(|f| f.v)
-            .collect(),
+        faces: bld.faces.iter().filter(|f| f.alive).map(|f| f.v).collect(),
     })
 }
 
@@ -365,7 +363,9 @@ mod tests {
 
     #[test]
     fn flat_inputs_have_no_hull() {
-        let p: Vec<DVec3> = (0..10).map(|i| DVec3::new(i as f64, (i * i) as f64, 0.0)).collect();
+        let p: Vec<DVec3> = (0..10)
+            .map(|i| DVec3::new(i as f64, (i * i) as f64, 0.0))
+            .collect();
         assert!(convex_hull(&p, None).is_none());
         let q: Vec<DVec3> = (0..10).map(|i| DVec3::splat(i as f64)).collect();
         assert!(convex_hull(&q, None).is_none());

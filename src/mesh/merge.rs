@@ -45,7 +45,11 @@ pub fn coincident_representatives(points: &[glam::DVec3]) -> Vec<u32> {
 /// smallest index; returns the number of points merged away.
 pub fn merge_coincident_points(mesh: &mut Mesh) -> usize {
     let rep = coincident_representatives(&mesh.points);
-    let merged = rep.iter().enumerate().filter(|(i, &r)| *i != r as usize).count();
+    let merged = rep
+        .iter()
+        .enumerate()
+        .filter(|(i, &r)| *i != r as usize)
+        .count();
     if merged == 0 {
         return 0;
     }
@@ -84,8 +88,10 @@ mod tests {
             }
         }
         m.points.push(DVec3::new(-0.0, 0.0, 1.0)); // 16: same as 4 via -0.0
-        m.cells.push(CellKind::Hexahedron, &[0, 1, 2, 3, 4, 5, 6, 7]);
-        m.cells.push(CellKind::Hexahedron, &[16, 9, 10, 11, 12, 13, 14, 15]);
+        m.cells
+            .push(CellKind::Hexahedron, &[0, 1, 2, 3, 4, 5, 6, 7]);
+        m.cells
+            .push(CellKind::Hexahedron, &[16, 9, 10, 11, 12, 13, 14, 15]);
         assert_eq!(Topology::build(&m.cells).boundary_face_count(), 12);
         assert_eq!(merge_coincident_points(&mut m), 5);
         assert_eq!(m.cells.nodes(1), &[4, 5, 6, 7, 12, 13, 14, 15]);

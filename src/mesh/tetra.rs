@@ -62,7 +62,12 @@ pub fn check_tetrahedralisation(topo: &Topology, tets: &[[u32; 4]]) -> Result<()
         if s.windows(2).any(|w| w[0] == w[1]) {
             return Err(TetError(format!("tet {i} {t:?} repeats a vertex")));
         }
-        for tri in [[t[0], t[1], t[2]], [t[0], t[1], t[3]], [t[0], t[2], t[3]], [t[1], t[2], t[3]]] {
+        for tri in [
+            [t[0], t[1], t[2]],
+            [t[0], t[1], t[3]],
+            [t[0], t[2], t[3]],
+            [t[1], t[2], t[3]],
+        ] {
             *uses.entry(sorted3(tri)).or_insert(0) += 1;
         }
     }
@@ -74,7 +79,9 @@ pub fn check_tetrahedralisation(topo: &Topology, tets: &[[u32; 4]]) -> Result<()
             let n = uses.get(&sorted3(tri)).copied().unwrap_or(0);
             let want = if interior { 2 } else { 1 };
             if n != want && bad.is_none() {
-                bad = Some(format!("face {f} triangle {tri:?} used by {n} tets, want {want}"));
+                bad = Some(format!(
+                    "face {f} triangle {tri:?} used by {n} tets, want {want}"
+                ));
             }
             boundary += (!interior) as usize;
         });

@@ -315,14 +315,13 @@ impl Topology {
                 return err(b);
             }
         }
-        for f in 0..nf {
-            let [a, b] = self.face_cells[f];
+        for (f, (&[a, b], &used)) in self.face_cells.iter().zip(&uses).enumerate() {
             let want = if b == NONE { 1 } else { 2 };
             if a == b {
                 return err(format!("face {f}: both sides are cell {a}"));
             }
-            if uses[f] != want {
-                return err(format!("face {f}: used {} times, want {want}", uses[f]));
+            if used != want {
+                return err(format!("face {f}: used {used} times, want {want}"));
             }
         }
         // Unique vertex sets, except for the counted non-manifold extras.
