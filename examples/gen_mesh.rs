@@ -78,10 +78,22 @@ fn main() -> Result<()> {
     Ok(())
 }
 
+/// CPU time (user + system) of this process so far, from `/proc/self/stat`
+/// (Linux; clock ticks of 10 ms). Wall times on a busy machine say little;
+/// CPU time says what the work costs.
+fn cpu_time() -> Option<std::time::Duration> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let after = stat.rsplit_once(')')?.1;
+    let f: Vec<&str> = after.split_whitespace().collect();
+    let ticks: u64 = f.get(11)?.parse::<u64>().ok()? + f.get(12)?.parse::<u64>().ok()?;
+    Some(std::time::Duration::from_millis(ticks * 10))
+}
+
 fn connect_and_report(hexes: Option<usize>, input: Option<&Path>) -> Result<()> {
     use zoovr::mesh::report::MeshReport;
     use zoovr::mesh::topology::Topology;
     let t0 = std::time::Instant::now();
+    let c0 = cpu_time();
     let mesh = match input {
         Some(p) => zoovr::io::read(p, &zoovr::io::ReadOptions::default())?,
         None => {
@@ -92,11 +104,19 @@ fn connect_and_report(hexes: Option<usize>, input: Option<&Path>) -> Result<()> 
             )
         }
     };
-    let t1 = std::time::Instant::now();
+    let (t1, c1) = (std::time::Instant::now(), cpu_time());
     let topo = Topology::build(&mesh.cells);
-    let t2 = std::time::Instant::now();
+    let (t2, c2) = (std::time::Instant::now(), cpu_time());
     let r = MeshReport::compute_with(&mesh, &topo);
-    let t3 = std::time::Instant::now();
+    let (t3, c3) = (std::time::Instant::now(), cpu_time());
+    if let (Some(c0), Some(c1), Some(c2), Some(c3)) = (c0, c1, c2, c3) {
+        eprintln!(
+            "cpu time: load {:?}, topology {:?}, report {:?}",
+            c1 - c0,
+            c2 - c1,
+            c3 - c2
+        );
+    }
     let n = mesh.cells.len().max(1) as f64;
     eprintln!(
         "{} cells: {} {:?}, topology {:?} ({:.0} ns/cell), report {:?} ({:.0} ns/cell)",

@@ -72,8 +72,11 @@ fn ngon_prism(n: usize) -> Vec<DVec3> {
     p
 }
 
-/// One convex cell of every kind: (kind, points, polyhedron faces).
-fn zoo_cells() -> Vec<(CellKind, Vec<DVec3>, Option<Vec<Vec<u32>>>)> {
+/// A test cell: kind, points, and the faces of a general polyhedron.
+type TestCell = (CellKind, Vec<DVec3>, Option<Vec<Vec<u32>>>);
+
+/// One convex cell of every kind.
+fn zoo_cells() -> Vec<TestCell> {
     let cube: Vec<DVec3> = (0..8)
         .map(|i| {
             let (x, y) = [(0., 0.), (1., 0.), (1., 1.), (0., 1.)][i % 4];

@@ -10,6 +10,7 @@
 //!    the seen faces by the triangles (horizon edge, `p`), linking neighbours;
 //!    hand the seen faces' outside points to the new faces they lie strictly
 //!    above, dropping the rest (they are inside).
+//!
 //! "Strictly above" is decided by the exact predicate
 //! [`crate::numeric::predicates::orient3d`], so coplanar points (whole faces
 //! of a structured grid) are never added and the loop cannot cycle; only the

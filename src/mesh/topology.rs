@@ -6,25 +6,31 @@
 //! of the first cell that listed it (outward for that cell when the cell is
 //! positively oriented). Ids only: no geometry is stored here.
 //!
-//! How [`Topology::build`] works (sort-based, no hash map):
+//! How [`Topology::build`] works (a bucket sort on the smallest point id,
+//! no hash map):
 //! 1. Every local face of every cell gets a *slot* (`cell_face_offsets` is
-//!    the CSR over cells). In parallel (rayon, chunks of cells), each slot
-//!    writes a 20-byte key: its sorted point ids padded with [`NONE`] (faces
-//!    of up to 4 points) followed by the slot number. Faces with more than 4
-//!    points (prism caps, polyhedron faces) go to a separate list of full
-//!    sorted id vectors.
-//! 2. The keys are sorted in parallel; equal faces become runs. In each run
-//!    the second slot is linked to the first one; further slots are
-//!    non-manifold (kept as boundary faces of their cells and counted).
-//! 3. One ordered pass over the cells turns links into face ids: a slot that
+//!    the CSR over cells). In parallel (rayon, chunks of cells), faces of up
+//!    to 4 points are counted per smallest point id (atomic counters); faces
+//!    with more points (prism caps, polyhedron faces) go to a separate list
+//!    of full sorted id vectors, sorted and matched on their own.
+//! 2. One pass in slot order writes each small face into its point's bucket
+//!    as 16 bytes: the other three sorted ids (padded with [`NONE`]) and the
+//!    slot.
+//! 3. Buckets are small (a few faces per point); each is sorted and equal
+//!    faces become runs, in parallel over groups of buckets. In each run the
+//!    second slot is linked to the first one; further slots are non-manifold
+//!    (kept as boundary faces of their cells and counted).
+//! 4. One ordered pass over the cells turns links into face ids: a slot that
 //!    starts a face creates it (ids therefore follow the first cell that
 //!    lists a face, as a hash-map build would give), a linked slot joins the
 //!    face of its partner. A face listed twice by the same cell is not an
 //!    interior face; it is also counted as non-manifold.
 //!
-//! Peak extra memory is the key array (20 bytes per cell face) plus one
-//! `u32` per cell face; 1M hexahedra connect in well under a second on two
-//! cores (see `benches/load.rs`).
+//! Peak extra memory is the bucket array (16 bytes per cell face), the
+//! links (8 bytes per interior face, then 4 per cell face) and 8 bytes per
+//! point; see `benches/load.rs` for times.
+
+use std::sync::atomic::{AtomicU32, Ordering};
 
 use rayon::prelude::*;
 use thiserror::Error;
@@ -56,19 +62,49 @@ pub struct Topology {
 #[error("topology invariant broken: {0}")]
 pub struct TopologyError(pub String);
 
-/// Cells per parallel work item when writing keys.
+/// Cells per parallel work item.
 const CHUNK: usize = 1 << 14;
+/// Bucket entries per parallel work item when matching.
+const MATCH_CHUNK: usize = 1 << 16;
 
-/// Key of a face of up to 4 points: sorted ids padded with [`NONE`], then the
-/// slot. Larger faces get the sentinel key `[NONE; 4]` (matched elsewhere).
+/// Sorted ids of a face of 1 to 4 points, padded with [`NONE`].
 #[inline]
-fn small_key(verts: &[u32], slot: u32) -> [u32; 5] {
-    let mut k = [NONE, NONE, NONE, NONE, slot];
-    if verts.len() <= 4 {
-        k[..verts.len()].copy_from_slice(verts);
-        k[..4].sort_unstable();
-    }
+fn sorted4(verts: &[u32]) -> [u32; 4] {
+    let mut k = [NONE; 4];
+    k[..verts.len()].copy_from_slice(verts);
+    k.sort_unstable();
     k
+}
+
+/// Whether a face takes the bucketed path (up to 4 points).
+#[inline]
+fn small(verts: &[u32]) -> bool {
+    (1..=4).contains(&verts.len())
+}
+
+/// Records the runs of equal keys in `sorted` (keys compared by `same`,
+/// slots read by `slot`): the second slot of a run links to the first; the
+/// rest are non-manifold. Returns `(pairs, nonmanifold)` and pushes links.
+fn link_runs<T>(
+    sorted: &[T],
+    same: impl Fn(&T, &T) -> bool,
+    slot: impl Fn(&T) -> u32,
+    links: &mut Vec<(u32, u32)>,
+) -> usize {
+    let mut nonmanifold = 0;
+    let mut i = 0;
+    while i < sorted.len() {
+        let mut j = i + 1;
+        while j < sorted.len() && same(&sorted[i], &sorted[j]) {
+            j += 1;
+        }
+        if j - i >= 2 {
+            links.push((slot(&sorted[i + 1]), slot(&sorted[i])));
+            nonmanifold += j - i - 2;
+        }
+        i = j;
+    }
+    nonmanifold
 }
 
 impl Topology {
@@ -83,85 +119,126 @@ impl Topology {
             cell_face_offsets.push(total);
         }
         let slots = total as usize;
+        let n_points = cells
+            .conn
+            .par_iter()
+            .copied()
+            .max()
+            .into_iter()
+            .chain(cells.poly_faces.values().flatten().flatten().copied())
+            .max()
+            .map_or(0, |m| m as usize + 1);
 
-        // 1. Keys, in parallel over chunks of cells.
-        let mut keys: Vec<[u32; 5]> = vec![[0; 5]; slots];
-        let mut jobs = Vec::with_capacity(n / CHUNK + 1);
-        let mut rest: &mut [[u32; 5]] = &mut keys;
-        let mut c0 = 0;
-        while c0 < n {
-            let c1 = (c0 + CHUNK).min(n);
-            let len = (cell_face_offsets[c1] - cell_face_offsets[c0]) as usize;
-            let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
-            rest = tail;
-            jobs.push((c0, c1, head));
-            c0 = c1;
-        }
+        // 1. Count small faces per smallest point; collect large faces.
+        let counts: Vec<AtomicU32> = (0..n_points).map(|_| AtomicU32::new(0)).collect();
         let offsets = &cell_face_offsets;
-        let mut large: Vec<(Vec<u32>, u32)> = jobs
-            .into_par_iter()
-            .flat_map_iter(|(c0, c1, out)| {
-                let base = offsets[c0];
+        let chunks: Vec<(usize, usize)> = (0..n)
+            .step_by(CHUNK)
+            .map(|c0| (c0, (c0 + CHUNK).min(n)))
+            .collect();
+        let mut large: Vec<(Vec<u32>, u32)> = chunks
+            .par_iter()
+            .flat_map_iter(|&(c0, c1)| {
                 let mut large = Vec::new();
-                let mut k = 0usize;
                 for c in c0..c1 {
-                    cells.for_each_face(c, |_, verts| {
-                        let slot = base + k as u32;
-                        if let Some(o) = out.get_mut(k) {
-                            *o = small_key(verts, slot);
-                        }
-                        if verts.len() > 4 {
+                    cells.for_each_face(c, |local, verts| {
+                        if small(verts) {
+                            let m = verts.iter().copied().min().unwrap_or(NONE);
+                            if let Some(x) = counts.get(m as usize) {
+                                x.fetch_add(1, Ordering::Relaxed);
+                            }
+                        } else if verts.len() > 4 {
                             let mut v = verts.to_vec();
                             v.sort_unstable();
-                            large.push((v, slot));
+                            large.push((v, offsets[c] + local as u32));
                         }
-                        k += 1;
                     });
                 }
                 large
             })
             .collect();
-
-        // 2. Sort and link runs of equal faces.
-        keys.par_sort_unstable();
-        let mut link = vec![NONE; slots];
-        let mut nonmanifold = 0usize;
-        let mut pairs = 0usize;
-        let mut i = 0;
-        while i < keys.len() {
-            let k = keys[i];
-            if k[..4] == [NONE; 4] {
-                break; // sentinels sort last
-            }
-            let mut j = i + 1;
-            while j < keys.len() && keys[j][..4] == k[..4] {
-                j += 1;
-            }
-            if j - i >= 2 {
-                link[keys[i + 1][4] as usize] = k[4];
-                pairs += 1;
-                nonmanifold += j - i - 2;
-            }
-            i = j;
+        let mut start = Vec::with_capacity(n_points + 1);
+        start.push(0u32);
+        let mut acc = 0u32;
+        for x in counts {
+            acc += x.into_inner();
+            start.push(acc);
         }
-        drop(keys);
+
+        // 2. Bucket entries (the other three ids and the slot), in slot order.
+        let mut entries: Vec<[u32; 4]> = vec![[0; 4]; acc as usize];
+        let mut cursor = start.clone();
+        for c in 0..n {
+            let base = cell_face_offsets[c];
+            cells.for_each_face(c, |local, verts| {
+                if !small(verts) {
+                    return;
+                }
+                let k = sorted4(verts);
+                if let Some(pos) = cursor.get_mut(k[0] as usize) {
+                    entries[*pos as usize] = [k[1], k[2], k[3], base + local as u32];
+                    *pos += 1;
+                }
+            });
+        }
+        drop(cursor);
+
+        // 3. Match within buckets (parallel over runs of whole buckets).
+        let mut jobs = Vec::new();
+        let mut rest: &mut [[u32; 4]] = &mut entries;
+        let (mut p0, mut taken) = (0usize, 0u32);
+        while p0 < n_points {
+            let mut p1 = p0 + 1;
+            while p1 < n_points && ((start[p1] - start[p0]) as usize) < MATCH_CHUNK {
+                p1 += 1;
+            }
+            let len = (start[p1] - taken) as usize;
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            rest = tail;
+            jobs.push((p0, p1, head));
+            taken = start[p1];
+            p0 = p1;
+        }
+        let start = &start;
+        let (links, mut nonmanifold) = jobs
+            .into_par_iter()
+            .map(|(p0, p1, chunk)| {
+                let mut links = Vec::new();
+                let mut nm = 0;
+                let base = start[p0];
+                for p in p0..p1 {
+                    let b = &mut chunk[(start[p] - base) as usize..(start[p + 1] - base) as usize];
+                    if b.len() < 2 {
+                        continue;
+                    }
+                    b.sort_unstable();
+                    nm += link_runs(b, |x, y| x[..3] == y[..3], |x| x[3], &mut links);
+                }
+                (links, nm)
+            })
+            .reduce(
+                || (Vec::new(), 0),
+                |mut a, b| {
+                    a.0.extend(b.0);
+                    (a.0, a.1 + b.1)
+                },
+            );
+        drop(entries);
+        let mut link = vec![NONE; slots];
+        let mut pairs = links.len();
+        for (second, first) in links {
+            link[second as usize] = first;
+        }
         large.par_sort_unstable();
-        let mut i = 0;
-        while i < large.len() {
-            let mut j = i + 1;
-            while j < large.len() && large[j].0 == large[i].0 {
-                j += 1;
-            }
-            if j - i >= 2 {
-                link[large[i + 1].1 as usize] = large[i].1;
-                pairs += 1;
-                nonmanifold += j - i - 2;
-            }
-            i = j;
+        let mut large_links = Vec::new();
+        nonmanifold += link_runs(&large, |x, y| x.0 == y.0, |x| x.1, &mut large_links);
+        pairs += large_links.len();
+        for (second, first) in large_links {
+            link[second as usize] = first;
         }
         drop(large);
 
-        // 3. Ordered pass: links become face ids.
+        // 4. Ordered pass: links become face ids.
         let n_faces = slots - pairs;
         let mut t = Topology {
             face_offsets: Vec::with_capacity(n_faces + 1),
@@ -315,14 +392,13 @@ impl Topology {
                 return err(b);
             }
         }
-        for f in 0..nf {
-            let [a, b] = self.face_cells[f];
+        for (f, (&[a, b], &used)) in self.face_cells.iter().zip(&uses).enumerate() {
             let want = if b == NONE { 1 } else { 2 };
             if a == b {
                 return err(format!("face {f}: both sides are cell {a}"));
             }
-            if uses[f] != want {
-                return err(format!("face {f}: used {} times, want {want}", uses[f]));
+            if used != want {
+                return err(format!("face {f}: used {used} times, want {want}"));
             }
         }
         // Unique vertex sets, except for the counted non-manifold extras.
