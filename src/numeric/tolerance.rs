@@ -18,3 +18,10 @@ pub const DEGENERATE_VOLUME_REL: f64 = 1e-12;
 /// merged by the optional coincident-point merge (exactly equal coordinates
 /// are always merged; this allows for ASCII round-off).
 pub const MERGE_POINTS_REL: f64 = 1e-12;
+
+/// Integral-function table fills (`integrate::fast`): below this fraction of
+/// the table's scalar range, `|s_b - s_f|` is too small for the difference
+/// quotients `(T(s_b) - T(s_f)) / (s_b - s_f)` (they lose
+/// `log10(|T| / |T_b - T_f|)` digits, math README 8.4) and the point values
+/// at the midpoint scalar are used instead (error O(ds) there).
+pub const INTEGRAL_FUNCTION_MIN_DS_REL: f64 = 1e-7;
