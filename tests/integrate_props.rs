@@ -125,7 +125,7 @@ const GL5: [(f64, f64); 5] = [
 ];
 
 /// Reference `[psi, phi_f, phi_b, w_f, w_b]` by composite Gauss-Legendre on
-/// panels over which the depth grows by at most ~0.4, truncated at depth 60
+/// panels over which the depth grows by at most ~0.2, truncated at depth 60
 /// (the tail is below 1e-19 relative for a, b <= 1e6).
 fn reference(a: f64, b: f64) -> [f64; 5] {
     let d = b - a;
@@ -134,8 +134,11 @@ fn reference(a: f64, b: f64) -> [f64; 5] {
     let mut x = 0.0f64;
     let sq = d.abs().sqrt();
     while x < 1.0 && dep(x) < 60.0 {
+        // Panel: depth grows by at most ~0.2 (rate taken at the panel end
+        // too, for increasing extinction).
         let rate = a + d * x;
-        let h = (0.25 / rate.max(1e-300)).min(0.5 / sq.max(1e-300)).min(0.25).min(1.0 - x);
+        let h0 = (0.2 / rate.max(1e-300)).min(0.3 / sq.max(1e-300)).min(0.125);
+        let h = h0.min(0.2 / (a + d * (x + h0)).max(1e-300)).min(1.0 - x);
         for &(t, w) in &GL5 {
             let xi = x + 0.5 * h * (t + 1.0);
             let e = 0.5 * h * w * (-dep(xi)).exp();
@@ -213,7 +216,7 @@ fn stress(n: usize) {
                 // only in the relative sense; the reference holds ~1e-15.
                 let abs_ok = (got[k] - re[k]).abs() <= 1e-300;
                 assert!(
-                    err < 1e-11 || abs_ok,
+                    err < 1e-12 || abs_ok,
                     "component {k} at a={a:e} b={b:e}: got {:e} ref {:e} rel {err:e}",
                     got[k],
                     re[k]
@@ -226,13 +229,8 @@ fn stress(n: usize) {
         worst[0], worst[1], worst[2], worst[3], worst[4]);
 }
 
+/// 1e6 samples, reference on every 4th (about 2 s at opt-level 1).
 #[test]
-fn stress_closed_form_1e5() {
-    stress(100_000);
-}
-
-#[test]
-#[ignore = "1e6 samples: run with --ignored (about 10 s at opt-level 1)"]
 fn stress_closed_form_1e6() {
     stress(1_000_000);
 }
@@ -294,3 +292,4 @@ fn hostile_inputs_do_not_produce_nan() {
         assert!(vv.glow.iter().all(|c| c.is_finite()) && vv.tau_mean.is_finite());
     }
 }
+
