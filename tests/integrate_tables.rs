@@ -166,28 +166,44 @@ fn cylinder_texels_are_exact_on_their_planes() {
     assert!(Table2d::new(&tf, 8, (0.0, 1.0), 0.0, Table2dKind::LinearInL).is_err());
 }
 
-/// The error tables of the report. Thresholds are loose upper bounds of the
-/// measured values (about 2x), so a regression in filling or interpolation
-/// fails.
+/// Error tables against the exact integrals at modest resolutions (fast);
+/// thresholds are loose upper bounds (about 2x) of the measured values, so a
+/// regression in filling or interpolation fails.
 #[test]
 fn table_errors_against_exact_integrals() {
-    let n = 4000;
+    error_tables(false);
+}
+
+/// The full error report (up to 128x128x64; about 10 s at opt-level 1):
+/// `cargo test --test integrate_tables -- --ignored --nocapture`.
+#[test]
+#[ignore = "slow: full resolution sweep for the report"]
+fn table_error_report() {
+    error_tables(true);
+}
+
+fn error_tables(full: bool) {
+    let n = if full { 4000 } else { 1500 };
+    let res3: &[(usize, usize)] = if full { &[(16, 16), (32, 16), (64, 32), (128, 64)] } else { &[(16, 16), (32, 16), (64, 32)] };
+    let res_fast: &[(usize, usize)] = if full { &[(64, 32), (128, 64)] } else { &[(64, 32)] };
+    let res2: &[usize] = if full { &[64, 256] } else { &[64] };
+    let res_cyl: &[(usize, usize)] = if full { &[(32, 32), (64, 64), (64, 256), (128, 128), (128, 512)] } else { &[(32, 32), (64, 128)] };
     let l_max = 1.0;
     eprintln!("| table | resolution | C rms | C max | alpha rms | alpha max |");
     eprintln!("| --- | --- | --- | --- | --- | --- |");
     for (tf_name, tf) in [("smooth", smooth_tf()), ("jump", jump_tf())] {
         let mut prev_rms = f64::INFINITY;
-        for &(ns, nl) in &[(16, 16), (32, 16), (64, 32), (128, 64)] {
+        for &(ns, nl) in res3 {
             let t = Table3d::exact(&tf, ns, nl, (0.0, 1.0), l_max).unwrap();
             let e = measure(&tf, l_max, n, |a, b, l| t.lookup(a, b, l));
             row(&format!("3D exact, {tf_name}"), &format!("{ns}x{ns}x{nl}"), e);
             assert!(e[0] < prev_rms, "3D error must fall with resolution");
             prev_rms = e[0];
-            if ns == 128 && tf_name == "smooth" {
-                assert!(e[1] < 0.02 && e[3] < 0.02, "{e:?}");
+            if ns == 64 && tf_name == "smooth" {
+                assert!(e[1] < 0.02 && e[3] < 0.012, "{e:?}");
             }
         }
-        for &(ns, nl) in &[(64, 32), (128, 64)] {
+        for &(ns, nl) in res_fast {
             let t = Table3d::fast(&tf, ns, nl, (0.0, 1.0), l_max, FastColour::MeanGlow).unwrap();
             let e = measure(&tf, l_max, n, |a, b, l| t.lookup(a, b, l));
             row(&format!("3D integral functions (mean glow), {tf_name}"), &format!("{ns}x{ns}x{nl}"), e);
@@ -196,19 +212,19 @@ fn table_errors_against_exact_integrals() {
             row(&format!("3D integral functions (no attenuation), {tf_name}"), &format!("{ns}x{ns}x{nl}"), e2);
             assert!(e[0] < e2[0], "mean glow beats no attenuation");
         }
-        for &ns in &[64, 256] {
+        for &ns in res2 {
             for (kind, name) in [(Table2dKind::LinearInL, "2D linear in l"), (Table2dKind::DepthGlow, "2D depth + glow")] {
                 let t = Table2d::new(&tf, ns, (0.0, 1.0), 0.5 * l_max, kind).unwrap();
                 let e = measure(&tf, l_max, n, |a, b, l| t.lookup(a, b, l));
                 row(&format!("{name}, {tf_name}"), &format!("{ns}x{ns}, l_ref = 0.5"), e);
             }
         }
-        for &(ns, planes) in &[(32, 32), (64, 64), (64, 256), (128, 128)] {
+        for &(ns, planes) in res_cyl {
             let t = CylinderTable::new(&tf, ns, planes, (0.0, 1.0), l_max).unwrap();
             let e = measure(&tf, l_max, n, |a, b, l| t.lookup(a, b, l));
             row(&format!("cylindrical, {tf_name}"), &format!("{ns}x{ns}x{planes} planes"), e);
-            if tf_name == "smooth" && ns == 128 {
-                assert!(e[1] < 0.05 && e[3] < 0.05, "{e:?}");
+            if tf_name == "smooth" && ns == 64 {
+                assert!(e[1] < 0.03 && e[3] < 0.03, "{e:?}");
             }
         }
     }
