@@ -126,6 +126,10 @@ fn bad_files_give_typed_errors() {
         TfError::Negative { .. }
     ));
     assert!(matches!(err(r#"{"points": []}"#), TfError::Empty));
+    assert!(matches!(
+        err(r#"{"points": [{"s": 0, "tau": 1e150, "rgb": [0,0,0]}]}"#),
+        TfError::OutOfRange { .. }
+    ));
     assert!(matches!(err(r#"{"zoovr_tf": 2, "points": []}"#), TfError::Version(2)));
     assert!(matches!(
         err(r#"{"points": [{"s": 0, "opacity": 1.5, "rgb": [0,0,0]}]}"#),

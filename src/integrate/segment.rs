@@ -47,9 +47,13 @@ pub(crate) fn for_each_piece(
         let (t1, c1) = tf.eval_piece(idx, s1);
         f(l * (x1 - x0), t0, t1, c0, c1);
     };
+    let cross = br.get(i0..i1).unwrap_or(&[]);
+    if cross.is_empty() {
+        piece(0.0, 1.0, s_f, s_b);
+        return;
+    }
     let inv = 1.0 / (s_b - s_f);
     let (mut x_prev, mut s_prev) = (0.0, s_f);
-    let cross = br.get(i0..i1).unwrap_or(&[]);
     let mut visit = |sk: f64| {
         let x = (sk - s_f) * inv;
         piece(x_prev, x, s_prev, sk);
@@ -64,7 +68,8 @@ pub(crate) fn for_each_piece(
     piece(x_prev, 1.0, s_prev, s_b);
 }
 
-/// Colour and depth of one linear piece.
+/// Colour, depth and opacity of one linear piece (`alpha` is exactly
+/// `-expm1(-depth)`).
 #[inline]
 fn piece_value(
     model: EmissionModel,
@@ -73,15 +78,16 @@ fn piece_value(
     t1: f64,
     c0: [f64; 3],
     c1: [f64; 3],
-) -> ([f64; 3], f64) {
-    let w = weights(t0 * l, t1 * l);
+) -> ([f64; 3], f64, f64) {
+    let (a, b) = (t0 * l, t1 * l);
+    let w = weights(a, b);
     let c = match model {
         EmissionModel::Glow => std::array::from_fn(|k| c0[k] * w.w_f + c1[k] * w.w_b),
         EmissionModel::Independent => {
             std::array::from_fn(|k| l * (c0[k] * w.phi_f + c1[k] * w.phi_b))
         }
     };
-    (c, 0.5 * l * (t0 + t1))
+    (c, 0.5 * (a + b), w.alpha)
 }
 
 /// Cleans inputs; `None` means the empty segment.
@@ -106,17 +112,24 @@ pub fn segment(tf: &TransferFunction, l: f64, s_f: f64, s_b: f64) -> SegmentValu
     let model = tf.model();
     let mut color = [0.0; 3];
     let mut depth = 0.0f64;
+    let mut alpha = 0.0;
+    let mut pieces = 0u32;
     for_each_piece(tf, l, s_f, s_b, |ls, t0, t1, c0, c1| {
-        let (c, d) = piece_value(model, ls, t0, t1, c0, c1);
+        let (c, d, a) = piece_value(model, ls, t0, t1, c0, c1);
         let tr = if depth == 0.0 { 1.0 } else { (-depth).exp() };
         for k in 0..3 {
             color[k] += tr * c[k];
         }
         depth += d;
+        alpha = a;
+        pieces += 1;
     });
+    if pieces != 1 {
+        alpha = -(-depth).exp_m1();
+    }
     SegmentValue {
         color,
-        alpha: -(-depth).exp_m1(),
+        alpha,
         depth,
     }
 }

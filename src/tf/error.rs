@@ -31,6 +31,13 @@ pub enum TfError {
         field: &'static str,
         value: f64,
     },
+    #[error("{what}: point {index}: {field} {value} is out of range (magnitude limit 1e100)")]
+    OutOfRange {
+        what: &'static str,
+        index: usize,
+        field: &'static str,
+        value: f64,
+    },
     #[error("{what}: point {index}: opacity {value} is outside [0, 1]")]
     OpacityRange {
         what: &'static str,

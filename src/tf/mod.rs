@@ -302,6 +302,10 @@ impl RayMaterial for TransferFunction {
     }
 }
 
+/// Largest magnitude accepted for any scalar, extinction, colour or
+/// emission value: keeps every product and integral-function sum finite.
+pub const VALUE_LIMIT: f64 = 1e100;
+
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Side {
     Left,
@@ -347,6 +351,14 @@ fn check_sorted(what: &'static str, s: impl Iterator<Item = f64>) -> Result<(), 
         if !value.is_finite() {
             return Err(TfError::NonFiniteScalar { what, index });
         }
+        if value.abs() > VALUE_LIMIT {
+            return Err(TfError::OutOfRange {
+                what,
+                index,
+                field: "scalar",
+                value,
+            });
+        }
         if value < prev {
             return Err(TfError::Unsorted {
                 what,
@@ -367,6 +379,14 @@ fn check_sorted(what: &'static str, s: impl Iterator<Item = f64>) -> Result<(), 
 fn check_value(what: &'static str, index: usize, field: &'static str, v: f64) -> Result<(), TfError> {
     if !v.is_finite() {
         return Err(TfError::NonFinite { what, index, field });
+    }
+    if v > VALUE_LIMIT {
+        return Err(TfError::OutOfRange {
+            what,
+            index,
+            field,
+            value: v,
+        });
     }
     if v < 0.0 {
         return Err(TfError::Negative {
