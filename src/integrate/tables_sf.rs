@@ -3,8 +3,8 @@
 //!
 //! `SF_TABLE[k]` holds, at the centre `x_k = k/16` (k = 0..=128), the values
 //! `[P, Q, B, G]` with `P = sqrt(pi) erfcx(x)`, `Q = 1 - x P`, `B = 2 Dawson(x)`,
-//! `G = 1 - x B`, correctly rounded (mpmath, 60 digits). `GL12` are the
-//! 12-point Gauss-Legendre nodes and weights on [0, 1].
+//! `G = 1 - x B`, correctly rounded (mpmath, 60 digits). `GL12` and `GL8`
+//! are the 12- and 8-point Gauss-Legendre nodes and weights on [0, 1].
 
 #![allow(clippy::approx_constant, clippy::excessive_precision)]
 
@@ -157,4 +157,17 @@ pub(crate) const GL12: [(f64, f64); 12] = [
     (0.8849513370971523, 0.08003916427167311),
     (0.9520586281852375, 0.05346966299765921),
     (0.9907803171233597, 0.023587668193255914),
+];
+
+/// 8-point Gauss-Legendre rule on [0, 1]: `(node, weight)`.
+#[rustfmt::skip]
+pub(crate) const GL8: [(f64, f64); 8] = [
+    (0.019855071751231884, 0.05061426814518813),
+    (0.10166676129318664, 0.11119051722668724),
+    (0.2372337950418355, 0.15685332293894363),
+    (0.4082826787521751, 0.181341891689181),
+    (0.591717321247825, 0.181341891689181),
+    (0.7627662049581645, 0.15685332293894363),
+    (0.8983332387068134, 0.11119051722668724),
+    (0.9801449282487681, 0.05061426814518813),
 ];
