@@ -4,6 +4,25 @@
 //! of one segment over which the scalar is linear, the transfer function's
 //! breakpoints, and the material at one scalar value. Segments composite
 //! front to back with [`RayAccumulator`].
+//!
+//! Submodules: [`weights`] (basis integrals of one linear piece, the ported
+//! closed form), [`segment`](mod@segment) (slicing at breakpoints, whole segments and
+//! rays, per-vertex values for the exact GPU mode), [`table3d`], [`table2d`]
+//! and [`cylinder`] (pre-integration tables filled from the exact integrals),
+//! [`fast`] (integral functions for approximate fills and local updates).
+
+pub mod cylinder;
+pub mod fast;
+mod grid;
+mod segment;
+pub mod table2d;
+pub mod table3d;
+mod tables_sf;
+pub mod weights;
+
+pub use segment::{ray, segment, vertex_values, VertexValues};
+pub use grid::TableError;
+pub use weights::{weights, Regime, Weights};
 
 /// Colour and opacity of one ray segment: premultiplied colour `C` (the
 /// segment's own light at its front), opacity `alpha = 1 - exp(-depth)` and

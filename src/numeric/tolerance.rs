@@ -19,6 +19,7 @@ pub const DEGENERATE_VOLUME_REL: f64 = 1e-12;
 /// are always merged; this allows for ASCII round-off).
 pub const MERGE_POINTS_REL: f64 = 1e-12;
 
+<<<<<<< HEAD
 /// Measured maximum absolute error of the exact mode's exponential table
 /// (`gpu::exptable`, 1024^2 texels, log-warped axes, f32 bilinear filtering)
 /// against the exact `1 - exp(-l tau)` over `l, tau` in `{0} + [1e-8, 1e6]`:
@@ -38,3 +39,11 @@ pub const COLOR_REFINE_TOL: f64 = 0.02;
 /// Exact mode: at most this many levels of midpoint refinement per region
 /// triangle for colour accuracy (each level splits a triangle in up to 4).
 pub const COLOR_REFINE_MAX_DEPTH: u32 = 3;
+=======
+/// Integral-function table fills (`integrate::fast`): below this fraction of
+/// the table's scalar range, `|s_b - s_f|` is too small for the difference
+/// quotients `(T(s_b) - T(s_f)) / (s_b - s_f)` (they lose
+/// `log10(|T| / |T_b - T_f|)` digits, math README 8.4) and the point values
+/// at the midpoint scalar are used instead (error O(ds) there).
+pub const INTEGRAL_FUNCTION_MIN_DS_REL: f64 = 1e-7;
+>>>>>>> integrate
