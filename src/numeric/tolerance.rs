@@ -18,3 +18,20 @@ pub const DEGENERATE_VOLUME_REL: f64 = 1e-12;
 /// merged by the optional coincident-point merge (exactly equal coordinates
 /// are always merged; this allows for ASCII round-off).
 pub const MERGE_POINTS_REL: f64 = 1e-12;
+
+/// Projection (perspective): pieces are clipped at `near * NEAR_CLIP_SCALE`
+/// rather than at the camera's near plane itself, so every clipped point lies
+/// strictly in front of the near plane and projects to a finite pixel
+/// position. `near` is 1e-9 of the camera distance: the clipped sliver is far
+/// below any pixel.
+pub const NEAR_CLIP_SCALE: f64 = 2.0;
+
+/// Projection (perspective): region values are interpolated linearly in
+/// screen space. Along a region edge the screen-space parameter deviates from
+/// the perspective-correct one by at most `|dz| / (4 min z)` on each face;
+/// edges where that (or the ray-length factor's curvature term `|d(uv)|^2 / 8`)
+/// exceeds this bound are split at their midpoint, so any quantity linear on
+/// a face is interpolated to within this fraction of its variation along the
+/// edge. 1e-3 keeps the interpolation error below an 8-bit colour step while
+/// splitting only cells that span more than ~0.4% of their distance in depth.
+pub const PERSPECTIVE_INTERP_REL: f64 = 1e-3;
