@@ -90,8 +90,8 @@ fn random_cells_perspective_error_bounded() {
         }
     }
     println!("perspective: max l error {worst_l:e} (of cell diameter), s error {worst_s:e} (of range)");
-    assert!(worst_l < 4.0 * PERSPECTIVE_INTERP_REL, "l {worst_l}");
-    assert!(worst_s < 4.0 * PERSPECTIVE_INTERP_REL, "s {worst_s}");
+    assert!(worst_l < 2.0 * PERSPECTIVE_INTERP_REL, "l {worst_l}");
+    assert!(worst_s < 2.0 * PERSPECTIVE_INTERP_REL, "s {worst_s}");
 }
 
 #[test]

@@ -225,7 +225,21 @@ impl Projector {
         self.emit(poly, out);
         // 7. Perspective refinement.
         if !camera.ortho && self.perspective_refine {
-            super::refine::refine_perspective(out, self.max_refine_depth, &mut self.refine);
+            let (smin, smax) = poly
+                .scalars
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &s| (a.min(s), b.max(s)));
+            let (lo, hi) = poly.points.iter().fold(
+                (glam::DVec3::splat(f64::INFINITY), glam::DVec3::splat(f64::NEG_INFINITY)),
+                |(a, b), &p| (a.min(p), b.max(p)),
+            );
+            super::refine::refine_perspective(
+                out,
+                smax - smin,
+                (hi - lo).length(),
+                self.max_refine_depth,
+                &mut self.refine,
+            );
         }
         Ok(())
     }

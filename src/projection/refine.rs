@@ -15,8 +15,9 @@
 //!   screen-space linear interpolation of values that are linear on a face
 //!   in 3D deviates from the perspective-correct value by at most
 //!   `|dz| / (4 min z)` of their variation along an edge, and the ray-length
-//!   factor `sqrt(1 + u^2 + v^2)` by at most `|d(u, v)|^2 / 8`; edges where
-//!   either exceeds [`PERSPECTIVE_INTERP_REL`] are split;
+//!   factor `sqrt(1 + u^2 + v^2)` by at most `|d(u, v)|^2 / 8`; edges whose
+//!   resulting error bound exceeds [`PERSPECTIVE_INTERP_REL`] of the piece's
+//!   scalar range (diameter, for `l`) are split;
 //! - colour accuracy in the exact mode ([`refine`] with the caller's
 //!   predicate, e.g. optical depth times colour spread, math README 8.1).
 
@@ -36,23 +37,58 @@ pub struct RefineScratch {
 }
 
 /// Whether the perspective interpolation bound asks to split edge `a`-`b`
-/// (see module docs). Always `false` for orthographic views.
-pub fn perspective_split(view: &ViewMap, a: &RegionVertex, b: &RegionVertex) -> bool {
+/// of a piece with scalar range `scalar_range` and diameter `diameter` (see
+/// module docs). Always `false` for orthographic views.
+///
+/// With `dev = |dz| / (4 min z)` the deviation of the screen-space parameter
+/// on the front (back) face and `curv = |d(u, v)|^2 / 8` that of the
+/// ray-length factor, the interpolation errors along the edge are at most
+/// `dev * |d s|` for the scalars and `g (dev_f |dz_f| + dev_b |dz_b|) +
+/// curv * l` for the thickness (`g` the ray-length factor). The edge is split
+/// when either exceeds [`PERSPECTIVE_INTERP_REL`] of `scalar_range`
+/// (`diameter`). Edges between two profile vertices (silhouette edges shared
+/// with neighbouring pieces) use the piece-independent test `dev > REL or
+/// curv > REL` so that both pieces split them alike.
+pub fn perspective_split(
+    view: &ViewMap,
+    scalar_range: f64,
+    diameter: f64,
+    a: &RegionVertex,
+    b: &RegionVertex,
+) -> bool {
     if view.ortho {
         return false;
     }
     let dev = |za: f64, zb: f64| (za - zb).abs() / (4.0 * za.min(zb));
     let d = view.plane(a.pos()) - view.plane(b.pos());
     let curv = d.length_squared() / 8.0;
-    let e = dev(a.z_front, b.z_front)
-        .max(dev(a.z_back, b.z_back))
-        .max(curv);
-    e > PERSPECTIVE_INTERP_REL
+    let (dev_f, dev_b) = (dev(a.z_front, b.z_front), dev(a.z_back, b.z_back));
+    if a.profile && b.profile {
+        return dev_f.max(curv) > PERSPECTIVE_INTERP_REL;
+    }
+    let es = (dev_f * (a.s_front - b.s_front).abs()).max(dev_b * (a.s_back - b.s_back).abs());
+    let g = view
+        .length_per_depth(a.pos())
+        .max(view.length_per_depth(b.pos()));
+    let el = g * (dev_f * (a.z_front - b.z_front).abs() + dev_b * (a.z_back - b.z_back).abs())
+        + curv * a.l.max(b.l);
+    es > PERSPECTIVE_INTERP_REL * scalar_range || el > PERSPECTIVE_INTERP_REL * diameter
 }
 
-pub(crate) fn refine_perspective(out: &mut Projected, max_depth: u32, s: &mut RefineScratch) {
+pub(crate) fn refine_perspective(
+    out: &mut Projected,
+    scalar_range: f64,
+    diameter: f64,
+    max_depth: u32,
+    s: &mut RefineScratch,
+) {
     let view = out.view;
-    refine_with(out, max_depth, |a, b| perspective_split(&view, a, b), s);
+    refine_with(
+        out,
+        max_depth,
+        |a, b| perspective_split(&view, scalar_range, diameter, a, b),
+        s,
+    );
 }
 
 /// Splits region triangles at edge midpoints, recursively (at most

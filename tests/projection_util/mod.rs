@@ -243,7 +243,15 @@ pub fn check_values(
     let smax = poly.scalars.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let scale_s = (smax - smin).max(1e-300);
     let (mut el, mut es) = (0.0f64, 0.0f64);
-    for t in &proj.triangles {
+    // At most 64 triangles per piece (refined perspective pieces have many).
+    let nt = proj.triangles.len();
+    let picks: Vec<usize> = if nt <= 64 {
+        (0..nt).collect()
+    } else {
+        (0..64).map(|_| (rng.next_u64() % nt as u64) as usize).collect()
+    };
+    for ti in picks {
+        let t = proj.triangles[ti];
         let [a, b, c] = t.map(|i| proj.vertices[i as usize]);
         for _ in 0..samples {
             // Interior barycentric coordinates away from the edges.
