@@ -20,8 +20,14 @@ fn check_area(proj: &Projected, poly: &Polyhedron, cam: &Camera) {
     let hull = hull_area(&pixels(poly, cam));
     let ra = proj.region_area();
     let ta = proj.triangle_area();
-    assert!((ra - hull).abs() <= 1e-9 * hull.max(1e-9), "regions {ra} hull {hull}");
-    assert!((ta - hull).abs() <= 1e-9 * hull.max(1e-9), "triangles {ta} hull {hull}");
+    assert!(
+        (ra - hull).abs() <= 1e-9 * hull.max(1e-9),
+        "regions {ra} hull {hull}"
+    );
+    assert!(
+        (ta - hull).abs() <= 1e-9 * hull.max(1e-9),
+        "triangles {ta} hull {hull}"
+    );
 }
 
 #[test]
@@ -40,7 +46,10 @@ fn random_cells_orthographic_exact() {
             pr.arrangement().sub.sanity_check().unwrap();
             check_area(&out, &poly, &cam);
             let (el, es) = check_values(&out, &poly, &mut rng, 4);
-            assert!(el < 1e-9 && es < 1e-9, "{kind:?}: l err {el:e}, s err {es:e}");
+            assert!(
+                el < 1e-9 && es < 1e-9,
+                "{kind:?}: l err {el:e}, s err {es:e}"
+            );
             // Profile vertices: l = 0 and equal scalars.
             for v in &out.vertices {
                 assert!(v.l >= 0.0);
@@ -89,7 +98,9 @@ fn random_cells_perspective_error_bounded() {
             worst_s = worst_s.max(es);
         }
     }
-    println!("perspective: max l error {worst_l:e} (of cell diameter), s error {worst_s:e} (of range)");
+    println!(
+        "perspective: max l error {worst_l:e} (of cell diameter), s error {worst_s:e} (of range)"
+    );
     assert!(worst_l < 2.0 * PERSPECTIVE_INTERP_REL, "l {worst_l}");
     assert!(worst_s < 2.0 * PERSPECTIVE_INTERP_REL, "s {worst_s}");
 }
@@ -118,7 +129,10 @@ fn perspective_without_refinement_is_worse() {
         let (el, es) = check_values(&out, &poly, &mut rng, 3);
         worst = worst.max(el).max(es);
     }
-    assert!(worst > 4.0 * PERSPECTIVE_INTERP_REL, "unrefined error {worst}");
+    assert!(
+        worst > 4.0 * PERSPECTIVE_INTERP_REL,
+        "unrefined error {worst}"
+    );
 }
 
 #[test]
@@ -205,9 +219,7 @@ fn cube_face_on() {
 #[test]
 fn cube_edge_on() {
     // Rotated 45 degrees about y: two faces edge-on... exactly dyadic.
-    let poly = hex_from_view(cube(|p| {
-        DVec3::new(p.x - p.z, p.y - 0.5, p.x + p.z + 2.0)
-    }));
+    let poly = hex_from_view(cube(|p| DVec3::new(p.x - p.z, p.y - 0.5, p.x + p.z + 2.0)));
     degenerate_case(&poly, None);
 }
 
@@ -219,7 +231,9 @@ fn parallelepiped_along_its_diagonal() {
         DVec3::new(-0.5, 1.0, 1.0),
         DVec3::new(-0.5, -1.0, 1.0),
     );
-    let poly = hex_from_view(cube(|p| e1 * p.x + e2 * p.y + e3 * p.z + DVec3::new(0.0, 0.0, 2.0)));
+    let poly = hex_from_view(cube(|p| {
+        e1 * p.x + e2 * p.y + e3 * p.z + DVec3::new(0.0, 0.0, 2.0)
+    }));
     degenerate_case(&poly, None);
     // The thick vertex is the merged corner pair, with l = |e1 + e2 + e3|.
     let cam = ortho_camera();
@@ -231,7 +245,9 @@ fn parallelepiped_along_its_diagonal() {
 
 #[test]
 fn nearly_flat_hex() {
-    let poly = hex_from_view(cube(|p| DVec3::new(p.x * 0.7 + p.y * 0.2, p.y, 2.0 + 1e-13 * p.z + 0.3 * p.x)));
+    let poly = hex_from_view(cube(|p| {
+        DVec3::new(p.x * 0.7 + p.y * 0.2, p.y, 2.0 + 1e-13 * p.z + 0.3 * p.x)
+    }));
     let cam = ortho_camera();
     let mut out = Projected::default();
     projector().project(&poly, &cam, &mut out).unwrap();
@@ -254,7 +270,11 @@ fn vertex_on_edge_and_vertex_on_vertex() {
     // Pyramid whose apex projects exactly onto a base edge, then onto a base
     // corner.
     use zoovr::mesh::{CellKind, Cells};
-    for apex in [DVec3::new(0.5, 0.0, 3.0), DVec3::new(1.0, 1.0, 3.0), DVec3::new(0.5, 0.5, 3.0)] {
+    for apex in [
+        DVec3::new(0.5, 0.0, 3.0),
+        DVec3::new(1.0, 1.0, 3.0),
+        DVec3::new(0.5, 0.5, 3.0),
+    ] {
         let base = [
             DVec3::new(0.0, 0.0, 2.0),
             DVec3::new(1.0, 0.0, 2.0),
@@ -305,7 +325,12 @@ fn bad_input_is_an_error() {
     let mut out = Projected::default();
     let mut pr = Projector::new();
     let mut p = Polyhedron::from_tet(
-        [DVec3::new(0., 0., 2.), DVec3::X + DVec3::Z * 2.0, DVec3::Y + DVec3::Z * 2.0, DVec3::Z * 3.0],
+        [
+            DVec3::new(0., 0., 2.),
+            DVec3::X + DVec3::Z * 2.0,
+            DVec3::Y + DVec3::Z * 2.0,
+            DVec3::Z * 3.0,
+        ],
         [0.0; 4],
     );
     p.triangles.push([0, 1, 9]);

@@ -14,7 +14,13 @@ fn tet_volume(p: &[DVec3; 4]) -> f64 {
 }
 
 fn random_tet(rng: &mut Rng) -> ([DVec3; 4], [f64; 4]) {
-    let p = std::array::from_fn(|_| DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(2.0, 4.0)));
+    let p = std::array::from_fn(|_| {
+        DVec3::new(
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(2.0, 4.0),
+        )
+    });
     let s = std::array::from_fn(|_| rng.range(0.0, 10.0));
     (p, s)
 }
@@ -29,14 +35,23 @@ fn check(cam: &Camera, seed: u64) {
     let mut multi = 0;
     for _ in 0..200 {
         let (p, s) = random_tet(&mut rng);
-        let mut bps: Vec<f64> = (0..rng.next_u64() % 4).map(|_| rng.range(-1.0, 11.0)).collect();
+        let mut bps: Vec<f64> = (0..rng.next_u64() % 4)
+            .map(|_| rng.range(-1.0, 11.0))
+            .collect();
         if rng.f64() < 0.3 {
             // A breakpoint exactly at a corner's scalar.
             bps.push(s[1]);
         }
         let slabs = slice_tet(p, s, &bps, cam);
-        let (smin, smax) = (s.iter().copied().fold(f64::INFINITY, f64::min), s.iter().copied().fold(f64::NEG_INFINITY, f64::max));
-        let inside: Vec<f64> = bps.iter().copied().filter(|&b| b > smin && b < smax).collect();
+        let (smin, smax) = (
+            s.iter().copied().fold(f64::INFINITY, f64::min),
+            s.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        );
+        let inside: Vec<f64> = bps
+            .iter()
+            .copied()
+            .filter(|&b| b > smin && b < smax)
+            .collect();
         // Volumes.
         let vol: f64 = slabs.iter().map(|x| x.volume()).sum();
         let v0 = tet_volume(&p);
@@ -50,8 +65,15 @@ fn check(cam: &Camera, seed: u64) {
         for slab in &slabs {
             slab.validate().unwrap();
             let lo = slab.scalars.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = slab.scalars.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            assert!(!inside.iter().any(|&b| b > lo && b < hi), "breakpoint inside slab [{lo}, {hi}]");
+            let hi = slab
+                .scalars
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max);
+            assert!(
+                !inside.iter().any(|&b| b > lo && b < hi),
+                "breakpoint inside slab [{lo}, {hi}]"
+            );
             // New points carry a breakpoint scalar exactly.
             for (q, sc) in slab.points.iter().zip(&slab.scalars) {
                 if !p.contains(q) {
@@ -66,20 +88,28 @@ fn check(cam: &Camera, seed: u64) {
             let w = rng.range(0.0, 1.0);
             let k = (rng.next_u64() % 4) as usize;
             let target = c * (1.0 - w) + p[k] * w;
-            let Some((px, py, _)) = cam.view_to_pixel(target) else { continue };
+            let Some((px, py, _)) = cam.view_to_pixel(target) else {
+                continue;
+            };
             let q = DVec2::new(px, py);
             let ts: Vec<Option<f64>> = slabs.iter().map(|x| entry_t(x, &view, q)).collect();
             for i in 0..ts.len() {
                 for j in i + 1..ts.len() {
                     if let (Some(a), Some(b)) = (ts[i], ts[j]) {
                         compared += 1;
-                        assert!(b <= a + 1e-9, "slab {j} (t {b}) drawn after slab {i} (t {a}) but behind it");
+                        assert!(
+                            b <= a + 1e-9,
+                            "slab {j} (t {b}) drawn after slab {i} (t {a}) but behind it"
+                        );
                     }
                 }
             }
         }
     }
-    assert!(compared > 200 && multi > 50, "{compared} comparisons, {multi} sliced tets");
+    assert!(
+        compared > 200 && multi > 50,
+        "{compared} comparisons, {multi} sliced tets"
+    );
 }
 
 #[test]
@@ -99,7 +129,12 @@ fn slabs_perspective_eye_between_planes() {
 
 #[test]
 fn no_breakpoint_inside_keeps_the_tet() {
-    let p = [DVec3::new(0., 0., 2.), DVec3::new(1., 0., 2.), DVec3::new(0., 1., 2.), DVec3::new(0., 0., 3.)];
+    let p = [
+        DVec3::new(0., 0., 2.),
+        DVec3::new(1., 0., 2.),
+        DVec3::new(0., 1., 2.),
+        DVec3::new(0., 0., 3.),
+    ];
     let s = [0.0, 1.0, 2.0, 3.0];
     let mut rng = Rng(1);
     let cam = random_camera(&mut rng, [0.0, 1.0, 0.0, 1.0, 2.0, 3.0], true);

@@ -31,8 +31,7 @@ fn project(t: [DVec3; 4], s: [f64; 4]) -> (Projected, Polyhedron) {
 }
 
 fn thick(out: &Projected) -> RegionVertex {
-    *out
-        .vertices
+    *out.vertices
         .iter()
         .max_by(|a, b| a.l.total_cmp(&b.l))
         .unwrap()
@@ -132,7 +131,11 @@ fn random_tets_are_class_1_or_2() {
     let (mut c1, mut c2) = (0, 0);
     for _ in 0..300 {
         let t: [DVec3; 4] = std::array::from_fn(|_| {
-            DVec3::new(rng.range(-0.8, 0.8), rng.range(-0.8, 0.8), rng.range(2.0, 3.0))
+            DVec3::new(
+                rng.range(-0.8, 0.8),
+                rng.range(-0.8, 0.8),
+                rng.range(2.0, 3.0),
+            )
         });
         let s: [f64; 4] = std::array::from_fn(|_| rng.range(0.0, 1.0));
         let (out, poly) = project(t, s);
@@ -148,7 +151,10 @@ fn random_tets_are_class_1_or_2() {
         assert!((th.l - l).abs() < 1e-12, "{} vs {l}", th.l);
         assert!((th.s_front - sf).abs() < 1e-9 && (th.s_back - sb).abs() < 1e-9);
         // All other vertices are profile vertices.
-        assert_eq!(out.vertices.iter().filter(|v| v.profile).count(), out.vertices.len() - 1);
+        assert_eq!(
+            out.vertices.iter().filter(|v| v.profile).count(),
+            out.vertices.len() - 1
+        );
         let _ = &cam;
     }
     assert!(c1 > 30 && c2 > 30, "{c1} {c2}");

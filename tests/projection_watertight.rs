@@ -69,12 +69,7 @@ fn covers(t: [DVec2; 3], p: DVec2) -> bool {
 }
 
 /// Per-pixel coverage counts of all cells' triangles, and the pieces.
-fn coverage(
-    pts: &[DVec3],
-    cells: &Cells,
-    s: &[f64],
-    cam: &Camera,
-) -> (Vec<u32>, Vec<Polyhedron>) {
+fn coverage(pts: &[DVec3], cells: &Cells, s: &[f64], cam: &Camera) -> (Vec<u32>, Vec<Polyhedron>) {
     let (w, h) = (cam.width as usize, cam.height as usize);
     let mut count = vec![0u32; w * h];
     let mut pr = Projector::new();
@@ -87,8 +82,14 @@ fn coverage(
             let tri = t.map(|i| out.vertices[i as usize].pos());
             let lo = tri[0].min(tri[1]).min(tri[2]);
             let hi = tri[0].max(tri[1]).max(tri[2]);
-            let (i0, i1) = ((lo.x - 0.5).floor().max(0.0) as usize, ((hi.x - 0.5).ceil().max(0.0) as usize).min(w - 1));
-            let (j0, j1) = ((lo.y - 0.5).floor().max(0.0) as usize, ((hi.y - 0.5).ceil().max(0.0) as usize).min(h - 1));
+            let (i0, i1) = (
+                (lo.x - 0.5).floor().max(0.0) as usize,
+                ((hi.x - 0.5).ceil().max(0.0) as usize).min(w - 1),
+            );
+            let (j0, j1) = (
+                (lo.y - 0.5).floor().max(0.0) as usize,
+                ((hi.y - 0.5).ceil().max(0.0) as usize).min(h - 1),
+            );
             for j in j0..=j1 {
                 for i in i0..=i1 {
                     if covers(tri, DVec2::new(i as f64 + 0.5, j as f64 + 0.5)) {
@@ -143,10 +144,17 @@ fn generic_view(ortho: bool, seed: u64) {
             }
             checked += 1;
             covered += (expect > 0) as usize;
-            assert_eq!(count[j * cam.width as usize + i], expect, "pixel ({i}, {j})");
+            assert_eq!(
+                count[j * cam.width as usize + i],
+                expect,
+                "pixel ({i}, {j})"
+            );
         }
     }
-    assert!(skipped * 50 < checked, "{skipped} ambiguous pixels of {checked}");
+    assert!(
+        skipped * 50 < checked,
+        "{skipped} ambiguous pixels of {checked}"
+    );
     assert!(covered > 100, "block covers {covered} pixels");
 }
 
@@ -193,7 +201,12 @@ fn block_face_on_with_pixel_centres_on_edges() {
     };
     let (x0, x1) = (t.x, t.x + 0.75);
     let (y0, y1) = (t.y, t.y + 0.75);
-    let (a, b, c, d) = (corner(x0, y1), corner(x1, y1), corner(x1, y0), corner(x0, y0));
+    let (a, b, c, d) = (
+        corner(x0, y1),
+        corner(x1, y1),
+        corner(x1, y0),
+        corner(x0, y0),
+    );
     let mut on_edges = 0;
     for j in 0..64usize {
         for i in 0..64usize {

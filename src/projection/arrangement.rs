@@ -289,7 +289,10 @@ impl Arrangement {
     /// line allowed, not both), or `None`.
     fn one_side(&self, l: Piece, m: Piece) -> Option<Side> {
         let (l0, l1) = (self.pt(l.a), self.pt(l.b));
-        let (s1, s2) = (orient2d(l0, l1, self.pt(m.a)), orient2d(l0, l1, self.pt(m.b)));
+        let (s1, s2) = (
+            orient2d(l0, l1, self.pt(m.a)),
+            orient2d(l0, l1, self.pt(m.b)),
+        );
         match (s1, s2) {
             (Side::On, Side::On) => None,
             (Side::On, s) | (s, Side::On) => Some(s),

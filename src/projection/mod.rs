@@ -327,7 +327,11 @@ thread_local! {
 
 /// Projects `poly` for `camera` into `out` with a per-thread [`Projector`]
 /// (allocation-free in steady state).
-pub fn project(poly: &Polyhedron, camera: &Camera, out: &mut Projected) -> Result<(), ProjectionError> {
+pub fn project(
+    poly: &Polyhedron,
+    camera: &Camera,
+    out: &mut Projected,
+) -> Result<(), ProjectionError> {
     PROJECTOR.with(|p| match p.try_borrow_mut() {
         Ok(mut p) => p.project(poly, camera, out),
         Err(_) => Projector::new().project(poly, camera, out),

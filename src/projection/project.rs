@@ -173,7 +173,10 @@ impl Projector {
                 continue;
             }
             for k in 0..3 {
-                let (u, v) = (self.canon[t[k] as usize], self.canon[t[(k + 1) % 3] as usize]);
+                let (u, v) = (
+                    self.canon[t[k] as usize],
+                    self.canon[t[(k + 1) % 3] as usize],
+                );
                 if u == v {
                     continue;
                 }
@@ -228,9 +231,14 @@ impl Projector {
             let (smin, smax) = poly
                 .scalars
                 .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &s| (a.min(s), b.max(s)));
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &s| {
+                    (a.min(s), b.max(s))
+                });
             let (lo, hi) = poly.points.iter().fold(
-                (glam::DVec3::splat(f64::INFINITY), glam::DVec3::splat(f64::NEG_INFINITY)),
+                (
+                    glam::DVec3::splat(f64::INFINITY),
+                    glam::DVec3::splat(f64::NEG_INFINITY),
+                ),
                 |(a, b), &p| (a.min(p), b.max(p)),
             );
             super::refine::refine_perspective(

@@ -187,7 +187,11 @@ fn emit_split(t: [u32; 3], m: [u32; 3], r: u32, tris: &mut Vec<[u32; 3]>, regs: 
         _ => {
             // Rotate so that edge 0 (a-b) is split.
             let k = (0..3).find(|&k| m[k] != NIL).unwrap_or(0);
-            let k = if n == 2 && m[(k + 2) % 3] != NIL { (k + 2) % 3 } else { k };
+            let k = if n == 2 && m[(k + 2) % 3] != NIL {
+                (k + 2) % 3
+            } else {
+                k
+            };
             let a = t[k];
             let b = t[(k + 1) % 3];
             let c = t[(k + 2) % 3];

@@ -39,7 +39,12 @@ pub enum TopologyError {
     #[error("vertex {0}: rotation does not visit all its half-edges")]
     Rotation(u32),
     #[error("euler formula violated: V={v} E={e} cycles={f} components={c}")]
-    Euler { v: usize, e: usize, f: usize, c: usize },
+    Euler {
+        v: usize,
+        e: usize,
+        f: usize,
+        c: usize,
+    },
     #[error("half-edge {0}: degenerate edge (loop)")]
     Loop(u32),
 }
@@ -301,7 +306,10 @@ impl Subdivision {
             x
         }
         for h in (0..n as u32).step_by(2) {
-            let (a, b) = (find(&mut parent, self.origin(h)), find(&mut parent, self.dest(h)));
+            let (a, b) = (
+                find(&mut parent, self.origin(h)),
+                find(&mut parent, self.dest(h)),
+            );
             if a != b {
                 parent[a as usize] = b;
             }

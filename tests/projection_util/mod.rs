@@ -86,7 +86,11 @@ pub fn random_affine(rng: &mut Rng) -> (DMat3, DVec3) {
         let m = DMat3::from_cols_array(&std::array::from_fn(|_| rng.range(-1.0, 1.0)));
         let d = m.determinant().abs();
         if d > 0.15 {
-            let t = DVec3::new(rng.range(-2.0, 2.0), rng.range(-2.0, 2.0), rng.range(-2.0, 2.0));
+            let t = DVec3::new(
+                rng.range(-2.0, 2.0),
+                rng.range(-2.0, 2.0),
+                rng.range(-2.0, 2.0),
+            );
             return (m, t);
         }
     }
@@ -115,7 +119,14 @@ pub fn random_cell(kind: CellKind, rng: &mut Rng) -> (Vec<DVec3>, Cells, Vec<f64
 }
 
 pub fn bounds(pts: &[DVec3]) -> [f64; 6] {
-    let mut b = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+    let mut b = [
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
     for p in pts {
         b[0] = b[0].min(p.x);
         b[1] = b[1].max(p.x);
@@ -240,7 +251,11 @@ pub fn check_values(
         }
     }
     let smin = poly.scalars.iter().copied().fold(f64::INFINITY, f64::min);
-    let smax = poly.scalars.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let smax = poly
+        .scalars
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
     let scale_s = (smax - smin).max(1e-300);
     let (mut el, mut es) = (0.0f64, 0.0f64);
     // At most 64 triangles per piece (refined perspective pieces have many).
@@ -248,7 +263,9 @@ pub fn check_values(
     let picks: Vec<usize> = if nt <= 64 {
         (0..nt).collect()
     } else {
-        (0..64).map(|_| (rng.next_u64() % nt as u64) as usize).collect()
+        (0..64)
+            .map(|_| (rng.next_u64() % nt as u64) as usize)
+            .collect()
     };
     for ti in picks {
         let t = proj.triangles[ti];
@@ -274,7 +291,9 @@ pub fn check_values(
                 continue;
             };
             el = el.max((l - lr).abs() / scale_l);
-            es = es.max((sf - sfr).abs() / scale_s).max((sb - sbr).abs() / scale_s);
+            es = es
+                .max((sf - sfr).abs() / scale_s)
+                .max((sb - sbr).abs() / scale_s);
         }
     }
     (el, es)
