@@ -58,7 +58,7 @@ fn refine_by_thickness_spread_keeps_values_exact() {
             // A stand-in for "optical depth x colour spread too large":
             // split where the thickness differs by more than 5% of the max.
             let lmax = out.vertices.iter().map(|v| v.l).fold(0.0, f64::max);
-            refine(&mut out, 3, |a, b| (a.l - b.l).abs() > 0.05 * lmax);
+            refine(&mut out, 12, |a, b| (a.l - b.l).abs() > 0.05 * lmax);
             assert!(out.triangles.len() > n0);
             assert!((out.triangle_area() - a0).abs() <= 1e-9 * a0);
             assert_eq!(out.triangles.len(), out.triangle_region.len());

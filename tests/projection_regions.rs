@@ -43,7 +43,7 @@ fn random_cells_orthographic_exact() {
             let poly = Polyhedron::from_cell(&cells, 0, &pts, |i| sc[i as usize], &cam).unwrap();
             assert!(poly.volume() > 0.0);
             pr.project(&poly, &cam, &mut out).unwrap();
-            pr.arrangement().sub.sanity_check().unwrap();
+            pr.arrangement().sanity_check().unwrap();
             check_area(&out, &poly, &cam);
             let (el, es) = check_values(&out, &poly, &mut rng, 4);
             assert!(

@@ -26,7 +26,7 @@ fn project(t: [DVec3; 4], s: [f64; 4]) -> (Projected, Polyhedron) {
     pr.check_each_insertion = true;
     let mut out = Projected::default();
     pr.project(&poly, &ortho(), &mut out).unwrap();
-    pr.arrangement().sub.sanity_check().unwrap();
+    pr.arrangement().sanity_check().unwrap();
     (out, poly)
 }
 

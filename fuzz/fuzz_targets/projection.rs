@@ -103,7 +103,7 @@ fuzz_target!(|data: &[u8]| {
     let mut out = Projected::default();
     for p in &pieces {
         if pr.project(p, &cam, &mut out).is_ok() {
-            pr.arrangement().sub.sanity_check().expect("sanity_check");
+            pr.arrangement().sanity_check().expect("sanity_check");
             assert!(out.region_area() >= 0.0);
         }
     }

@@ -27,11 +27,11 @@ pub const MERGE_POINTS_REL: f64 = 1e-12;
 pub const NEAR_CLIP_SCALE: f64 = 2.0;
 
 /// Projection (perspective): region values are interpolated linearly in
-/// screen space. Along a region edge the screen-space parameter deviates from
-/// the perspective-correct one by at most `|dz| / (4 min z)` on each face;
-/// edges where that (or the ray-length factor's curvature term `|d(uv)|^2 / 8`)
-/// exceeds this bound are split at their midpoint, so any quantity linear on
-/// a face is interpolated to within this fraction of its variation along the
-/// edge. 1e-3 keeps the interpolation error below an 8-bit colour step while
-/// splitting only cells that span more than ~0.4% of their distance in depth.
+/// screen space. Region edges whose interpolation error bound (screen-space
+/// vs perspective-correct parameter: `|dz| / (4 min z)` per face, plus the
+/// ray-length factor's curvature `|d(u, v)|^2 / 8`) exceeds this fraction of
+/// the piece's scalar range (of its diameter, for the thickness `l`) are split
+/// at their midpoint. 1e-3 keeps the error of the interpolated scalars and
+/// thickness below ~1e-3 of the piece's range/diameter (measured: <= 1.2e-3
+/// in close-up wide-angle views) while leaving ordinary views unrefined.
 pub const PERSPECTIVE_INTERP_REL: f64 = 1e-3;

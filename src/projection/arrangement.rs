@@ -27,7 +27,7 @@
 
 use glam::DVec2;
 
-use super::subdivision::{Subdivision, NIL};
+use super::subdivision::{Subdivision, TopologyError, NIL};
 use crate::numeric::predicates::{orient2d, Side};
 
 /// A segment between two original points, with the triangles on its sides:
@@ -447,6 +447,64 @@ impl Arrangement {
             self.edge_piece.resize(e + 1, NIL);
         }
         self.edge_piece[e] = p;
+    }
+
+    /// Checks the topology ([`Subdivision::sanity_check`]) and, once every
+    /// piece is in, the geometry: one connected component whose outer
+    /// boundary is convex (exact turns of its original points), and bounded
+    /// faces whose areas sum to the area inside it (they partition the
+    /// silhouette).
+    pub fn sanity_check(&self) -> Result<(), TopologyError> {
+        self.sub.sanity_check()?;
+        if !self.done() || self.sub.half_edge_count() == 0 {
+            return Ok(());
+        }
+        let mut mark = Vec::new();
+        let (mut inside, mut outer, mut n_outer) = (0.0, 0.0, 0);
+        let mut convex = true;
+        self.sub.trace_faces(&mut mark, |h0| {
+            let mut a = 0.0;
+            let mut h = h0;
+            loop {
+                a += self.pt(self.sub.origin(h)).perp_dot(self.pt(self.sub.dest(h)));
+                h = self.sub.next(h);
+                if h == h0 {
+                    break;
+                }
+            }
+            if a > 0.0 {
+                inside += a;
+                return;
+            }
+            n_outer += 1;
+            outer -= a;
+            loop {
+                let (u, v, w) = (
+                    self.sub.origin(h),
+                    self.sub.dest(h),
+                    self.sub.dest(self.sub.next(h)),
+                );
+                let pu = self.pt(u);
+                // Outer cycles run clockwise: no counter-clockwise turn.
+                if orient2d(pu, self.pt(v), self.pt(w)) == Side::Positive {
+                    convex = false;
+                }
+                h = self.sub.next(h);
+                if h == h0 {
+                    break;
+                }
+            }
+        });
+        if n_outer != 1 {
+            return Err(TopologyError::Geometry("not exactly one outer boundary"));
+        }
+        if !convex {
+            return Err(TopologyError::Geometry("outer boundary not convex"));
+        }
+        if (inside - outer).abs() > 1e-9 * outer {
+            return Err(TopologyError::Geometry("regions do not partition the silhouette"));
+        }
+        Ok(())
     }
 
     fn other_piece(&self, v: u32, p: u32) -> u32 {

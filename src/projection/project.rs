@@ -45,7 +45,7 @@ enum Facing {
 /// Reusable projection state (see module docs).
 #[derive(Clone, Debug)]
 pub struct Projector {
-    /// Run [`super::Subdivision::sanity_check`] after every inserted edge and fail
+    /// Run [`Arrangement::sanity_check`] after every inserted edge and fail
     /// with [`ProjectionError::Topology`] on the first violation (tests).
     pub check_each_insertion: bool,
     /// Refine regions for perspective views (on by default).
@@ -218,7 +218,7 @@ impl Projector {
         self.arr.prepare(&self.pix, &self.segs);
         while self.arr.insert_next() {
             if self.check_each_insertion {
-                self.arr.sub.sanity_check()?;
+                self.arr.sanity_check()?;
             }
         }
         // 5. Faces.

@@ -47,6 +47,8 @@ pub enum TopologyError {
     },
     #[error("half-edge {0}: degenerate edge (loop)")]
     Loop(u32),
+    #[error("geometry: {0}")]
+    Geometry(&'static str),
 }
 
 #[derive(Clone, Copy, Debug)]
