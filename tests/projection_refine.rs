@@ -63,7 +63,7 @@ fn refine_by_thickness_spread_keeps_values_exact() {
             assert!((out.triangle_area() - a0).abs() <= 1e-9 * a0);
             assert_eq!(out.triangles.len(), out.triangle_region.len());
             assert_conforming(&out);
-            let (el, es) = check_values(&out, &poly, &mut rng, 2);
+            let (el, es, _) = check_values(&out, &poly, &mut rng, 2);
             assert!(el < 1e-9 && es < 1e-9, "{el:e} {es:e}");
             // After three levels, edges still over the threshold are at
             // most 1/8 of the original ones: the spread left is bounded.

@@ -113,9 +113,9 @@ impl Clipper {
             // Emit the kept polygon (convex) as a fan.
             let mut ids = [0u32; 9];
             let m = self.poly.len().min(ids.len());
-            for k in 0..m {
+            for (k, id) in ids.iter_mut().enumerate().take(m) {
                 let key = self.poly[k].key;
-                ids[k] = self.point_of(key, src, what, levels, value, out);
+                *id = self.point_of(key, src, what, levels, value, out);
             }
             for k in 1..m - 1 {
                 if ids[0] != ids[k] && ids[k] != ids[k + 1] && ids[0] != ids[k + 1] {

@@ -153,8 +153,8 @@ impl FaceTri {
     fn new(poly: &Polyhedron, pix: &[DVec2], t: u32) -> FaceTri {
         let mut f = FaceTri::default();
         if let Some(tri) = poly.triangles.get(t as usize) {
-            for k in 0..3 {
-                let i = tri[k] as usize;
+            for (k, &i) in tri.iter().enumerate() {
+                let i = i as usize;
                 f.p[k] = pix[i];
                 f.z[k] = poly.points[i].z;
                 f.s[k] = poly.scalars[i];

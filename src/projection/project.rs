@@ -26,7 +26,7 @@
 
 use glam::DVec2;
 
-use super::arrangement::{Arrangement, Piece};
+use super::arrangement::{is_outer, Arrangement, Piece};
 use super::clip::{ClipValue, Clipper};
 use super::polyhedron::Polyhedron;
 use super::subdivision::NIL;
@@ -62,6 +62,7 @@ pub struct Projector {
     mark: Vec<bool>,
     face_of: Vec<u32>,
     face_start: Vec<u32>,
+    cycles: Vec<(u32, f64)>,
     face_fb: Vec<[u32; 2]>,
     vmap: Vec<u32>,
     on_hull: Vec<bool>,
@@ -84,6 +85,7 @@ impl Default for Projector {
             mark: Vec::new(),
             face_of: Vec::new(),
             face_start: Vec::new(),
+            cycles: Vec::new(),
             face_fb: Vec::new(),
             vmap: Vec::new(),
             on_hull: Vec::new(),
@@ -252,42 +254,34 @@ impl Projector {
         Ok(())
     }
 
-    /// Traces face cycles; bounded faces (positive area) get ids.
+    /// Traces face cycles; bounded faces get ids (see
+    /// [`super::arrangement::is_outer`]).
     fn trace_regions(&mut self) {
         let sub = &self.arr.sub;
         let nh = sub.half_edge_count();
         self.face_of.clear();
         self.face_of.resize(nh, NIL);
         self.face_start.clear();
-        let pos = &self.arr.pos;
-        let face_of = &mut self.face_of;
-        let starts = &mut self.face_start;
-        sub.trace_faces(&mut self.mark, |h0| {
-            let mut area = 0.0;
+        self.cycles.clear();
+        let arr = &self.arr;
+        let cycles = &mut self.cycles;
+        sub.trace_faces(&mut self.mark, |h0| cycles.push((h0, arr.cycle_area(h0))));
+        let amin = self.cycles.iter().fold(0.0, |m: f64, c| m.min(c.1));
+        for &(h0, a) in &self.cycles {
+            if is_outer(a, amin) {
+                continue;
+            }
+            let id = self.face_start.len() as u32;
+            self.face_start.push(h0);
             let mut h = h0;
-            let mut k = 0;
             loop {
-                let (a, b) = (pos[sub.origin(h) as usize], pos[sub.dest(h) as usize]);
-                area += a.perp_dot(b);
+                self.face_of[h as usize] = id;
                 h = sub.next(h);
-                k += 1;
-                if h == h0 || k > nh {
+                if h == h0 || self.face_of[h as usize] == id {
                     break;
                 }
             }
-            if area > 0.0 {
-                let id = starts.len() as u32;
-                starts.push(h0);
-                let mut h = h0;
-                loop {
-                    face_of[h as usize] = id;
-                    h = sub.next(h);
-                    if h == h0 || face_of[h as usize] == id {
-                        break;
-                    }
-                }
-            }
-        });
+        }
     }
 
     /// Front and back triangle of every bounded face.
@@ -311,9 +305,9 @@ impl Projector {
                 continue;
             }
             let s = slots(h);
-            for k in 0..2 {
-                if self.face_fb[f as usize][k] == NIL {
-                    self.face_fb[f as usize][k] = s[k];
+            for (slot, &v) in self.face_fb[f as usize].iter_mut().zip(&s) {
+                if *slot == NIL {
+                    *slot = v;
                 }
             }
         }

@@ -46,9 +46,9 @@ pub struct RefineScratch {
 /// `dev * |d s|` for the scalars and `g (dev_f |dz_f| + dev_b |dz_b|) +
 /// curv * l` for the thickness (`g` the ray-length factor). The edge is split
 /// when either exceeds [`PERSPECTIVE_INTERP_REL`] of `scalar_range`
-/// (`diameter`). Edges between two profile vertices (silhouette edges shared
-/// with neighbouring pieces) use the piece-independent test `dev > REL or
-/// curv > REL` so that both pieces split them alike.
+/// (`diameter`). Edges between two profile vertices (silhouette edges, shared
+/// with neighbouring pieces) are never split: `l = 0` all along them, so
+/// their values have no weight in the integral, and neighbours agree.
 pub fn perspective_split(
     view: &ViewMap,
     scalar_range: f64,
@@ -64,7 +64,8 @@ pub fn perspective_split(
     let curv = d.length_squared() / 8.0;
     let (dev_f, dev_b) = (dev(a.z_front, b.z_front), dev(a.z_back, b.z_back));
     if a.profile && b.profile {
-        return dev_f.max(curv) > PERSPECTIVE_INTERP_REL;
+        // l = 0 all along a silhouette edge: its values carry no weight.
+        return false;
     }
     let es = (dev_f * (a.s_front - b.s_front).abs()).max(dev_b * (a.s_back - b.s_back).abs());
     let g = view

@@ -237,13 +237,15 @@ pub fn pixels(poly: &Polyhedron, cam: &Camera) -> Vec<DVec2> {
 }
 
 /// Checks region values against direct ray casting at random points of each
-/// triangle; returns the max errors `(l, s)` relative to `(scale_l, scale_s)`.
+/// triangle; returns the max errors `(l, s, s_weighted)` relative to the
+/// piece's diameter and scalar range; `s_weighted` is the scalar error times
+/// `l / diameter` (what the integral feels: a segment of length l).
 pub fn check_values(
     proj: &Projected,
     poly: &Polyhedron,
     rng: &mut Rng,
     samples: usize,
-) -> (f64, f64) {
+) -> (f64, f64, f64) {
     let mut scale_l: f64 = 0.0;
     for p in &poly.points {
         for q in &poly.points {
@@ -257,7 +259,7 @@ pub fn check_values(
         .copied()
         .fold(f64::NEG_INFINITY, f64::max);
     let scale_s = (smax - smin).max(1e-300);
-    let (mut el, mut es) = (0.0f64, 0.0f64);
+    let (mut el, mut es, mut ew) = (0.0f64, 0.0f64, 0.0f64);
     // At most 64 triangles per piece (refined perspective pieces have many).
     let nt = proj.triangles.len();
     let picks: Vec<usize> = if nt <= 64 {
@@ -291,10 +293,10 @@ pub fn check_values(
                 continue;
             };
             el = el.max((l - lr).abs() / scale_l);
-            es = es
-                .max((sf - sfr).abs() / scale_s)
-                .max((sb - sbr).abs() / scale_s);
+            let e = (sf - sfr).abs().max((sb - sbr).abs()) / scale_s;
+            es = es.max(e);
+            ew = ew.max(e * lr / scale_l);
         }
     }
-    (el, es)
+    (el, es, ew)
 }
