@@ -1,1 +1,339 @@
-//! Winged-edge projection of convex cells into regions (issue 6).
+//! Projection of one convex piece into screen regions (issue 6; MWS section II).
+//!
+//! A [`Polyhedron`] (a cell, tetrahedron or breakpoint slab in camera view
+//! space, its boundary triangulated) is projected onto the image plane and
+//! cut into convex *regions*, the faces of a winged-edge (half-edge) planar
+//! subdivision of its projected edges. Each region lies under exactly one
+//! front and one back boundary triangle, so in orthographic views the
+//! thickness `l` and the front and back scalars are exactly linear on it.
+//!
+//! Layers, one module each:
+//! - `subdivision`: half-edge topology only (ids in arenas, `sanity_check`);
+//! - `arrangement`: inserting segments one by one with exact predicates;
+//! - `project`: the [`Projector`] pipeline (near clip, projection, regions,
+//!   per-vertex values, fan triangles);
+//! - `refine`: conforming midpoint refinement of region triangles, for the
+//!   perspective error bound and for colour accuracy ([`refine`]);
+//! - `clip`: band clipping (near plane, slabs); `slabs`: [`slice_tet`];
+//! - `polyhedron`: the input type and its builders.
+//!
+//! Conventions:
+//! - Pixel coordinates are [`Camera::view_to_pixel`]'s continuous `(px, py)`
+//!   (pixel centres at `i + 0.5`, `py` growing downwards). "CCW" below means
+//!   a positive `orient2d` in `(px, py)` taken as ordinary x/y axes (which
+//!   is clockwise as displayed, since `py` points down). Regions and output
+//!   triangles are CCW in that sense; rasterisers should not cull.
+//! - Perspective: vertex values are meant to be interpolated *linearly in
+//!   screen space* (no perspective division). Regions are refined until that
+//!   interpolation deviates from the perspective-correct value by at most
+//!   [`crate::numeric::tolerance::PERSPECTIVE_INTERP_REL`] of each
+//!   quantity's variation along an edge (see `refine`); `l` is the length
+//!   of the actual ray segment, in world units.
+//! - Profile vertices are silhouette vertices where the front and back
+//!   surfaces meet: `l = 0`, `s_front = s_back`. (A silhouette vertex on a
+//!   face seen exactly edge-on keeps the thickness along that face.)
+
+mod arrangement;
+mod clip;
+mod polyhedron;
+mod project;
+mod refine;
+mod slabs;
+pub mod subdivision;
+
+use glam::DVec2;
+use thiserror::Error;
+
+pub use arrangement::{Arrangement, Piece};
+pub use clip::{ClipValue, Clipper};
+pub use polyhedron::Polyhedron;
+pub use project::Projector;
+pub use refine::{perspective_split, refine};
+pub use slabs::slice_tet;
+pub use subdivision::{Subdivision, TopologyError};
+
+use crate::camera::Camera;
+use crate::numeric::predicates::{orient2d, Side};
+
+/// Errors of projection (bad input or an inconsistent subdivision).
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ProjectionError {
+    #[error("point index {0} out of range")]
+    IndexOutOfRange(u32),
+    #[error("{points} points but {scalars} scalars")]
+    LengthMismatch { points: usize, scalars: usize },
+    #[error("non-finite coordinate or scalar")]
+    NonFinite,
+    #[error("no cell {0}")]
+    NoSuchCell(usize),
+    #[error("a point is behind the near plane after clipping")]
+    BehindNearPlane,
+    #[error("the clipped surface is not closed")]
+    OpenSurface,
+    #[error("a region has no front or back triangle (non-convex piece?)")]
+    UnassignedRegion,
+    #[error("inconsistent subdivision: {0}")]
+    Topology(#[from] TopologyError),
+}
+
+/// One vertex of the screen regions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RegionVertex {
+    /// Continuous pixel coordinates ([`Camera::view_to_pixel`]).
+    pub px: f64,
+    pub py: f64,
+    /// View depth where the ray through the vertex enters / leaves the piece.
+    pub z_front: f64,
+    pub z_back: f64,
+    /// Length of the ray segment inside the piece, world units.
+    pub l: f64,
+    /// Scalar at the entry and exit points.
+    pub s_front: f64,
+    pub s_back: f64,
+    /// Silhouette vertex with `l = 0` (see module docs).
+    pub profile: bool,
+}
+
+/// What the projection needs of the camera to turn pixel positions back into
+/// rays: view-plane extents and image size.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ViewMap {
+    pub ortho: bool,
+    pub half_width: f64,
+    pub half_height: f64,
+    pub width: f64,
+    pub height: f64,
+}
+
+impl ViewMap {
+    /// The map of `camera`.
+    pub fn of(camera: &Camera) -> ViewMap {
+        let (hw, hh) = camera.half_extent();
+        ViewMap {
+            ortho: camera.ortho,
+            half_width: hw,
+            half_height: hh,
+            width: camera.width as f64,
+            height: camera.height as f64,
+        }
+    }
+
+    /// View-plane coordinates of a pixel position: `(x, y)` (orthographic)
+    /// or `(x / z, y / z)` (perspective).
+    #[inline]
+    pub fn plane(&self, q: DVec2) -> DVec2 {
+        DVec2::new(
+            (2.0 * q.x / self.width - 1.0) * self.half_width,
+            (1.0 - 2.0 * q.y / self.height) * self.half_height,
+        )
+    }
+
+    /// Ray length per unit of depth at pixel position `q`.
+    #[inline]
+    pub fn length_per_depth(&self, q: DVec2) -> f64 {
+        if self.ortho {
+            1.0
+        } else {
+            let u = self.plane(q);
+            (1.0 + u.length_squared()).sqrt()
+        }
+    }
+}
+
+/// A boundary triangle as seen on screen: pixel positions of its corners
+/// with their depths and scalars.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FaceTri {
+    pub p: [DVec2; 3],
+    pub z: [f64; 3],
+    pub s: [f64; 3],
+}
+
+impl FaceTri {
+    fn new(poly: &Polyhedron, pix: &[DVec2], t: u32) -> FaceTri {
+        let mut f = FaceTri::default();
+        if let Some(tri) = poly.triangles.get(t as usize) {
+            for (k, &i) in tri.iter().enumerate() {
+                let i = i as usize;
+                f.p[k] = pix[i];
+                f.z[k] = poly.points[i].z;
+                f.s[k] = poly.scalars[i];
+            }
+        }
+        f
+    }
+
+    /// Depth and scalar of the triangle's plane along the ray through pixel
+    /// position `q` (exactly the corner's data when `q` is a corner).
+    pub fn eval(&self, view: &ViewMap, q: DVec2) -> (f64, f64) {
+        for k in 0..3 {
+            if self.p[k] == q {
+                return (self.z[k], self.s[k]);
+            }
+        }
+        let [a, b, c] = self.p;
+        let den = (b - a).perp_dot(c - a);
+        if den == 0.0 {
+            return (self.z[0], self.s[0]);
+        }
+        let lb = (q - a).perp_dot(c - a) / den;
+        let lc = (b - a).perp_dot(q - a) / den;
+        let la = 1.0 - lb - lc;
+        let lam = [la, lb, lc];
+        if view.ortho {
+            let z = lam[0] * self.z[0] + lam[1] * self.z[1] + lam[2] * self.z[2];
+            let s = lam[0] * self.s[0] + lam[1] * self.s[1] + lam[2] * self.s[2];
+            (z, s)
+        } else {
+            // Perspective-correct: weights lambda_i / z_i.
+            let w = [lam[0] / self.z[0], lam[1] / self.z[1], lam[2] / self.z[2]];
+            let sw = w[0] + w[1] + w[2];
+            let s = (w[0] * self.s[0] + w[1] * self.s[1] + w[2] * self.s[2]) / sw;
+            (1.0 / sw, s)
+        }
+    }
+}
+
+impl RegionVertex {
+    /// Values at pixel position `q` of a region with triangles `front` and
+    /// `back`; `on_hull` marks silhouette vertices.
+    pub fn evaluate(
+        view: &ViewMap,
+        front: &FaceTri,
+        back: &FaceTri,
+        q: DVec2,
+        on_hull: bool,
+    ) -> RegionVertex {
+        let (zf, sf) = front.eval(view, q);
+        let (mut zb, mut sb) = back.eval(view, q);
+        let mut profile = false;
+        if zb <= zf {
+            zb = zf;
+            if on_hull {
+                profile = true;
+                sb = sf;
+            }
+        }
+        RegionVertex {
+            px: q.x,
+            py: q.y,
+            z_front: zf,
+            z_back: zb,
+            l: (zb - zf) * view.length_per_depth(q),
+            s_front: sf,
+            s_back: sb,
+            profile,
+        }
+    }
+
+    /// Pixel position.
+    #[inline]
+    pub fn pos(&self) -> DVec2 {
+        DVec2::new(self.px, self.py)
+    }
+}
+
+/// The projection of one piece (reused between calls).
+#[derive(Clone, Debug, Default)]
+pub struct Projected {
+    /// Region vertices (shared between the regions and triangles).
+    pub vertices: Vec<RegionVertex>,
+    /// Convex regions, CCW (see module docs), indices into `vertices`.
+    pub regions: Vec<Vec<u32>>,
+    /// Triangles for the rasteriser: a fan of each region, refined where
+    /// needed (perspective, [`refine`]); CCW, positive area.
+    pub triangles: Vec<[u32; 3]>,
+    /// Region of each triangle.
+    pub triangle_region: Vec<u32>,
+    /// Front and back triangle of each region.
+    pub region_faces: Vec<[FaceTri; 2]>,
+    /// The camera mapping the values were computed for.
+    pub view: ViewMap,
+    spare: Vec<Vec<u32>>,
+}
+
+impl Projected {
+    /// Empties everything, keeping allocations.
+    pub fn clear(&mut self) {
+        self.vertices.clear();
+        while let Some(mut r) = self.regions.pop() {
+            r.clear();
+            self.spare.push(r);
+        }
+        self.triangles.clear();
+        self.triangle_region.clear();
+        self.region_faces.clear();
+    }
+
+    fn push_region(&mut self) -> usize {
+        let r = self.spare.pop().unwrap_or_default();
+        self.regions.push(r);
+        self.regions.len() - 1
+    }
+
+    /// Fan-triangulates every region, skipping triangles whose exact
+    /// orientation is not positive (zero area, or inverted by rounding of a
+    /// crossing point).
+    fn triangulate_regions(&mut self) {
+        self.triangles.clear();
+        self.triangle_region.clear();
+        for (r, reg) in self.regions.iter().enumerate() {
+            if reg.len() < 3 {
+                continue;
+            }
+            let a = reg[0];
+            for k in 1..reg.len() - 1 {
+                let (b, c) = (reg[k], reg[k + 1]);
+                let [pa, pb, pc] = [a, b, c].map(|i| self.vertices[i as usize].pos());
+                if orient2d(pa, pb, pc) == Side::Positive {
+                    self.triangles.push([a, b, c]);
+                    self.triangle_region.push(r as u32);
+                }
+            }
+        }
+    }
+
+    /// Sum of the areas of the regions (pixel units).
+    pub fn region_area(&self) -> f64 {
+        self.regions
+            .iter()
+            .map(|r| {
+                let mut a = 0.0;
+                for k in 0..r.len() {
+                    let p = self.vertices[r[k] as usize].pos();
+                    let q = self.vertices[r[(k + 1) % r.len()] as usize].pos();
+                    a += p.perp_dot(q);
+                }
+                0.5 * a
+            })
+            .sum()
+    }
+
+    /// Sum of the areas of the triangles (pixel units).
+    pub fn triangle_area(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.vertices[i as usize].pos());
+                0.5 * (b - a).perp_dot(c - a)
+            })
+            .sum()
+    }
+}
+
+thread_local! {
+    static PROJECTOR: std::cell::RefCell<Projector> = std::cell::RefCell::new(Projector::new());
+}
+
+/// Projects `poly` for `camera` into `out` with a per-thread [`Projector`]
+/// (allocation-free in steady state).
+pub fn project(
+    poly: &Polyhedron,
+    camera: &Camera,
+    out: &mut Projected,
+) -> Result<(), ProjectionError> {
+    PROJECTOR.with(|p| match p.try_borrow_mut() {
+        Ok(mut p) => p.project(poly, camera, out),
+        Err(_) => Projector::new().project(poly, camera, out),
+    })
+}

@@ -1,0 +1,157 @@
+//! Projection cost per cell kind (one core): microseconds per projected
+//! piece, and regions / vertices per kind. Fixed seeds; cells are random
+//! affine images of the reference shapes, cameras random (orthographic and
+//! perspective at the default 30-degree view angle) and fitted to a box 50
+//! times the cell's size, as for one cell of a ~50^3 mesh.
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use glam::{DMat3, DVec3};
+use zoovr::camera::{Camera, CameraParams};
+use zoovr::mesh::{CellKind, Cells};
+use zoovr::projection::{Polyhedron, Projected, Projector};
+
+struct Rng(u64);
+impl Rng {
+    fn f64(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545F4914F6CDD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.f64()
+    }
+}
+
+fn reference(kind: CellKind) -> Vec<DVec3> {
+    let v = DVec3::new;
+    let ngon = |n: usize| -> Vec<DVec3> {
+        (0..2 * n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
+                v(a.cos(), a.sin(), (i / n) as f64)
+            })
+            .collect()
+    };
+    match kind {
+        CellKind::Tetra => vec![v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.), v(0., 0., 1.)],
+        CellKind::Pyramid => vec![
+            v(0., 0., 0.),
+            v(1., 0., 0.),
+            v(1., 1., 0.),
+            v(0., 1., 0.),
+            v(0.5, 0.5, 1.),
+        ],
+        CellKind::Wedge => vec![
+            v(0., 0., 0.),
+            v(1., 0., 0.),
+            v(0., 1., 0.),
+            v(0., 0., 1.),
+            v(1., 0., 1.),
+            v(0., 1., 1.),
+        ],
+        CellKind::Hexahedron => vec![
+            v(0., 0., 0.),
+            v(1., 0., 0.),
+            v(1., 1., 0.),
+            v(0., 1., 0.),
+            v(0., 0., 1.),
+            v(1., 0., 1.),
+            v(1., 1., 1.),
+            v(0., 1., 1.),
+        ],
+        CellKind::PentagonalPrism => ngon(5),
+        _ => ngon(6),
+    }
+}
+
+/// 64 random pieces of `kind` with their cameras.
+fn pieces(kind: CellKind, ortho: bool, seed: u64) -> Vec<(Polyhedron, Camera)> {
+    let mut rng = Rng(seed);
+    let r = reference(kind);
+    (0..64)
+        .map(|_| {
+            let m = loop {
+                let m = DMat3::from_cols_array(&std::array::from_fn(|_| rng.range(-1.0, 1.0)));
+                if m.determinant().abs() > 0.15 {
+                    break m;
+                }
+            };
+            let pts: Vec<DVec3> = r.iter().map(|&p| m * p).collect();
+            let mut cells = Cells::default();
+            cells.push(kind, &(0..r.len() as u32).collect::<Vec<_>>());
+            let mut lo = DVec3::splat(f64::INFINITY);
+            let mut hi = -lo;
+            for p in &pts {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+            }
+            let c = (lo + hi) * 0.5;
+            let e = (hi - lo) * 25.0;
+            let cam = Camera::fit(
+                [
+                    c.x - e.x,
+                    c.x + e.x,
+                    c.y - e.y,
+                    c.y + e.y,
+                    c.z - e.z,
+                    c.z + e.z,
+                ],
+                &CameraParams {
+                    azimuth: rng.range(-180.0, 180.0),
+                    elevation: rng.range(-80.0, 80.0),
+                    ortho,
+                    ..Default::default()
+                },
+            );
+            let s: Vec<f64> = (0..r.len()).map(|_| rng.f64()).collect();
+            let poly = Polyhedron::from_cell(&cells, 0, &pts, |i| s[i as usize], &cam).unwrap();
+            (poly, cam)
+        })
+        .collect()
+}
+
+fn bench(c: &mut Criterion) {
+    let kinds = [
+        (CellKind::Tetra, "tet"),
+        (CellKind::Pyramid, "pyramid"),
+        (CellKind::Wedge, "wedge"),
+        (CellKind::Hexahedron, "hex"),
+        (CellKind::PentagonalPrism, "penta_prism"),
+        (CellKind::HexagonalPrism, "hexa_prism"),
+    ];
+    let mut pr = Projector::new();
+    let mut out = Projected::default();
+    for (kind, name) in kinds {
+        for ortho in [true, false] {
+            let set = pieces(kind, ortho, 42);
+            let (mut regions, mut verts, mut tris) = (0, 0, 0);
+            for (p, cam) in &set {
+                pr.project(p, cam, &mut out).unwrap();
+                regions += out.regions.len();
+                verts += out.vertices.len();
+                tris += out.triangles.len();
+            }
+            let n = set.len() as f64;
+            let mode = if ortho { "ortho" } else { "persp" };
+            println!(
+                "{name} ({mode}): {:.2} regions, {:.2} vertices, {:.2} triangles per piece",
+                regions as f64 / n,
+                verts as f64 / n,
+                tris as f64 / n
+            );
+            c.bench_function(&format!("project_{name}_{mode}"), |b| {
+                let mut k = 0;
+                b.iter(|| {
+                    let (p, cam) = &set[k % set.len()];
+                    k += 1;
+                    pr.project(black_box(p), cam, &mut out).unwrap();
+                    black_box(out.triangles.len())
+                })
+            });
+        }
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

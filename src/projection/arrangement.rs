@@ -1,0 +1,586 @@
+//! The geometry layer over [`Subdivision`]: inserting projected segments one
+//! by one, splitting at crossings, with every combinatorial decision exact.
+//!
+//! Input: 2D points (the projected polyhedron vertices, coincident ones
+//! already merged to one id) and segments between them. Preparation
+//! ([`Arrangement::prepare`]) splits every segment at the original points lying
+//! exactly on its interior (exact `orient2d` plus coordinate comparisons) and
+//! merges identical pieces, so that afterwards two pieces meet only at a shared
+//! endpoint or at a *proper* crossing (each strictly on both sides of the
+//! other). Collinear overlaps (faces seen edge-on) vanish in this step.
+//!
+//! Insertion ([`Arrangement::insert_next`]) of piece `p` finds its proper
+//! crossings with the pieces already inserted (four `orient2d` on original
+//! endpoints), creates one vertex per crossing, whose position is computed in
+//! `f64` from the two pieces' original endpoints (never from other computed
+//! points), splits the crossed edge, then connects the consecutive vertices of
+//! `p`. Where a new edge goes in the rotation around a vertex is decided by
+//! an exact angular comparison: around an original point every incident piece
+//! ends there, so directions compare with `orient2d(u, far1, far2)`; around a
+//! crossing there are exactly two pieces, compared with `orient2d` of their
+//! endpoints. The order of crossings along a piece is exact when the two
+//! crossing pieces share an endpoint or one lies on one side of the other's
+//! line -- always the case for a convex polyhedron, whose front edges never
+//! cross each other (nor the back edges). Only three mutually crossing
+//! pieces (a non-convex input) fall back to comparing `f64` parameters, and
+//! [`Subdivision::sanity_check`] then reports whether that was consistent.
+
+use glam::DVec2;
+
+use super::subdivision::{Subdivision, TopologyError, NIL};
+use crate::numeric::predicates::{orient2d, Side};
+
+/// A segment between two original points, with the triangles on its sides:
+/// `side = [front_left, front_right, back_left, back_right]` (triangle ids or
+/// `NIL`), left and right of the direction `a -> b`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Piece {
+    pub a: u32,
+    pub b: u32,
+    pub side: [u32; 4],
+}
+
+#[derive(Clone, Copy, Debug)]
+struct ChainEntry {
+    v: u32,
+    /// Forward half-edge from `v` along the piece (`NIL` for the last entry
+    /// or before the piece is inserted).
+    h: u32,
+}
+
+/// A segment arrangement (see module docs).
+#[derive(Clone, Debug, Default)]
+pub struct Arrangement {
+    /// The topology. Vertex ids `0..n_points` are the original points.
+    pub sub: Subdivision,
+    /// Position of every subdivision vertex.
+    pub pos: Vec<DVec2>,
+    /// For crossing vertices, the two pieces that cross there (`[NIL, NIL]`
+    /// for original points).
+    pub cross: Vec<[u32; 2]>,
+    /// The prepared pieces.
+    pub pieces: Vec<Piece>,
+    /// Piece of every edge (`h >> 1`); the even half-edge runs `a -> b`.
+    pub edge_piece: Vec<u32>,
+    chains: Vec<Vec<ChainEntry>>,
+    /// Cyclic angular rank (counter-clockwise) of each piece's direction at
+    /// its ends: `[at a (towards b), at b (towards a)]`.
+    end_rank: Vec<[u16; 2]>,
+    /// Angular rank of every half-edge's direction around its origin.
+    hrank: Vec<u16>,
+    sort_buf: Vec<(u32, bool)>,
+    inserted: usize,
+    n_points: usize,
+    scratch: Vec<u32>,
+}
+
+#[inline]
+fn half_of(d: DVec2) -> u8 {
+    // 0 for angles in [0, pi), 1 for [pi, 2 pi); exact sign tests.
+    if d.y > 0.0 || (d.y == 0.0 && d.x > 0.0) {
+        0
+    } else {
+        1
+    }
+}
+
+#[inline]
+fn flip(s: Side) -> Side {
+    match s {
+        Side::Positive => Side::Negative,
+        Side::Negative => Side::Positive,
+        Side::On => Side::On,
+    }
+}
+
+impl Arrangement {
+    /// Clears the arrangement and prepares `segments` over `points` (see
+    /// module docs). Segments are `(a, b, side)` with `a != b`; `points`
+    /// become subdivision vertices `0..points.len()`.
+    pub fn prepare(&mut self, points: &[DVec2], segments: &[Piece]) {
+        self.sub.clear();
+        self.pos.clear();
+        self.cross.clear();
+        self.pieces.clear();
+        self.edge_piece.clear();
+        for c in &mut self.chains {
+            c.clear();
+        }
+        self.inserted = 0;
+        self.n_points = points.len();
+        for &p in points {
+            self.sub.add_vertex();
+            self.pos.push(p);
+            self.cross.push([NIL, NIL]);
+        }
+        let mut on = std::mem::take(&mut self.scratch);
+        for s in segments {
+            let (pa, pb) = (points[s.a as usize], points[s.b as usize]);
+            // Original points strictly inside the segment, sorted along it.
+            on.clear();
+            let (lo, hi) = (pa.min(pb), pa.max(pb));
+            for (v, &q) in points.iter().enumerate() {
+                let v = v as u32;
+                if v == s.a || v == s.b || q.x < lo.x || q.x > hi.x || q.y < lo.y || q.y > hi.y {
+                    continue;
+                }
+                if q == pa || q == pb || orient2d(pa, pb, q) != Side::On {
+                    continue;
+                }
+                // Collinear and inside the bounding box: strictly between.
+                // Skip duplicates of an already listed position.
+                if on.iter().any(|&w| points[w as usize] == q) {
+                    continue;
+                }
+                // Insertion in order of distance from a (exact: collinear
+                // points compare by their coordinates along the segment).
+                let key = |w: u32| {
+                    let p = points[w as usize];
+                    if pa.x != pb.x {
+                        (p.x - pa.x).abs()
+                    } else {
+                        (p.y - pa.y).abs()
+                    }
+                };
+                let k = key(v);
+                let at = on.iter().position(|&w| key(w) > k).unwrap_or(on.len());
+                on.insert(at, v);
+            }
+            let mut prev = s.a;
+            for i in 0..=on.len() {
+                let next = if i < on.len() { on[i] } else { s.b };
+                self.add_piece(Piece {
+                    a: prev,
+                    b: next,
+                    side: s.side,
+                });
+                prev = next;
+            }
+        }
+        self.scratch = on;
+        self.rank_original_vertices();
+    }
+
+    /// Sorts the pieces around every original point by exact angle once, so
+    /// that insertion positions are found by comparing integer ranks.
+    fn rank_original_vertices(&mut self) {
+        self.end_rank.clear();
+        self.end_rank.resize(self.pieces.len(), [0, 0]);
+        self.hrank.clear();
+        let mut buf = std::mem::take(&mut self.sort_buf);
+        for v in 0..self.n_points as u32 {
+            buf.clear();
+            for (i, p) in self.pieces.iter().enumerate() {
+                if p.a == v {
+                    buf.push((i as u32, true));
+                } else if p.b == v {
+                    buf.push((i as u32, false));
+                }
+            }
+            // Insertion sort (exact comparisons, a handful of elements).
+            for i in 1..buf.len() {
+                let mut j = i;
+                while j > 0 && self.angle_less(v, buf[j], buf[j - 1]) {
+                    buf.swap(j, j - 1);
+                    j -= 1;
+                }
+            }
+            for (r, &(p, at_a)) in buf.iter().enumerate() {
+                self.end_rank[p as usize][if at_a { 0 } else { 1 }] = r as u16;
+            }
+        }
+        self.sort_buf = buf;
+    }
+
+    /// Rank of direction `d` (piece, forward) at vertex `u`.
+    fn rank(&self, u: u32, d: (u32, bool)) -> u16 {
+        if (u as usize) < self.n_points {
+            self.end_rank[d.0 as usize][if d.1 { 0 } else { 1 }]
+        } else {
+            // Crossing of q (first) and p: counter-clockwise order is
+            // q+, p+, q-, p- when p+ is counter-clockwise of q+, else
+            // q+, p-, q-, p+.
+            let [q, p] = self.cross[u as usize];
+            let (qq, pp) = (self.pieces[q as usize], self.pieces[p as usize]);
+            let ccw = orient2d(self.pt(qq.a), self.pt(qq.b), self.pt(pp.b)) == Side::Positive;
+            match (d.0 == q, d.1, ccw) {
+                (true, true, _) => 0,
+                (true, false, _) => 2,
+                (false, fwd, ccw) => {
+                    if fwd == ccw {
+                        1
+                    } else {
+                        3
+                    }
+                }
+            }
+        }
+    }
+
+    fn set_rank(&mut self, h: u32, r: u16) {
+        if self.hrank.len() <= h as usize {
+            self.hrank.resize(h as usize + 1, 0);
+        }
+        self.hrank[h as usize] = r;
+    }
+
+    fn add_piece(&mut self, p: Piece) {
+        // Canonical direction a < b (flip sides accordingly), then merge.
+        let p = if p.a < p.b {
+            p
+        } else {
+            Piece {
+                a: p.b,
+                b: p.a,
+                side: [p.side[1], p.side[0], p.side[3], p.side[2]],
+            }
+        };
+        if let Some(q) = self.pieces.iter_mut().find(|q| q.a == p.a && q.b == p.b) {
+            for k in 0..4 {
+                if q.side[k] == NIL {
+                    q.side[k] = p.side[k];
+                }
+            }
+            return;
+        }
+        self.pieces.push(p);
+    }
+
+    /// Number of prepared pieces.
+    pub fn piece_count(&self) -> usize {
+        self.pieces.len()
+    }
+
+    /// Whether every piece has been inserted.
+    pub fn done(&self) -> bool {
+        self.inserted == self.pieces.len()
+    }
+
+    #[inline]
+    fn pt(&self, v: u32) -> DVec2 {
+        self.pos[v as usize]
+    }
+
+    /// Whether pieces `p` and `q` cross properly (exact).
+    fn crosses(&self, p: Piece, q: Piece) -> bool {
+        if p.a == q.a || p.a == q.b || p.b == q.a || p.b == q.b {
+            return false;
+        }
+        let (p0, p1, q0, q1) = (self.pt(p.a), self.pt(p.b), self.pt(q.a), self.pt(q.b));
+        if p0.x.max(p1.x) < q0.x.min(q1.x)
+            || q0.x.max(q1.x) < p0.x.min(p1.x)
+            || p0.y.max(p1.y) < q0.y.min(q1.y)
+            || q0.y.max(q1.y) < p0.y.min(p1.y)
+        {
+            return false;
+        }
+        let s = |x: Side| x != Side::On;
+        let (o1, o2) = (orient2d(p0, p1, q0), orient2d(p0, p1, q1));
+        if !(s(o1) && s(o2) && o1 != o2) {
+            return false;
+        }
+        let (o3, o4) = (orient2d(q0, q1, p0), orient2d(q0, q1, p1));
+        s(o3) && s(o4) && o3 != o4
+    }
+
+    /// Parameter along `p` of its crossing with `q`, in `f64` from the
+    /// original endpoints.
+    fn param(&self, p: Piece, q: Piece) -> f64 {
+        let (p0, p1, q0, q1) = (self.pt(p.a), self.pt(p.b), self.pt(q.a), self.pt(q.b));
+        let d = p1 - p0;
+        let e = q1 - q0;
+        let den = d.perp_dot(e);
+        let t = (q0 - p0).perp_dot(e) / den;
+        if t.is_finite() {
+            t.clamp(0.0, 1.0)
+        } else {
+            0.5
+        }
+    }
+
+    /// Position of the crossing of pieces `p` and `q`, symmetric in `p, q`.
+    fn crossing_point(&self, p: u32, q: u32) -> DVec2 {
+        let (p, q) = if p < q { (p, q) } else { (q, p) };
+        let (pp, qq) = (self.pieces[p as usize], self.pieces[q as usize]);
+        let t = self.param(pp, qq);
+        let (p0, p1) = (self.pt(pp.a), self.pt(pp.b));
+        let x = p0 + (p1 - p0) * t;
+        // Keep the rounded point inside both bounding boxes.
+        let (q0, q1) = (self.pt(qq.a), self.pt(qq.b));
+        let lo = p0.min(p1).max(q0.min(q1));
+        let hi = p0.max(p1).min(q0.max(q1));
+        x.max(lo).min(hi)
+    }
+
+    /// Whether, along piece `p` (direction `a -> b`), its crossing with `q1`
+    /// comes before its crossing with `q2`.
+    fn cross_before(&self, p: u32, q1: u32, q2: u32) -> bool {
+        let pp = self.pieces[p as usize];
+        let (a, b) = (self.pieces[q1 as usize], self.pieces[q2 as usize]);
+        let (p0, p1) = (self.pt(pp.a), self.pt(pp.b));
+        // (i) q1 and q2 share an endpoint v off the line of p.
+        let shared = if a.a == b.a || a.a == b.b {
+            Some(a.a)
+        } else if a.b == b.a || a.b == b.b {
+            Some(a.b)
+        } else {
+            None
+        };
+        if let Some(v) = shared {
+            let w1 = if a.a == v { a.b } else { a.a };
+            let w2 = if b.a == v { b.b } else { b.a };
+            let pv = self.pt(v);
+            let turn = orient2d(pv, self.pt(w1), self.pt(w2));
+            match orient2d(p0, p1, pv) {
+                Side::Positive if turn != Side::On => return turn == Side::Positive,
+                Side::Negative if turn != Side::On => return turn == Side::Negative,
+                _ => {}
+            }
+        } else {
+            // (ii) q2 on one side of the line of q1.
+            if let Some(s) = self.one_side(a, b) {
+                return orient2d(self.pt(a.a), self.pt(a.b), p1) == s;
+            }
+            // (iii) q1 on one side of the line of q2.
+            if let Some(s) = self.one_side(b, a) {
+                return orient2d(self.pt(b.a), self.pt(b.b), p1) != s;
+            }
+        }
+        // (iv) three mutually crossing pieces: f64 parameters.
+        let (t1, t2) = (self.param(pp, a), self.param(pp, b));
+        if t1 != t2 {
+            t1 < t2
+        } else {
+            q1 < q2
+        }
+    }
+
+    /// The side of the line of `l` on which all of `m` lies (endpoints on the
+    /// line allowed, not both), or `None`.
+    fn one_side(&self, l: Piece, m: Piece) -> Option<Side> {
+        let (l0, l1) = (self.pt(l.a), self.pt(l.b));
+        let (s1, s2) = (
+            orient2d(l0, l1, self.pt(m.a)),
+            orient2d(l0, l1, self.pt(m.b)),
+        );
+        match (s1, s2) {
+            (Side::On, Side::On) => None,
+            (Side::On, s) | (s, Side::On) => Some(s),
+            (s, t) if s == t => Some(s),
+            _ => None,
+        }
+    }
+
+    /// Direction vector (rounded; used for its exact coordinate signs only,
+    /// which `b - a` keeps because subtraction of doubles is sign-exact).
+    #[inline]
+    fn dir_vec(&self, d: (u32, bool)) -> DVec2 {
+        let p = self.pieces[d.0 as usize];
+        let v = self.pt(p.b) - self.pt(p.a);
+        if d.1 {
+            v
+        } else {
+            -v
+        }
+    }
+
+    /// Exact sign of `cross(d1, d2)` for two directions leaving vertex `u`.
+    fn cross_sign(&self, u: u32, d1: (u32, bool), d2: (u32, bool)) -> Side {
+        let (p1, p2) = (self.pieces[d1.0 as usize], self.pieces[d2.0 as usize]);
+        if (u as usize) < self.n_points {
+            let far = |p: Piece| if p.a == u { p.b } else { p.a };
+            orient2d(self.pt(u), self.pt(far(p1)), self.pt(far(p2)))
+        } else {
+            // Crossing of exactly two pieces: cross(forward p1, forward p2)
+            // has the sign of orient2d(p1.a, p1.b, p2.b).
+            let s = orient2d(self.pt(p1.a), self.pt(p1.b), self.pt(p2.b));
+            if d1.1 == d2.1 {
+                s
+            } else {
+                flip(s)
+            }
+        }
+    }
+
+    /// Whether direction `d1` has a smaller angle than `d2` (angles from the
+    /// +x axis counter-clockwise, in `[0, 2 pi)`), at vertex `u`.
+    fn angle_less(&self, u: u32, d1: (u32, bool), d2: (u32, bool)) -> bool {
+        let (h1, h2) = (half_of(self.dir_vec(d1)), half_of(self.dir_vec(d2)));
+        if h1 != h2 {
+            return h1 < h2;
+        }
+        self.cross_sign(u, d1, d2) == Side::Positive
+    }
+
+    /// The outgoing half-edge of `u` after which direction `d` goes in
+    /// clockwise order (`NIL` when `u` is isolated).
+    fn find_after(&self, u: u32, d: u16) -> u32 {
+        let h0 = self.sub.vertex_edge(u);
+        if h0 == NIL {
+            return NIL;
+        }
+        let mut h = h0;
+        let mut guard = 0;
+        loop {
+            // Clockwise from h comes n: d goes after h (clockwise) when it
+            // lies strictly between n and h counter-clockwise.
+            let n = self.sub.cw_next(h);
+            if n == h {
+                return h;
+            }
+            let (a, b) = (self.hrank[n as usize], self.hrank[h as usize]);
+            let between = if a < b {
+                a < d && d < b
+            } else {
+                a < d || d < b
+            };
+            if between {
+                return h;
+            }
+            h = n;
+            guard += 1;
+            if h == h0 || guard > self.sub.half_edge_count() {
+                // Inconsistent rotation (only possible after the inexact
+                // fallback): any position keeps the structure well formed.
+                return h0;
+            }
+        }
+    }
+
+    /// Inserts the next prepared piece; returns `false` when all are in.
+    pub fn insert_next(&mut self) -> bool {
+        if self.inserted >= self.pieces.len() {
+            return false;
+        }
+        let p = self.inserted as u32;
+        self.inserted += 1;
+        if self.chains.len() < self.pieces.len() {
+            self.chains.resize_with(self.pieces.len(), Vec::new);
+        }
+        let pp = self.pieces[p as usize];
+        let mut chain = std::mem::take(&mut self.chains[p as usize]);
+        chain.clear();
+        chain.push(ChainEntry { v: pp.a, h: NIL });
+        // Crossings with earlier pieces.
+        for q in 0..p {
+            let qq = self.pieces[q as usize];
+            if !self.crosses(pp, qq) {
+                continue;
+            }
+            let w = self.sub.add_vertex();
+            let x = self.crossing_point(p, q);
+            self.pos.push(x);
+            self.cross.push([q, p]);
+            // Position on q's chain (the first and last entries are q's ends).
+            let qc = &self.chains[q as usize];
+            let mut i = 1;
+            while i + 1 < qc.len() {
+                let other = self.other_piece(qc[i].v, q);
+                if self.cross_before(q, p, other) {
+                    break;
+                }
+                i += 1;
+            }
+            let h = self.chains[q as usize][i - 1].h;
+            let old_back = self.hrank[(h ^ 1) as usize];
+            let h2 = self.sub.split(h, w);
+            self.set_edge_piece(h2, q);
+            // h keeps its origin; h^1 now leaves w backwards along q; h2
+            // leaves w forwards; h2^1 leaves the old end like h^1 did.
+            let (rb, rf) = (self.rank(w, (q, false)), self.rank(w, (q, true)));
+            self.set_rank(h ^ 1, rb);
+            self.set_rank(h2, rf);
+            self.set_rank(h2 ^ 1, old_back);
+            self.chains[q as usize].insert(i, ChainEntry { v: w, h: h2 });
+            // Insertion sort into p's chain.
+            let mut j = chain.len();
+            while j > 1 && self.cross_before(p, q, self.other_piece(chain[j - 1].v, p)) {
+                j -= 1;
+            }
+            chain.insert(j, ChainEntry { v: w, h: NIL });
+        }
+        chain.push(ChainEntry { v: pp.b, h: NIL });
+        for k in 0..chain.len() - 1 {
+            let (u, v) = (chain[k].v, chain[k + 1].v);
+            let (ru, rv) = (self.rank(u, (p, true)), self.rank(v, (p, false)));
+            let after_u = self.find_after(u, ru);
+            let after_v = self.find_after(v, rv);
+            let h = self.sub.connect(u, v, after_u, after_v);
+            self.set_edge_piece(h, p);
+            self.set_rank(h, ru);
+            self.set_rank(h ^ 1, rv);
+            chain[k].h = h;
+        }
+        self.chains[p as usize] = chain;
+        true
+    }
+
+    fn set_edge_piece(&mut self, h: u32, p: u32) {
+        let e = (h >> 1) as usize;
+        if self.edge_piece.len() <= e {
+            self.edge_piece.resize(e + 1, NIL);
+        }
+        self.edge_piece[e] = p;
+    }
+
+    /// Checks the topology ([`Subdivision::sanity_check`]) and, once every
+    /// piece is in, the geometry: a single outer boundary (one connected
+    /// component), and bounded faces whose areas sum to the area inside it
+    /// (they partition the silhouette).
+    pub fn sanity_check(&self) -> Result<(), TopologyError> {
+        self.sub.sanity_check()?;
+        if !self.done() || self.sub.half_edge_count() == 0 {
+            return Ok(());
+        }
+        let mut mark = Vec::new();
+        let mut areas = Vec::new();
+        self.sub
+            .trace_faces(&mut mark, |h0| areas.push(self.cycle_area(h0)));
+        let amin = areas.iter().copied().fold(0.0, f64::min);
+        let n_outer = areas.iter().filter(|&&a| is_outer(a, amin)).count();
+        let inside: f64 = areas.iter().filter(|&&a| !is_outer(a, amin)).sum();
+        if n_outer != 1 {
+            return Err(TopologyError::Geometry("not exactly one outer boundary"));
+        }
+        if (inside + amin).abs() > 1e-9 * -amin {
+            return Err(TopologyError::Geometry(
+                "regions do not partition the silhouette",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Twice the signed area of the face cycle through `h0`.
+    pub fn cycle_area(&self, h0: u32) -> f64 {
+        let mut a = 0.0;
+        let mut h = h0;
+        let mut k = 0;
+        loop {
+            a += self
+                .pt(self.sub.origin(h))
+                .perp_dot(self.pt(self.sub.dest(h)));
+            h = self.sub.next(h);
+            k += 1;
+            if h == h0 || k > self.sub.half_edge_count() {
+                return a;
+            }
+        }
+    }
+
+    fn other_piece(&self, v: u32, p: u32) -> u32 {
+        let c = self.cross[v as usize];
+        if c[0] == p {
+            c[1]
+        } else {
+            c[0]
+        }
+    }
+}
+
+/// Whether a face cycle of (twice the) signed area `a` is an outer boundary,
+/// given the most negative cycle area `amin`: bounded faces have positive
+/// area, except slivers whose rounded crossing points make their computed
+/// area zero or slightly negative; those are tiny next to the outer cycle.
+pub fn is_outer(a: f64, amin: f64) -> bool {
+    a < 0.0 && -a > 1e-9 * -amin
+}

@@ -1,0 +1,230 @@
+//! Clipping a triangulated convex piece to a band `lo <= f <= hi` of a
+//! per-point value `f` that is linear on every triangle: the near plane
+//! (`f = z`) and breakpoint slabs (`f = scalar`).
+//!
+//! Each boundary triangle is clipped (Sutherland-Hodgman) against both
+//! levels. A new point is always computed from the two *original* points of
+//! the triangle edge it lies on (a clipped polygon's edge that crosses a
+//! level is part of an original edge: the other kind of edge lies on the
+//! previous level), with the endpoints in a canonical order that depends only
+//! on their positions, so two cells sharing the edge get bit-identical points;
+//! its value is set to the level exactly. The caps are the boundary loops left
+//! after cancelling opposite on-level edges of the kept polygons; they are
+//! convex and fan-triangulated. A piece that only touches the band is empty.
+
+use glam::DVec3;
+
+use super::polyhedron::Polyhedron;
+use super::ProjectionError;
+
+/// What is clipped: the view depth `z` or the scalar.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClipValue {
+    Depth,
+    Scalar,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Key {
+    Orig(u32),
+    /// On original edge (i, j), i < j, at level 0 (lo) or 1 (hi).
+    Cut(u32, u32, u8),
+}
+
+#[derive(Clone, Copy, Debug)]
+struct PV {
+    key: Key,
+    f: f64,
+}
+
+/// Scratch for [`Clipper::clip`].
+#[derive(Clone, Debug, Default)]
+pub struct Clipper {
+    map: Vec<(Key, u32)>,
+    poly: Vec<PV>,
+    tmp: Vec<PV>,
+    level_edges: Vec<(u32, u32)>,
+}
+
+impl Clipper {
+    /// Clips `src` to `lo <= f <= hi` into `out` (cleared first). Returns
+    /// `Ok(false)` when nothing of positive volume is left (then `out` is
+    /// empty).
+    pub fn clip(
+        &mut self,
+        src: &Polyhedron,
+        what: ClipValue,
+        lo: f64,
+        hi: f64,
+        out: &mut Polyhedron,
+    ) -> Result<bool, ProjectionError> {
+        out.clear();
+        let value = |i: u32| -> f64 {
+            match what {
+                ClipValue::Depth => src.points[i as usize].z,
+                ClipValue::Scalar => src.scalars[i as usize],
+            }
+        };
+        let (mut vmin, mut vmax) = (f64::INFINITY, f64::NEG_INFINITY);
+        for i in 0..src.points.len() as u32 {
+            vmin = vmin.min(value(i));
+            vmax = vmax.max(value(i));
+        }
+        if !(vmax > lo && vmin < hi) {
+            return Ok(false);
+        }
+        self.map.clear();
+        self.level_edges.clear();
+        let levels = [lo, hi];
+        for t in &src.triangles {
+            self.poly.clear();
+            for &i in t {
+                self.poly.push(PV {
+                    key: Key::Orig(i),
+                    f: value(i),
+                });
+            }
+            for lev in 0..2u8 {
+                let l = levels[lev as usize];
+                if !l.is_finite() {
+                    continue;
+                }
+                let inside = |f: f64| if lev == 0 { f >= l } else { f <= l };
+                self.tmp.clear();
+                let n = self.poly.len();
+                for k in 0..n {
+                    let (p, q) = (self.poly[k], self.poly[(k + 1) % n]);
+                    if inside(p.f) {
+                        self.tmp.push(p);
+                    }
+                    if (p.f < l && q.f > l) || (p.f > l && q.f < l) {
+                        let (i, j) = original_edge(p.key, q.key);
+                        self.tmp.push(PV {
+                            key: Key::Cut(i.min(j), i.max(j), lev),
+                            f: l,
+                        });
+                    }
+                }
+                std::mem::swap(&mut self.poly, &mut self.tmp);
+            }
+            if self.poly.len() < 3 {
+                continue;
+            }
+            // Emit the kept polygon (convex) as a fan.
+            let mut ids = [0u32; 9];
+            let m = self.poly.len().min(ids.len());
+            for (k, id) in ids.iter_mut().enumerate().take(m) {
+                let key = self.poly[k].key;
+                *id = self.point_of(key, src, what, levels, value, out);
+            }
+            for k in 1..m - 1 {
+                if ids[0] != ids[k] && ids[k] != ids[k + 1] && ids[0] != ids[k + 1] {
+                    out.triangles.push([ids[0], ids[k], ids[k + 1]]);
+                }
+            }
+            // Directed edges lying on a level.
+            for k in 0..m {
+                let (p, q) = (self.poly[k], self.poly[(k + 1) % m]);
+                let on_lo = p.f == lo && q.f == lo;
+                let on_hi = p.f == hi && q.f == hi;
+                if (on_lo || on_hi) && ids[k] != ids[(k + 1) % m] {
+                    self.level_edges.push((ids[k], ids[(k + 1) % m]));
+                }
+            }
+        }
+        // Cancel opposite pairs; what is left bounds the caps.
+        let mut k = 0;
+        while k < self.level_edges.len() {
+            let (a, b) = self.level_edges[k];
+            if let Some(j) = self.level_edges.iter().position(|&e| e == (b, a)) {
+                let (hi_i, lo_i) = (k.max(j), k.min(j));
+                self.level_edges.swap_remove(hi_i);
+                self.level_edges.swap_remove(lo_i);
+                k = 0;
+                continue;
+            }
+            k += 1;
+        }
+        // Chain the rest into loops; each cap runs opposite to them.
+        while let Some((a0, b0)) = self.level_edges.pop() {
+            let start = a0;
+            let mut cur = b0;
+            let mut loop_pts = [0u32; 64];
+            loop_pts[0] = a0;
+            let mut n = 1;
+            while cur != start {
+                if n >= loop_pts.len() {
+                    return Err(ProjectionError::OpenSurface);
+                }
+                loop_pts[n] = cur;
+                n += 1;
+                match self.level_edges.iter().position(|e| e.0 == cur) {
+                    Some(j) => {
+                        cur = self.level_edges.swap_remove(j).1;
+                    }
+                    None => return Err(ProjectionError::OpenSurface),
+                }
+            }
+            // Reverse loop: fan from loop_pts[0] over the reversed order.
+            for k in 1..n.saturating_sub(1) {
+                out.triangles
+                    .push([loop_pts[0], loop_pts[n - k], loop_pts[n - k - 1]]);
+            }
+        }
+        Ok(!out.triangles.is_empty())
+    }
+
+    /// Output index of the point with `key`, creating it on first use.
+    fn point_of(
+        &mut self,
+        key: Key,
+        src: &Polyhedron,
+        what: ClipValue,
+        levels: [f64; 2],
+        value: impl Fn(u32) -> f64,
+        out: &mut Polyhedron,
+    ) -> u32 {
+        if let Some(&(_, i)) = self.map.iter().find(|(k, _)| *k == key) {
+            return i;
+        }
+        let idx = out.points.len() as u32;
+        match key {
+            Key::Orig(i) => {
+                out.points.push(src.points[i as usize]);
+                out.scalars.push(src.scalars[i as usize]);
+            }
+            Key::Cut(i, j, lev) => {
+                let l = levels[lev as usize];
+                let (pi, pj) = (src.points[i as usize], src.points[j as usize]);
+                // Canonical order by position, so that neighbours agree.
+                let (a, b) = if lex_less(pi, pj) { (i, j) } else { (j, i) };
+                let (pa, pb) = (src.points[a as usize], src.points[b as usize]);
+                let (fa, fb) = (value(a), value(b));
+                let mu = ((l - fa) / (fb - fa)).clamp(0.0, 1.0);
+                let mut p = pa + (pb - pa) * mu;
+                let (sa, sb) = (src.scalars[a as usize], src.scalars[b as usize]);
+                let mut s = sa + (sb - sa) * mu;
+                match what {
+                    ClipValue::Depth => p.z = l,
+                    ClipValue::Scalar => s = l,
+                }
+                out.points.push(p);
+                out.scalars.push(s);
+            }
+        }
+        self.map.push((key, idx));
+        idx
+    }
+}
+
+fn lex_less(a: DVec3, b: DVec3) -> bool {
+    (a.z, a.x, a.y) < (b.z, b.x, b.y)
+}
+
+/// The original edge a clipped-polygon edge that crosses a level lies on.
+fn original_edge(p: Key, q: Key) -> (u32, u32) {
+    match (p, q) {
+        (Key::Cut(i, j, _), _) | (_, Key::Cut(i, j, _)) => (i, j),
+        (Key::Orig(i), Key::Orig(j)) => (i, j),
+    }
+}

@@ -1,0 +1,211 @@
+//! Conforming midpoint refinement of the region triangles.
+//!
+//! The decision to split is made per *edge*, from the edge's two vertices
+//! only, so the two triangles sharing an edge always agree (no T-junctions
+//! inside a piece; across pieces, silhouette edges between profile vertices
+//! carry the same data in both pieces, hence the same decision). A triangle
+//! with one, two or three split edges becomes two, three or four triangles;
+//! a new vertex sits at the pixel midpoint `(a + b) / 2` (bit-identical from
+//! either side) and gets exact values from its region's front and back
+//! triangles, like every other vertex. Levels repeat until no edge asks for a
+//! split or the depth limit is reached.
+//!
+//! Two uses:
+//! - perspective views ([`perspective_split`], applied by the projector):
+//!   screen-space linear interpolation of values that are linear on a face
+//!   in 3D deviates from the perspective-correct value by at most
+//!   `|dz| / (4 min z)` of their variation along an edge, and the ray-length
+//!   factor `sqrt(1 + u^2 + v^2)` by at most `|d(u, v)|^2 / 8`; edges whose
+//!   resulting error bound exceeds [`PERSPECTIVE_INTERP_REL`] of the piece's
+//!   scalar range (diameter, for `l`) are split;
+//! - colour accuracy in the exact mode ([`refine`] with the caller's
+//!   predicate, e.g. optical depth times colour spread, math README 8.1).
+
+use glam::DVec2;
+
+use super::subdivision::NIL;
+use super::{Projected, RegionVertex, ViewMap};
+use crate::numeric::tolerance::PERSPECTIVE_INTERP_REL;
+
+/// Scratch buffers of the refinement.
+#[derive(Clone, Debug, Default)]
+pub struct RefineScratch {
+    edges: Vec<(u32, u32)>,
+    mids: Vec<u32>,
+    tris: Vec<[u32; 3]>,
+    regs: Vec<u32>,
+}
+
+/// Whether the perspective interpolation bound asks to split edge `a`-`b`
+/// of a piece with scalar range `scalar_range` and diameter `diameter` (see
+/// module docs). Always `false` for orthographic views.
+///
+/// With `dev = |dz| / (4 min z)` the deviation of the screen-space parameter
+/// on the front (back) face and `curv = |d(u, v)|^2 / 8` that of the
+/// ray-length factor, the interpolation errors along the edge are at most
+/// `dev * |d s|` for the scalars and `g (dev_f |dz_f| + dev_b |dz_b|) +
+/// curv * l` for the thickness (`g` the ray-length factor). The edge is split
+/// when either exceeds [`PERSPECTIVE_INTERP_REL`] of `scalar_range`
+/// (`diameter`). Edges between two profile vertices (silhouette edges, shared
+/// with neighbouring pieces) are never split: `l = 0` all along them, so
+/// their values have no weight in the integral, and neighbours agree.
+pub fn perspective_split(
+    view: &ViewMap,
+    scalar_range: f64,
+    diameter: f64,
+    a: &RegionVertex,
+    b: &RegionVertex,
+) -> bool {
+    if view.ortho {
+        return false;
+    }
+    let dev = |za: f64, zb: f64| (za - zb).abs() / (4.0 * za.min(zb));
+    let d = view.plane(a.pos()) - view.plane(b.pos());
+    let curv = d.length_squared() / 8.0;
+    let (dev_f, dev_b) = (dev(a.z_front, b.z_front), dev(a.z_back, b.z_back));
+    if a.profile && b.profile {
+        // l = 0 all along a silhouette edge: its values carry no weight.
+        return false;
+    }
+    let es = (dev_f * (a.s_front - b.s_front).abs()).max(dev_b * (a.s_back - b.s_back).abs());
+    let g = view
+        .length_per_depth(a.pos())
+        .max(view.length_per_depth(b.pos()));
+    let el = g * (dev_f * (a.z_front - b.z_front).abs() + dev_b * (a.z_back - b.z_back).abs())
+        + curv * a.l.max(b.l);
+    es > PERSPECTIVE_INTERP_REL * scalar_range || el > PERSPECTIVE_INTERP_REL * diameter
+}
+
+pub(crate) fn refine_perspective(
+    out: &mut Projected,
+    scalar_range: f64,
+    diameter: f64,
+    max_depth: u32,
+    s: &mut RefineScratch,
+) {
+    let view = out.view;
+    refine_with(
+        out,
+        max_depth,
+        |a, b| perspective_split(&view, scalar_range, diameter, a, b),
+        s,
+    );
+}
+
+/// Splits region triangles at edge midpoints, recursively (at most
+/// `max_depth` levels), wherever `split(a, b)` says so for an edge's two
+/// vertices. `regions` keeps the unrefined polygons; `triangles` and
+/// `triangle_region` are replaced.
+pub fn refine(
+    out: &mut Projected,
+    max_depth: u32,
+    split: impl FnMut(&RegionVertex, &RegionVertex) -> bool,
+) {
+    let mut s = RefineScratch::default();
+    refine_with(out, max_depth, split, &mut s);
+}
+
+pub(crate) fn refine_with(
+    out: &mut Projected,
+    max_depth: u32,
+    mut split: impl FnMut(&RegionVertex, &RegionVertex) -> bool,
+    s: &mut RefineScratch,
+) {
+    for _ in 0..max_depth {
+        s.edges.clear();
+        for t in &out.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let key = (a.min(b), a.max(b));
+                if split(&out.vertices[key.0 as usize], &out.vertices[key.1 as usize]) {
+                    s.edges.push(key);
+                }
+            }
+        }
+        if s.edges.is_empty() {
+            return;
+        }
+        s.edges.sort_unstable();
+        s.edges.dedup();
+        s.mids.clear();
+        s.mids.resize(s.edges.len(), NIL);
+        s.tris.clear();
+        s.regs.clear();
+        for ti in 0..out.triangles.len() {
+            let t = out.triangles[ti];
+            let r = out.triangle_region[ti];
+            let mut m = [NIL; 3];
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if let Ok(i) = s.edges.binary_search(&(a.min(b), a.max(b))) {
+                    if s.mids[i] == NIL {
+                        s.mids[i] = midpoint(out, r, a.min(b), a.max(b));
+                    }
+                    m[k] = s.mids[i];
+                }
+            }
+            emit_split(t, m, r, &mut s.tris, &mut s.regs);
+        }
+        std::mem::swap(&mut out.triangles, &mut s.tris);
+        std::mem::swap(&mut out.triangle_region, &mut s.regs);
+    }
+}
+
+/// Creates the midpoint vertex of edge `a`-`b` in region `r`.
+fn midpoint(out: &mut Projected, r: u32, a: u32, b: u32) -> u32 {
+    let (va, vb) = (out.vertices[a as usize], out.vertices[b as usize]);
+    let q = (DVec2::new(va.px, va.py) + DVec2::new(vb.px, vb.py)) * 0.5;
+    let [front, back] = out.region_faces[r as usize];
+    let mut v = RegionVertex::evaluate(&out.view, &front, &back, q, false);
+    if va.profile && vb.profile {
+        v.z_back = v.z_front;
+        v.s_back = v.s_front;
+        v.l = 0.0;
+        v.profile = true;
+    }
+    out.vertices.push(v);
+    (out.vertices.len() - 1) as u32
+}
+
+/// The triangles of `t = [a, b, c]` with midpoints `m = [ab, bc, ca]`
+/// (`NIL` where the edge is not split).
+fn emit_split(t: [u32; 3], m: [u32; 3], r: u32, tris: &mut Vec<[u32; 3]>, regs: &mut Vec<u32>) {
+    let n = m.iter().filter(|&&x| x != NIL).count();
+    let mut push = |x: [u32; 3]| {
+        tris.push(x);
+        regs.push(r);
+    };
+    match n {
+        0 => push(t),
+        3 => {
+            let [a, b, c] = t;
+            let [ab, bc, ca] = m;
+            push([a, ab, ca]);
+            push([ab, b, bc]);
+            push([ca, bc, c]);
+            push([ab, bc, ca]);
+        }
+        _ => {
+            // Rotate so that edge 0 (a-b) is split.
+            let k = (0..3).find(|&k| m[k] != NIL).unwrap_or(0);
+            let k = if n == 2 && m[(k + 2) % 3] != NIL {
+                (k + 2) % 3
+            } else {
+                k
+            };
+            let a = t[k];
+            let b = t[(k + 1) % 3];
+            let c = t[(k + 2) % 3];
+            let ab = m[k];
+            let bc = m[(k + 1) % 3];
+            if bc == NIL {
+                push([a, ab, c]);
+                push([ab, b, c]);
+            } else {
+                push([ab, b, bc]);
+                push([a, ab, bc]);
+                push([a, bc, c]);
+            }
+        }
+    }
+}
