@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch. Each command lives in its own file;
 //! `anyhow` is used only here, at the edge.
 
+mod compare;
 mod info;
 
 use clap::{Parser, Subcommand};
@@ -18,6 +19,9 @@ enum Command {
     /// Print what a file holds: cells by kind, points, bounds, arrays, time
     /// steps, topology and cell-quality counts.
     Info(info::InfoArgs),
+    /// Compare two images: max absolute, RMS and PSNR over pixels and
+    /// channels (float values for two EXR files, else PNG display values).
+    Compare(compare::CompareArgs),
 }
 
 /// Parses the arguments, runs the command and returns the exit code.
@@ -32,6 +36,7 @@ pub fn run() -> i32 {
     };
     let result = match cli.command {
         Command::Info(args) => info::run(&args),
+        Command::Compare(args) => compare::run(&args),
     };
     match result {
         Ok(()) => 0,
