@@ -19,7 +19,12 @@ fn zoovr(args: &[&str]) -> (i32, String, String) {
 
 fn field(out: &str, key: &str) -> f64 {
     let line = out.lines().find(|l| l.starts_with(key)).expect(key);
-    line[key.len()..].split_whitespace().next().unwrap().parse().unwrap()
+    line[key.len()..]
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap()
 }
 
 fn s(p: &Path) -> &str {

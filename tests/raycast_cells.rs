@@ -50,14 +50,27 @@ fn zoo() -> Vec<(&'static str, Mesh)> {
             "pyramid",
             one_cell(
                 CellKind::Pyramid,
-                &[[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.], [0.5, 0.4, 1.]],
+                &[
+                    [0., 0., 0.],
+                    [1., 0., 0.],
+                    [1., 1., 0.],
+                    [0., 1., 0.],
+                    [0.5, 0.4, 1.],
+                ],
             ),
         ),
         (
             "wedge",
             one_cell(
                 CellKind::Wedge,
-                &[[0., 0., 0.], [0., 1., 0.], [1., 0., 0.], [0., 0., 1.], [0., 1., 1.], [1., 0., 1.]],
+                &[
+                    [0., 0., 0.],
+                    [0., 1., 0.],
+                    [1., 0., 0.],
+                    [0., 0., 1.],
+                    [0., 1., 1.],
+                    [1., 0., 1.],
+                ],
             ),
         ),
         (
@@ -142,14 +155,25 @@ fn ray_through_a_tet_has_the_hand_derived_thickness() {
 /// A few rays through each cell, from outside, in many directions.
 fn rays_through(mesh: &Mesh) -> Vec<zoovr::camera::Ray> {
     let nodes = mesh.cells.nodes(0);
-    let c: DVec3 =
-        nodes.iter().map(|&v| mesh.points[v as usize]).sum::<DVec3>() / nodes.len() as f64;
+    let c: DVec3 = nodes
+        .iter()
+        .map(|&v| mesh.points[v as usize])
+        .sum::<DVec3>()
+        / nodes.len() as f64;
     let mut out = Vec::new();
     for k in 0..40 {
         let a = k as f64 * 2.399;
         let z = 1.0 - 2.0 * ((k as f64 + 0.5) / 40.0);
-        let d = DVec3::new((1.0 - z * z).sqrt() * a.cos(), (1.0 - z * z).sqrt() * a.sin(), z);
-        let off = DVec3::new((k as f64 * 0.37).sin(), (k as f64 * 0.91).cos(), (k as f64 * 0.13).sin()) * 0.25;
+        let d = DVec3::new(
+            (1.0 - z * z).sqrt() * a.cos(),
+            (1.0 - z * z).sqrt() * a.sin(),
+            z,
+        );
+        let off = DVec3::new(
+            (k as f64 * 0.37).sin(),
+            (k as f64 * 0.91).cos(),
+            (k as f64 * 0.13).sin(),
+        ) * 0.25;
         let target = c + off;
         out.push(ray(target - d * 5.0, d));
     }
@@ -210,7 +234,11 @@ fn linear_field_in_every_kind_is_integrated_exactly_by_all_models() {
         };
         for model in MODELS {
             let rc = Raycaster::new(scene, model).unwrap();
-            let tol = if model == FieldModel::Native { 1e-7 } else { 1e-12 };
+            let tol = if model == FieldModel::Native {
+                1e-7
+            } else {
+                1e-12
+            };
             for r in rays_through(&mesh) {
                 let chord = convex_chord(&r, &planes, 0.0);
                 if chord < 1e-9 {
@@ -233,7 +261,10 @@ fn linear_field_in_every_kind_is_integrated_exactly_by_all_models() {
                     want.depth
                 );
                 for k in 0..3 {
-                    assert!((acc.color[k] - want.color[k]).abs() < tol, "{name} {model:?}");
+                    assert!(
+                        (acc.color[k] - want.color[k]).abs() < tol,
+                        "{name} {model:?}"
+                    );
                 }
             }
         }
@@ -299,12 +330,32 @@ fn native_trilinear_field_matches_independent_quadrature() {
             }
             depth += h * mat.tau;
         }
-        let acc = rc.trace(&m, &r, 0.0, &opts(FieldModel::Native), &mut Default::default());
-        assert!((acc.depth - depth).abs() < 1e-7 * (1.0 + depth), "{} vs {depth}", acc.depth);
+        let acc = rc.trace(
+            &m,
+            &r,
+            0.0,
+            &opts(FieldModel::Native),
+            &mut Default::default(),
+        );
+        assert!(
+            (acc.depth - depth).abs() < 1e-7 * (1.0 + depth),
+            "{} vs {depth}",
+            acc.depth
+        );
         for k in 0..3 {
-            assert!((acc.color[k] - color[k]).abs() < 1e-7, "{:?} vs {color:?}", acc.color);
+            assert!(
+                (acc.color[k] - color[k]).abs() < 1e-7,
+                "{:?} vs {color:?}",
+                acc.color
+            );
         }
-        let f = faces.trace(&m, &r, 0.0, &opts(FieldModel::Faces), &mut Default::default());
+        let f = faces.trace(
+            &m,
+            &r,
+            0.0,
+            &opts(FieldModel::Faces),
+            &mut Default::default(),
+        );
         model_gap = model_gap.max((f.depth - depth).abs());
     }
     // The test discriminates: the faces field differs from the trilinear one.

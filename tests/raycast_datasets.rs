@@ -92,7 +92,10 @@ fn render_every_shared_dataset_at_128() {
             .unwrap_or_else(|e| panic!("{rel}: {e}"));
         assert_eq!(img.count_non_finite(), 0, "{rel}");
         let visible = img.pixels.iter().filter(|p| p[3] > 1e-3).count();
-        assert!(visible > 0 || mesh.cells.is_empty(), "{rel}: nothing visible");
+        assert!(
+            visible > 0 || mesh.cells.is_empty(),
+            "{rel}: nothing visible"
+        );
         rendered += 1;
     }
     eprintln!("rendered {rendered} of {} datasets", FILES.len());

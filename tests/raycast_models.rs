@@ -23,7 +23,12 @@ fn material() -> TestMaterial {
     TestMaterial {
         s: vec![0.1, 0.4, 0.45, 0.9],
         tau: vec![0.0, 1.5, 4.0, 0.3],
-        color: vec![[0.2, 0.1, 1.0], [1.0, 0.3, 0.0], [0.0, 1.0, 0.2], [1.0, 1.0, 1.0]],
+        color: vec![
+            [0.2, 0.1, 1.0],
+            [1.0, 0.3, 0.0],
+            [0.0, 1.0, 0.2],
+            [1.0, 1.0, 1.0],
+        ],
     }
 }
 
@@ -70,7 +75,11 @@ fn models_agree_on_a_parallelepiped_grid_with_a_linear_field() {
         |i, j, k| DVec3::new(0.4 * i + 0.1 * j, 0.35 * j + 0.05 * k, 0.3 * k + 0.08 * i),
         None,
     );
-    let s: Vec<f64> = mesh.points.iter().map(|p| 0.05 + 0.5 * p.x + 0.3 * p.y + 0.4 * p.z).collect();
+    let s: Vec<f64> = mesh
+        .points
+        .iter()
+        .map(|p| 0.05 + 0.5 * p.x + 0.3 * p.y + 0.4 * p.z)
+        .collect();
     let cams = cameras(&mesh);
     for imgs in images(&mesh, &s, &cams) {
         let mut seen = 0.0f32;
@@ -89,11 +98,19 @@ fn models_agree_on_a_parallelepiped_grid_with_a_linear_field() {
 fn models_agree_on_a_tet_mesh() {
     let warped = grid(
         [3, 2, 2],
-        |i, j, k| DVec3::new(i + 0.2 * (j * k).sin(), j + 0.15 * (i * 1.3).cos(), k + 0.1 * i * j),
+        |i, j, k| {
+            DVec3::new(
+                i + 0.2 * (j * k).sin(),
+                j + 0.15 * (i * 1.3).cos(),
+                k + 0.1 * i * j,
+            )
+        },
         Some(&shuffle(36, 3)),
     );
     let mesh = to_tets(&warped);
-    let s: Vec<f64> = (0..mesh.points.len()).map(|i| 0.5 + 0.45 * (i as f64 * 1.7).sin()).collect();
+    let s: Vec<f64> = (0..mesh.points.len())
+        .map(|i| 0.5 + 0.45 * (i as f64 * 1.7).sin())
+        .collect();
     let cams = cameras(&mesh);
     for imgs in images(&mesh, &s, &cams) {
         for k in 1..3 {
@@ -111,7 +128,11 @@ fn faces_and_tets_bound_the_same_volume_on_a_warped_grid() {
         |i, j, k| {
             let r = 2.0 + i * 0.5;
             let a = j * 0.4 + 0.15 * (k * 2.1).sin();
-            DVec3::new(r * a.cos() + 0.2 * (k + j).sin(), r * a.sin(), k * 0.6 + 0.25 * (i * 1.9).cos())
+            DVec3::new(
+                r * a.cos() + 0.2 * (k + j).sin(),
+                r * a.sin(),
+                k * 0.6 + 0.25 * (i * 1.9).cos(),
+            )
         },
         None,
     );
@@ -131,10 +152,31 @@ fn faces_and_tets_bound_the_same_volume_on_a_warped_grid() {
         for j in 0..32 {
             for i in 0..32 {
                 let r = cam.pixel_ray(i, j);
-                let a = faces.trace(&m, &r, 0.0, &opts(FieldModel::Faces), &mut Default::default());
-                let b = tets.trace(&m, &r, 0.0, &opts(FieldModel::Tets), &mut Default::default());
-                let c = native.trace(&m, &r, 0.0, &opts(FieldModel::Native), &mut Default::default());
-                assert!((a.depth - b.depth).abs() < 1e-10 * (1.0 + a.depth), "pixel {i},{j}");
+                let a = faces.trace(
+                    &m,
+                    &r,
+                    0.0,
+                    &opts(FieldModel::Faces),
+                    &mut Default::default(),
+                );
+                let b = tets.trace(
+                    &m,
+                    &r,
+                    0.0,
+                    &opts(FieldModel::Tets),
+                    &mut Default::default(),
+                );
+                let c = native.trace(
+                    &m,
+                    &r,
+                    0.0,
+                    &opts(FieldModel::Native),
+                    &mut Default::default(),
+                );
+                assert!(
+                    (a.depth - b.depth).abs() < 1e-10 * (1.0 + a.depth),
+                    "pixel {i},{j}"
+                );
                 assert!((a.depth - c.depth).abs() < 1e-10 * (1.0 + a.depth));
                 hits += (a.depth > 0.0) as usize;
             }
@@ -144,7 +186,11 @@ fn faces_and_tets_bound_the_same_volume_on_a_warped_grid() {
     // A linear point field over the same warped grid: faces and tets are
     // both exact for it wherever it is linear on every face triangle and
     // tet, which it is (linear in position).
-    let s: Vec<f64> = mesh.points.iter().map(|p| 0.1 + 0.1 * p.x + 0.05 * p.y + 0.3 * p.z).collect();
+    let s: Vec<f64> = mesh
+        .points
+        .iter()
+        .map(|p| 0.1 + 0.1 * p.x + 0.05 * p.y + 0.3 * p.z)
+        .collect();
     let scene = Scene {
         scalars: Scalars::Point(&s),
         ..scene

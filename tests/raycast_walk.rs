@@ -75,7 +75,10 @@ fn check_rays(name: &str, mesh: &Mesh, bx: &[(DVec3, DVec3)], rays: &[Ray], mode
             let want = oracle(bx, r, 0.0);
             let segs = rc.segments(r, 0.0);
             for w in segs.windows(2) {
-                assert!(w[1].t_in >= w[0].t_out - 1e-12, "{name} {model:?}: overlapping segments");
+                assert!(
+                    w[1].t_in >= w[0].t_out - 1e-12,
+                    "{name} {model:?}: overlapping segments"
+                );
             }
             let len: f64 = segs.iter().map(|s| s.t_out - s.t_in).sum();
             assert!(
@@ -84,7 +87,10 @@ fn check_rays(name: &str, mesh: &Mesh, bx: &[(DVec3, DVec3)], rays: &[Ray], mode
             );
             let acc = rc.trace(&m, r, 0.0, &opts(model), &mut Default::default());
             assert!(acc.alpha().is_finite() && acc.color.iter().all(|c| c.is_finite()));
-            assert!((acc.depth - TAU * want).abs() < 1e-9 * (1.0 + want), "{name} {model:?}");
+            assert!(
+                (acc.depth - TAU * want).abs() < 1e-9 * (1.0 + want),
+                "{name} {model:?}"
+            );
         }
     }
 }
@@ -108,7 +114,10 @@ fn grid_line_rays(n: f64) -> Vec<Ray> {
         }
     }
     rays.push(ray(DVec3::splat(-1.0), DVec3::ONE));
-    rays.push(ray(DVec3::new(n + 1.0, -1.0, -1.0), DVec3::new(-1.0, 1.0, 1.0)));
+    rays.push(ray(
+        DVec3::new(n + 1.0, -1.0, -1.0),
+        DVec3::new(-1.0, 1.0, 1.0),
+    ));
     rays.push(ray(DVec3::new(-1.0, 0.0, 2.0), DVec3::new(1.0, 1.0, 0.0)));
     rays.push(ray(DVec3::new(-1.0, 1.0, -1.0), DVec3::new(1.0, 0.0, 1.0)));
     rays.push(ray(DVec3::new(-2.0, -1.0, 0.5), DVec3::new(2.0, 1.0, 0.0)));
@@ -121,7 +130,13 @@ fn rays_through_grid_vertices_and_edges_give_the_exact_alpha() {
     let mesh = unit_grid([n, n, n], None);
     let bx = boxes(&mesh);
     let rays = grid_line_rays(n as f64);
-    check_rays("grid", &mesh, &bx, &rays, &[FieldModel::Faces, FieldModel::Tets]);
+    check_rays(
+        "grid",
+        &mesh,
+        &bx,
+        &rays,
+        &[FieldModel::Faces, FieldModel::Tets],
+    );
     // Interior grid lines see the full depth n: alpha = 1 - exp(-tau n).
     let topology = topo(&mesh);
     let scene = Scene {
@@ -131,7 +146,13 @@ fn rays_through_grid_vertices_and_edges_give_the_exact_alpha() {
     };
     let m = TestMaterial::constant(TAU, [1.0; 3]);
     let rc = Raycaster::new(scene, FieldModel::Faces).unwrap();
-    let acc = rc.trace(&m, &rays[0], 0.0, &opts(FieldModel::Faces), &mut Default::default());
+    let acc = rc.trace(
+        &m,
+        &rays[0],
+        0.0,
+        &opts(FieldModel::Faces),
+        &mut Default::default(),
+    );
     assert!((acc.alpha() - (1.0 - (-TAU * n as f64).exp())).abs() < 1e-14);
     // The same grid as tets with scrambled point numbering (different
     // diagonals everywhere).
@@ -162,7 +183,12 @@ fn five_and_six_tet_cubes_render_the_same_exact_image() {
     let hex = unit_grid([1, 1, 1], None);
     let m = TestMaterial::constant(2.0, [0.9, 0.6, 0.3]);
     let bx = [(DVec3::ZERO, DVec3::ONE)];
-    for (az, el, ortho) in [(0.0, 0.0, true), (20.0, 35.0, false), (45.0, 35.264389682754654, true), (90.0, 0.0, false)] {
+    for (az, el, ortho) in [
+        (0.0, 0.0, true),
+        (20.0, 35.0, false),
+        (45.0, 35.264389682754654, true),
+        (90.0, 0.0, false),
+    ] {
         let p = CameraParams {
             width: 40,
             height: 40,
@@ -219,11 +245,20 @@ fn non_convex_meshes_are_left_and_re_entered() {
     for k in 0..60 {
         let a = k as f64 * 0.71;
         let d = DVec3::new(a.cos(), a.sin(), 0.3 * (k as f64 * 1.3).sin());
-        rays.push(ray(DVec3::new(1.5, 1.5, 1.0) - d * 6.0 + DVec3::new(0.0, 0.0, (k as f64 * 0.37).sin()), d));
+        rays.push(ray(
+            DVec3::new(1.5, 1.5, 1.0) - d * 6.0 + DVec3::new(0.0, 0.0, (k as f64 * 0.37).sin()),
+            d,
+        ));
     }
     let r0 = oracle(&bx, &rays[0], 0.0);
     assert!((r0 - 2.0).abs() < 1e-12);
-    check_rays("C-shape", &mesh, &bx, &rays, &[FieldModel::Faces, FieldModel::Tets, FieldModel::Native]);
+    check_rays(
+        "C-shape",
+        &mesh,
+        &bx,
+        &rays,
+        &[FieldModel::Faces, FieldModel::Tets, FieldModel::Native],
+    );
     // Two disconnected blocks that touch along a face without sharing points.
     let a = grid([2, 2, 2], |i, j, k| DVec3::new(i, j, k), None);
     let b = grid([2, 2, 2], |i, j, k| DVec3::new(i + 2.0, j, k), None);
@@ -242,7 +277,13 @@ fn non_convex_meshes_are_left_and_re_entered() {
         ray(DVec3::new(2.0, 1.0, -1.0), DVec3::Z),
     ];
     assert!((oracle(&bx2, &rays2[0], 0.0) - 4.0).abs() < 1e-12);
-    check_rays("touching blocks", &two, &bx2, &rays2, &[FieldModel::Faces, FieldModel::Tets]);
+    check_rays(
+        "touching blocks",
+        &two,
+        &bx2,
+        &rays2,
+        &[FieldModel::Faces, FieldModel::Tets],
+    );
 }
 
 #[test]
@@ -263,12 +304,25 @@ fn inverted_and_degenerate_cells_and_eyes_inside() {
     let eye = DVec3::new(1.3, 1.6, 1.2);
     for k in 0..30 {
         let a = k as f64 * 0.9;
-        rays.push(ray(eye, DVec3::new(a.cos(), a.sin(), (k as f64 * 0.3).cos())));
+        rays.push(ray(
+            eye,
+            DVec3::new(a.cos(), a.sin(), (k as f64 * 0.3).cos()),
+        ));
     }
-    check_rays("inverted", &mesh, &bx, &rays, &[FieldModel::Faces, FieldModel::Tets, FieldModel::Native]);
+    check_rays(
+        "inverted",
+        &mesh,
+        &bx,
+        &rays,
+        &[FieldModel::Faces, FieldModel::Tets, FieldModel::Native],
+    );
 
     // A zero-volume layer: planes k = 1 and k = 2 coincide.
-    let flat = grid([2, 2, 3], |i, j, k| DVec3::new(i, j, if k >= 2.0 { k - 1.0 } else { k }), None);
+    let flat = grid(
+        [2, 2, 3],
+        |i, j, k| DVec3::new(i, j, if k >= 2.0 { k - 1.0 } else { k }),
+        None,
+    );
     let bxf = boxes(&flat);
     let raysf = vec![
         ray(DVec3::new(0.5, 0.5, -1.0), DVec3::Z),
@@ -276,7 +330,13 @@ fn inverted_and_degenerate_cells_and_eyes_inside() {
         ray(DVec3::new(-1.0, 0.5, 1.0), DVec3::X),
         ray(DVec3::new(-1.0, -1.0, -1.0), DVec3::new(1.0, 1.0, 1.0)),
     ];
-    check_rays("flat layer", &flat, &bxf, &raysf, &[FieldModel::Faces, FieldModel::Tets, FieldModel::Native]);
+    check_rays(
+        "flat layer",
+        &flat,
+        &bxf,
+        &raysf,
+        &[FieldModel::Faces, FieldModel::Tets, FieldModel::Native],
+    );
 }
 
 #[test]
@@ -325,7 +385,20 @@ fn bad_input_is_an_error_not_a_panic() {
         topology: &t,
         scalars: Scalars::Constant(0.0),
     };
-    let cam = Camera::fit(empty.bounds(), &CameraParams { width: 4, height: 4, ..Default::default() });
-    let img = render(&scene, &TestMaterial::constant(1.0, [1.0; 3]), &cam, &opts(FieldModel::Faces)).unwrap();
+    let cam = Camera::fit(
+        empty.bounds(),
+        &CameraParams {
+            width: 4,
+            height: 4,
+            ..Default::default()
+        },
+    );
+    let img = render(
+        &scene,
+        &TestMaterial::constant(1.0, [1.0; 3]),
+        &cam,
+        &opts(FieldModel::Faces),
+    )
+    .unwrap();
     assert!(img.pixels.iter().all(|p| *p == [0.0; 4]));
 }

@@ -48,8 +48,14 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     } else {
         compare_display(&a, &b, [0.0; 3])?
     };
-    println!("values:  {}", if float { "float RGBA" } else { "display RGB" });
-    println!("max_abs: {:.6e} at pixel ({}, {})", d.max_abs, d.worst.0, d.worst.1);
+    println!(
+        "values:  {}",
+        if float { "float RGBA" } else { "display RGB" }
+    );
+    println!(
+        "max_abs: {:.6e} at pixel ({}, {})",
+        d.max_abs, d.worst.0, d.worst.1
+    );
     println!("rms:     {:.6e}", d.rms);
     println!("psnr:    {:.2} dB", d.psnr);
     if let Some(path) = &args.diff {

@@ -165,24 +165,28 @@ mod tests {
         let bvh = Bvh::build(&boxes, 1e-9);
         let mut stack = Vec::new();
         let mut got = Vec::new();
-        bvh.query(
-            DVec3::new(3.5, 4.5, -1.0),
-            DVec3::Z,
-            0.0,
-            &mut stack,
-            |i| got.push(i),
-        );
+        bvh.query(DVec3::new(3.5, 4.5, -1.0), DVec3::Z, 0.0, &mut stack, |i| {
+            got.push(i)
+        });
         // Candidates come by leaf: the box hit, plus at most a leaf's worth
         // of neighbours, never a far box.
         assert!(got.contains(&34) && got.len() <= 2 * LEAF_SIZE, "{got:?}");
-        assert!(got.iter().all(|&i| (i / 10).abs_diff(3) <= 2 && (i % 10).abs_diff(4) <= 2));
+        assert!(got
+            .iter()
+            .all(|&i| (i / 10).abs_diff(3) <= 2 && (i % 10).abs_diff(4) <= 2));
         got.clear();
         // Behind the origin: t0 = 0 excludes it, t0 = -inf includes it.
-        bvh.query(DVec3::new(3.5, 4.5, 1.0), DVec3::Z, 0.0, &mut stack, |i| got.push(i));
-        assert!(got.is_empty());
-        bvh.query(DVec3::new(3.5, 4.5, 1.0), DVec3::Z, f64::NEG_INFINITY, &mut stack, |i| {
+        bvh.query(DVec3::new(3.5, 4.5, 1.0), DVec3::Z, 0.0, &mut stack, |i| {
             got.push(i)
         });
+        assert!(got.is_empty());
+        bvh.query(
+            DVec3::new(3.5, 4.5, 1.0),
+            DVec3::Z,
+            f64::NEG_INFINITY,
+            &mut stack,
+            |i| got.push(i),
+        );
         assert!(got.contains(&34));
     }
 }

@@ -227,8 +227,7 @@ mod tests {
                 let mut hits = 0;
                 for k in 0..5 {
                     let k1 = (k + 1) % 5;
-                    if cross(&f, [5, ids[k], ids[k1]], [DVec3::ZERO, ring[k], ring[k1]]).is_some()
-                    {
+                    if cross(&f, [5, ids[k], ids[k1]], [DVec3::ZERO, ring[k], ring[k1]]).is_some() {
                         hits += 1;
                     }
                 }

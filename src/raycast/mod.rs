@@ -169,7 +169,10 @@ fn validate(scene: &Scene) -> Result<(), RaycastError> {
     }
     let cells = &mesh.cells;
     if cells.offsets.len() != cells.len() + 1 && !cells.is_empty() {
-        return Err(RaycastError::TopologyMismatch(cells.offsets.len(), cells.len()));
+        return Err(RaycastError::TopologyMismatch(
+            cells.offsets.len(),
+            cells.len(),
+        ));
     }
     for c in 0..cells.len() {
         let (a, b) = (cells.offsets[c] as usize, cells.offsets[c + 1] as usize);
@@ -299,7 +302,9 @@ impl<'a> Raycaster<'a> {
 
     fn point_scalar(&self, v: [u32; 3], w: [f64; 3]) -> f64 {
         match self.scene.scalars {
-            Scalars::Point(s) => w[0] * s[v[0] as usize] + w[1] * s[v[1] as usize] + w[2] * s[v[2] as usize],
+            Scalars::Point(s) => {
+                w[0] * s[v[0] as usize] + w[1] * s[v[1] as usize] + w[2] * s[v[2] as usize]
+            }
             Scalars::Cell(_) | Scalars::Constant(_) => 0.0,
         }
     }

@@ -274,7 +274,11 @@ pub fn integrate<M: RayMaterial>(
     let mut ts = Vec::with_capacity(SAMPLES + 8);
     let mut vals = Vec::with_capacity(SAMPLES + 8);
     for k in 0..=SAMPLES {
-        let t = if k == SAMPLES { t_out } else { t_in + h * k as f64 };
+        let t = if k == SAMPLES {
+            t_out
+        } else {
+            t_in + h * k as f64
+        };
         ts.push(t);
         vals.push(field.eval(t)?);
     }
@@ -369,9 +373,11 @@ fn refine<M: RayMaterial>(
     let l = colloc(field, m, a, mid)?;
     let r = colloc(field, m, mid, b)?;
     let both = combine(l, r);
-    let err = (both.0 - whole.0)
-        .abs()
-        .max((0..3).map(|k| (both.1[k] - whole.1[k]).abs()).fold(0.0, f64::max));
+    let err = (both.0 - whole.0).abs().max(
+        (0..3)
+            .map(|k| (both.1[k] - whole.1[k]).abs())
+            .fold(0.0, f64::max),
+    );
     if err <= NATIVE_INTEGRAL_TOL || level >= MAX_LEVEL || !(mid > a && mid < b) {
         return Some(both);
     }

@@ -228,8 +228,11 @@ pub fn box_planes(lo: DVec3, hi: DVec3) -> Vec<(DVec3, f64)> {
 /// the centroid, whatever the cell's orientation).
 pub fn cell_planes(mesh: &Mesh, c: usize) -> Vec<(DVec3, f64)> {
     let nodes = mesh.cells.nodes(c);
-    let centroid: DVec3 =
-        nodes.iter().map(|&v| mesh.points[v as usize]).sum::<DVec3>() / nodes.len() as f64;
+    let centroid: DVec3 = nodes
+        .iter()
+        .map(|&v| mesh.points[v as usize])
+        .sum::<DVec3>()
+        / nodes.len() as f64;
     let mut planes = Vec::new();
     mesh.cells.for_each_face(c, |_, f| {
         let p: Vec<DVec3> = f.iter().map(|&v| mesh.points[v as usize]).collect();
