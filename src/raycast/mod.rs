@@ -35,7 +35,6 @@ pub mod walk;
 
 use std::borrow::Cow;
 
-use glam::DVec3;
 use rayon::prelude::*;
 use thiserror::Error;
 
@@ -383,10 +382,10 @@ impl<'a> Raycaster<'a> {
             f64::INFINITY
         };
         let native = self.model == FieldModel::Native;
-        self.for_each_segment(ray, t_near, scratch, |s, raw| {
+        self.for_each_segment(ray, t_near, scratch, |s, _| {
             let l = s.t_out - s.t_in;
             let v = if native {
-                native::segment_value(self.scene, material, ray, s, raw)
+                native::segment_value(self.scene, material, ray, s)
             } else {
                 material.segment(l, s.s_in, s.s_out)
             };
@@ -457,12 +456,4 @@ pub fn trace_ray<M: RayMaterial>(
 ) -> Result<RayAccumulator, RaycastError> {
     let rc = Raycaster::new(*scene, opts.model)?;
     Ok(rc.trace(material, ray, 0.0, opts, &mut Scratch::default()))
-}
-
-/// The scene's world-space centre and a point helper for tests.
-pub fn ray_towards(origin: DVec3, target: DVec3) -> Ray {
-    Ray {
-        origin,
-        dir: (target - origin).normalize(),
-    }
 }

@@ -28,7 +28,6 @@ use std::sync::OnceLock;
 
 use glam::{DMat3, DVec3};
 
-use super::walk::RawSegment;
 use super::{Scalars, Scene, Segment};
 use crate::camera::Ray;
 use crate::integrate::{RayMaterial, SegmentValue};
@@ -393,7 +392,6 @@ pub fn segment_value<M: RayMaterial>(
     material: &M,
     ray: &Ray,
     seg: &Segment,
-    _raw: &RawSegment,
 ) -> SegmentValue {
     let l = seg.t_out - seg.t_in;
     let fallback = || material.segment(l, seg.s_in, seg.s_out);

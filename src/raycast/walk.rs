@@ -74,6 +74,8 @@ pub struct Scratch {
     proj: Vec<(u32, DVec3, Proj)>,
     entries: Vec<(f64, u32, [f64; 3])>,
     stack: Vec<u32>,
+    /// Edge values of the current cell by local node pair (NaN: not yet).
+    edges: Vec<f64>,
 }
 
 #[inline]
@@ -278,6 +280,12 @@ impl<'a> WalkMesh<'a> {
             let p = self.points[n as usize];
             proj.push((n, p, frame.project(p)));
         }
+        // Each edge is shared by two triangles of the cell: cache its value
+        // by local node pair (value of j -> i is minus that of i -> j).
+        let nn = nodes.len();
+        let edges = &mut scratch.edges;
+        edges.clear();
+        edges.resize(nn * nn, f64::NAN);
         let faces = self.topo.faces_of(c);
         let mut best: Option<Exit> = None;
         let mut consider = |fid: u32, tri: [usize; 3], proj: &[(u32, DVec3, Proj)]| {
@@ -286,12 +294,19 @@ impl<'a> WalkMesh<'a> {
             if (fid, key) == entry {
                 return;
             }
+            let mut edge = |i: usize, j: usize| {
+                let v = edges[i * nn + j];
+                if !v.is_nan() {
+                    return v;
+                }
+                let (a, b) = (&proj[i], &proj[j]);
+                let v = frame.edge(a.0, a.1, &a.2, b.0, b.1, &b.2);
+                edges[i * nn + j] = v;
+                edges[j * nn + i] = -v;
+                v
+            };
+            let e = [edge(tri[0], tri[1]), edge(tri[1], tri[2]), edge(tri[2], tri[0])];
             let [a, b, cc] = tri.map(|k| &proj[k]);
-            let e = [
-                frame.edge(a.0, a.1, &a.2, b.0, b.1, &b.2),
-                frame.edge(b.0, b.1, &b.2, cc.0, cc.1, &cc.2),
-                frame.edge(cc.0, cc.1, &cc.2, a.0, a.1, &a.2),
-            ];
             let Some(x) = RayFrame::crossing(e, [a.2.z, b.2.z, cc.2.z]) else {
                 return;
             };
