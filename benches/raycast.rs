@@ -190,7 +190,7 @@ impl RayMaterial for BenchTf {
         let mut out = SegmentValue::default();
         let (lo, hi) = (s_f.min(s_b), s_f.max(s_b));
         let mut x0 = 0.0;
-        let mut emit = |x0: f64, x1: f64, out: &mut SegmentValue| {
+        let emit = |x0: f64, x1: f64, out: &mut SegmentValue| {
             let (sa, sb) = (s_f + (s_b - s_f) * x0, s_f + (s_b - s_f) * x1);
             let (ta, tb) = (self.at(sa).0, self.at(sb).0);
             let d = l * (x1 - x0) * 0.5 * (ta + tb);
@@ -198,8 +198,8 @@ impl RayMaterial for BenchTf {
                 let c = self.at(0.5 * (sa + sb)).1;
                 let a = -(-d).exp_m1();
                 let tr = (-out.depth).exp();
-                for k in 0..3 {
-                    out.color[k] += tr * c[k] * a;
+                for (o, ck) in out.color.iter_mut().zip(c) {
+                    *o += tr * ck * a;
                 }
                 out.depth += d;
             }
@@ -248,6 +248,21 @@ fn peak_rss_mib() -> f64 {
         .map_or(0.0, |kb| kb / 1024.0)
 }
 
+/// CPU seconds (user + system) used by this process so far: on a loaded
+/// machine wall time says little, CPU time / cores is the idle-machine time.
+fn cpu_seconds() -> f64 {
+    std::fs::read_to_string("/proc/self/stat")
+        .ok()
+        .and_then(|s| {
+            let rest = s.rsplit_once(')')?.1;
+            let f: Vec<&str> = rest.split_whitespace().collect();
+            let ut: f64 = f.get(11)?.parse().ok()?;
+            let st: f64 = f.get(12)?.parse().ok()?;
+            Some((ut + st) / 100.0)
+        })
+        .unwrap_or(0.0)
+}
+
 fn camera(mesh: &Mesh, ortho: bool, size: u32) -> Camera {
     let p = CameraParams {
         width: size,
@@ -284,7 +299,12 @@ fn bench(c: &mut Criterion) {
         .unwrap_or(512);
     let mut g = c.benchmark_group("raycast_hex_shell");
     g.sample_size(10);
-    for model in [FieldModel::Faces, FieldModel::Tets, FieldModel::Native] {
+    let models: Vec<FieldModel> = std::env::var("RAYCAST_BENCH_MODELS")
+        .unwrap_or_else(|_| "faces,tets,native".into())
+        .split(',')
+        .filter_map(|m| m.parse().ok())
+        .collect();
+    for model in models {
         let t = Instant::now();
         let rc = Raycaster::new(scene, model).unwrap();
         eprintln!(
@@ -303,12 +323,14 @@ fn bench(c: &mut Criterion) {
                 ..Default::default()
             };
             let t = Instant::now();
+            let cpu = cpu_seconds();
             let img = rc.render(&tf, &cam, &opts);
             let cover = img.pixels.iter().filter(|p| p[3] > 0.0).count();
             eprintln!(
-                "{model:?} {}: first frame {:.3} s ({cover} covered pixels); peak RSS {:.0} MiB",
+                "{model:?} {}: first frame {:.3} s wall, {:.2} s CPU ({cover} covered pixels); peak RSS {:.0} MiB",
                 if ortho { "ortho" } else { "persp" },
                 t.elapsed().as_secs_f64(),
+                cpu_seconds() - cpu,
                 peak_rss_mib()
             );
             if let Ok(dir) = std::env::var("RAYCAST_BENCH_OUT") {

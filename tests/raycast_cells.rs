@@ -325,8 +325,8 @@ fn native_trilinear_field_matches_independent_quadrature() {
             let t = a + h * (i as f64 + 0.5);
             let mat = zoovr::integrate::RayMaterial::material(&m, tri(r.origin + r.dir * t));
             let e = (-(depth + 0.5 * h * mat.tau)).exp();
-            for k in 0..3 {
-                color[k] += h * mat.source[k] * e;
+            for (c, g) in color.iter_mut().zip(mat.source) {
+                *c += h * g * e;
             }
             depth += h * mat.tau;
         }

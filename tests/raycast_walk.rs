@@ -96,7 +96,7 @@ fn check_rays(name: &str, mesh: &Mesh, bx: &[(DVec3, DVec3)], rays: &[Ray], mode
 }
 
 fn unit_grid(n: [usize; 3], perm: Option<&[u32]>) -> Mesh {
-    grid(n, |i, j, k| DVec3::new(i, j, k), perm)
+    grid(n, DVec3::new, perm)
 }
 
 /// Rays along grid lines (through edges and vertices), along faces, through
@@ -260,7 +260,7 @@ fn non_convex_meshes_are_left_and_re_entered() {
         &[FieldModel::Faces, FieldModel::Tets, FieldModel::Native],
     );
     // Two disconnected blocks that touch along a face without sharing points.
-    let a = grid([2, 2, 2], |i, j, k| DVec3::new(i, j, k), None);
+    let a = grid([2, 2, 2], DVec3::new, None);
     let b = grid([2, 2, 2], |i, j, k| DVec3::new(i + 2.0, j, k), None);
     let mut two = a.clone();
     let off = a.points.len() as u32;

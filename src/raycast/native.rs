@@ -85,16 +85,12 @@ fn quadrature() -> &'static Quadrature {
             }
             v
         };
-        let mut s = [[0.0; GL_N]; GL_N];
-        for i in 0..GL_N {
-            for j in 0..GL_N {
-                let mut acc = 0.0;
-                for k in 0..GL_N {
-                    acc += w[k] * lagrange(j, x[i] * x[k]);
-                }
-                s[i][j] = x[i] * acc;
-            }
-        }
+        let s = std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                let acc: f64 = (0..GL_N).map(|k| w[k] * lagrange(j, x[i] * x[k])).sum();
+                x[i] * acc
+            })
+        });
         Quadrature { x, w, s }
     })
 }
@@ -314,8 +310,8 @@ pub fn integrate<M: RayMaterial>(
         if w[1] > w[0] {
             let (d, c) = piece(field, material, w[0], w[1])?;
             let tr = (-acc.depth).exp();
-            for k in 0..3 {
-                acc.color[k] += tr * c[k];
+            for (a, ck) in acc.color.iter_mut().zip(c) {
+                *a += tr * ck;
             }
             acc.depth += d;
         }
@@ -400,7 +396,7 @@ pub fn segment_value<M: RayMaterial>(
     };
     let cells = &scene.mesh.cells;
     let c = seg.cell as usize;
-    if !(l > 0.0) || c >= cells.len() {
+    if l.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || c >= cells.len() {
         return fallback();
     }
     let kind = cells.kinds[c];

@@ -305,7 +305,11 @@ impl<'a> WalkMesh<'a> {
                 edges[j * nn + i] = -v;
                 v
             };
-            let e = [edge(tri[0], tri[1]), edge(tri[1], tri[2]), edge(tri[2], tri[0])];
+            let e = [
+                edge(tri[0], tri[1]),
+                edge(tri[1], tri[2]),
+                edge(tri[2], tri[0]),
+            ];
             let [a, b, cc] = tri.map(|k| &proj[k]);
             let Some(x) = RayFrame::crossing(e, [a.2.z, b.2.z, cc.2.z]) else {
                 return;
