@@ -21,6 +21,7 @@ pub const MERGE_POINTS_REL: f64 = 1e-12;
 
 <<<<<<< HEAD
 <<<<<<< HEAD
+<<<<<<< HEAD
 /// Measured maximum absolute error of the exact mode's exponential table
 /// (`gpu::exptable`, 1024^2 texels, log-warped axes, f32 bilinear filtering)
 /// against the exact `1 - exp(-l tau)` over `l, tau` in `{0} + [1e-8, 1e6]`:
@@ -66,3 +67,34 @@ pub const NEAR_CLIP_SCALE: f64 = 2.0;
 /// in close-up wide-angle views) while leaving ordinary views unrefined.
 pub const PERSPECTIVE_INTERP_REL: f64 = 1e-3;
 >>>>>>> projection
+=======
+/// Safety factor of the floating-point filter in front of the exact
+/// ray/edge predicate (`raycast::geometry`): the 2D cross product of two
+/// projected vertices is trusted when it exceeds `K eps |a - o| |b - o|`
+/// (scaled by the ray's origin magnitude). A first-order error analysis
+/// gives about 16 (projection, subtraction, product rounding and the
+/// direction's own rounding); 64 leaves a margin. Larger only means more
+/// exact evaluations, never a different answer.
+pub const PLUCKER_FILTER_K: f64 = 64.0;
+
+/// The ray caster stops a ray when its transmittance falls below this
+/// (accumulated opacity `>= 1 - 1e-6`): the rest of the ray can change each
+/// premultiplied channel by at most this times the brightest glow colour,
+/// far below the 1/255 of a PNG value.
+pub const RAY_TERMINATION_TRANSMITTANCE: f64 = 1e-6;
+
+/// Re-entering the mesh through the boundary after leaving it: entries up to
+/// this fraction of the bounds diagonal before the exit point still count
+/// (coincident but unshared faces of touching parts, whose crossing depths
+/// round differently).
+pub const RAY_REENTRY_SLACK_REL: f64 = 1e-12;
+
+/// Native field model: absolute tolerance (colour and optical depth, per
+/// cell segment) of the adaptive Gauss-Legendre collocation that integrates
+/// the ray through the iso-parametric field.
+pub const NATIVE_INTEGRAL_TOL: f64 = 1e-9;
+
+/// Native field model: Newton inversion of the iso-parametric map stops when
+/// the parametric step is below this (parametric coordinates are O(1)).
+pub const NATIVE_NEWTON_TOL: f64 = 1e-13;
+>>>>>>> raycast

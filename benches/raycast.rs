@@ -1,0 +1,354 @@
+//! Ray caster benchmark: the `hex_shell` scene of
+//! `../shared/data/synthetic/README.md`, generated in memory with the same
+//! map and field as `../shared/peer/gen_meshes.py` (64^3 points, 250,047
+//! curvilinear hexahedra, twisted 270-degree annular sector, point scalar `f`
+//! normalised to [0, 1], coordinates rounded to f32 like the file), camera
+//! azimuth 20, elevation 35, zoom 1.25, 512 x 512, and the transfer function
+//! of `bench_tf.json` (extinction = opacity / 0.5, glow colour).
+//!
+//! The transfer function's `segment` here slices at breakpoints and uses the
+//! exact depth with the colour at each sub-segment's midpoint (the cost class
+//! of the closed form, not its colour accuracy; the real `tf` closed form
+//! plugs in at merge time).
+//!
+//! `cargo bench --bench raycast` prints setup time and memory, then criterion
+//! timings per frame for faces/tets x perspective/ortho and native.
+
+use std::time::Instant;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use glam::DVec3;
+use zoovr::camera::{Camera, CameraParams};
+use zoovr::integrate::{Material, RayMaterial, SegmentValue};
+use zoovr::mesh::topology::Topology;
+use zoovr::mesh::{CellKind, Cells, Mesh};
+use zoovr::raycast::{FieldModel, RaycastOptions, Raycaster, Scalars, Scene};
+
+const N: usize = 64;
+
+fn shell_map(u: f64, v: f64, w: f64) -> DVec3 {
+    let (twist, sector) = (std::f64::consts::FRAC_PI_2, 1.5 * std::f64::consts::PI);
+    let theta = sector * u;
+    let pi = std::f64::consts::PI;
+    let dr = (v - 0.5) + 0.04 * (3.0 * pi * w).sin() * (4.0 * pi * u).sin();
+    let dz = (w - 0.5) * 0.8;
+    let phi = twist * u;
+    let r = 1.5 + dr * phi.cos() - dz * phi.sin();
+    let z = dr * phi.sin() + dz * phi.cos();
+    DVec3::new(r * theta.cos(), r * theta.sin(), z)
+}
+
+fn field(p: DVec3) -> f64 {
+    const G: [([f64; 3], f64, f64); 5] = [
+        ([1.5, 0.0, 0.0], 0.35, 1.0),
+        ([0.0, 1.6, 0.1], 0.30, 0.9),
+        ([-1.4, 0.3, -0.1], 0.45, 0.8),
+        ([-0.2, -1.5, 0.0], 0.25, 1.0),
+        ([1.0, 1.1, 0.2], 0.20, 0.7),
+    ];
+    let mut f = 0.0;
+    for (c, s, w) in G {
+        let d2 = (p - DVec3::from_array(c)).length_squared();
+        f += w * (-d2 / (2.0 * s * s)).exp();
+    }
+    let r = p.x.hypot(p.y);
+    let dcore = (r - 1.5).hypot(p.z);
+    f + 0.35 * (-(dcore * dcore) / (2.0 * 0.15 * 0.15)).exp()
+}
+
+/// The hex shell mesh and its normalised point scalar.
+pub fn hex_shell() -> (Mesh, Vec<f64>) {
+    let g = |i: usize| i as f64 / (N - 1) as f64;
+    let mut points = Vec::with_capacity(N * N * N);
+    for k in 0..N {
+        for j in 0..N {
+            for i in 0..N {
+                let p = shell_map(g(i), g(j), g(k));
+                points.push(DVec3::new(
+                    p.x as f32 as f64,
+                    p.y as f32 as f64,
+                    p.z as f32 as f64,
+                ));
+            }
+        }
+    }
+    let f: Vec<f64> = points.iter().map(|&p| field(p)).collect();
+    let (lo, hi) = f.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| {
+        (a.0.min(v), a.1.max(v))
+    });
+    let f: Vec<f64> = f
+        .iter()
+        .map(|v| (((v - lo) / (hi - lo)) as f32) as f64)
+        .collect();
+    let mut cells = Cells::default();
+    for k in 0..N - 1 {
+        for j in 0..N - 1 {
+            for i in 0..N - 1 {
+                let c = (i + N * (j + N * k)) as u32;
+                let (n, nn) = (N as u32, (N * N) as u32);
+                cells.push(
+                    CellKind::Hexahedron,
+                    &[
+                        c,
+                        c + 1,
+                        c + 1 + n,
+                        c + n,
+                        c + nn,
+                        c + nn + 1,
+                        c + nn + 1 + n,
+                        c + nn + n,
+                    ],
+                );
+            }
+        }
+    }
+    let mesh = Mesh {
+        points,
+        cells,
+        ..Default::default()
+    };
+    (mesh, f)
+}
+
+/// `bench_tf.json`: piecewise-linear extinction and glow colour.
+pub struct BenchTf {
+    s: Vec<f64>,
+    tau: Vec<f64>,
+    rgb: Vec<[f64; 3]>,
+}
+
+impl BenchTf {
+    pub fn new() -> BenchTf {
+        let op = [
+            (0.0, 0.0),
+            (0.28, 0.0),
+            (0.3, 0.5),
+            (0.4, 0.5),
+            (0.45, 0.02),
+            (0.6, 0.02),
+            (0.62, 0.9),
+            (0.75, 0.9),
+            (0.8, 0.2),
+            (1.0, 0.2),
+        ];
+        let col = [
+            (0.0, [0.0, 0.0, 1.0]),
+            (0.3, [0.0, 0.6, 1.0]),
+            (0.45, [0.1, 0.9, 0.3]),
+            (0.62, [1.0, 0.9, 0.0]),
+            (0.8, [1.0, 0.3, 0.0]),
+            (1.0, [0.8, 0.0, 0.3]),
+        ];
+        let mut s: Vec<f64> = op
+            .iter()
+            .map(|p| p.0)
+            .chain(col.iter().map(|c| c.0))
+            .collect();
+        s.sort_by(f64::total_cmp);
+        s.dedup();
+        let lerp = |x: f64, pts: &[(f64, f64)]| {
+            let k = pts
+                .iter()
+                .rposition(|p| p.0 <= x)
+                .unwrap_or(0)
+                .min(pts.len() - 2);
+            let t = ((x - pts[k].0) / (pts[k + 1].0 - pts[k].0)).clamp(0.0, 1.0);
+            pts[k].1 * (1.0 - t) + pts[k + 1].1 * t
+        };
+        let tau = s.iter().map(|&x| lerp(x, &op) / 0.5).collect();
+        let rgb = s
+            .iter()
+            .map(|&x| {
+                std::array::from_fn(|c| {
+                    let pts: Vec<(f64, f64)> = col.iter().map(|p| (p.0, p.1[c])).collect();
+                    lerp(x, &pts)
+                })
+            })
+            .collect();
+        BenchTf { s, tau, rgb }
+    }
+
+    #[inline]
+    fn at(&self, x: f64) -> (f64, [f64; 3]) {
+        let n = self.s.len();
+        let x = x.clamp(self.s[0], self.s[n - 1]);
+        let k = self.s.partition_point(|&b| b <= x).clamp(1, n - 1) - 1;
+        let t = (x - self.s[k]) / (self.s[k + 1] - self.s[k]);
+        let c = std::array::from_fn(|i| self.rgb[k][i] * (1.0 - t) + self.rgb[k + 1][i] * t);
+        (self.tau[k] * (1.0 - t) + self.tau[k + 1] * t, c)
+    }
+}
+
+impl Default for BenchTf {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RayMaterial for BenchTf {
+    fn segment(&self, l: f64, s_f: f64, s_b: f64) -> SegmentValue {
+        let mut out = SegmentValue::default();
+        let (lo, hi) = (s_f.min(s_b), s_f.max(s_b));
+        let mut x0 = 0.0;
+        let emit = |x0: f64, x1: f64, out: &mut SegmentValue| {
+            let (sa, sb) = (s_f + (s_b - s_f) * x0, s_f + (s_b - s_f) * x1);
+            let (ta, tb) = (self.at(sa).0, self.at(sb).0);
+            let d = l * (x1 - x0) * 0.5 * (ta + tb);
+            if d > 0.0 {
+                let c = self.at(0.5 * (sa + sb)).1;
+                let a = -(-d).exp_m1();
+                let tr = (-out.depth).exp();
+                for (o, ck) in out.color.iter_mut().zip(c) {
+                    *o += tr * ck * a;
+                }
+                out.depth += d;
+            }
+        };
+        if hi > lo {
+            let i0 = self.s.partition_point(|&b| b <= lo);
+            let i1 = self.s.partition_point(|&b| b < hi);
+            let mut cuts: Vec<f64> = self.s[i0..i1]
+                .iter()
+                .map(|&b| (b - s_f) / (s_b - s_f))
+                .collect();
+            if s_b < s_f {
+                cuts.reverse();
+            }
+            for x in cuts {
+                emit(x0, x, &mut out);
+                x0 = x;
+            }
+        }
+        emit(x0, 1.0, &mut out);
+        out.alpha = -(-out.depth).exp_m1();
+        out
+    }
+
+    fn breakpoints(&self) -> &[f64] {
+        &self.s
+    }
+
+    fn material(&self, s: f64) -> Material {
+        let (tau, c) = self.at(s);
+        Material {
+            tau,
+            source: c.map(|x| x * tau),
+        }
+    }
+}
+
+fn peak_rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(0.0, |kb| kb / 1024.0)
+}
+
+/// CPU seconds (user + system) used by this process so far: on a loaded
+/// machine wall time says little, CPU time / cores is the idle-machine time.
+fn cpu_seconds() -> f64 {
+    std::fs::read_to_string("/proc/self/stat")
+        .ok()
+        .and_then(|s| {
+            let rest = s.rsplit_once(')')?.1;
+            let f: Vec<&str> = rest.split_whitespace().collect();
+            let ut: f64 = f.get(11)?.parse().ok()?;
+            let st: f64 = f.get(12)?.parse().ok()?;
+            Some((ut + st) / 100.0)
+        })
+        .unwrap_or(0.0)
+}
+
+fn camera(mesh: &Mesh, ortho: bool, size: u32) -> Camera {
+    let p = CameraParams {
+        width: size,
+        height: size,
+        azimuth: 20.0,
+        elevation: 35.0,
+        zoom: 1.25,
+        ortho,
+        ..Default::default()
+    };
+    Camera::fit(mesh.bounds(), &p)
+}
+
+fn bench(c: &mut Criterion) {
+    let t = Instant::now();
+    let (mesh, f) = hex_shell();
+    let topology = Topology::build(&mesh.cells);
+    eprintln!(
+        "hex_shell: {} hexes, {} points; mesh + topology built in {:.2} s; peak RSS {:.0} MiB",
+        mesh.cells.len(),
+        mesh.points.len(),
+        t.elapsed().as_secs_f64(),
+        peak_rss_mib()
+    );
+    let scene = Scene {
+        mesh: &mesh,
+        topology: &topology,
+        scalars: Scalars::Point(&f),
+    };
+    let tf = BenchTf::new();
+    let size: u32 = std::env::var("RAYCAST_BENCH_SIZE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(512);
+    let mut g = c.benchmark_group("raycast_hex_shell");
+    g.sample_size(10);
+    let models: Vec<FieldModel> = std::env::var("RAYCAST_BENCH_MODELS")
+        .unwrap_or_else(|_| "faces,tets,native".into())
+        .split(',')
+        .filter_map(|m| m.parse().ok())
+        .collect();
+    for model in models {
+        let t = Instant::now();
+        let rc = Raycaster::new(scene, model).unwrap();
+        eprintln!(
+            "{model:?}: setup {:.2} s, {:.1} MiB of ray-caster structures, peak RSS {:.0} MiB",
+            t.elapsed().as_secs_f64(),
+            rc.bytes() as f64 / 1048576.0,
+            peak_rss_mib()
+        );
+        for ortho in [false, true] {
+            if model == FieldModel::Native && ortho {
+                continue;
+            }
+            let cam = camera(&mesh, ortho, size);
+            let opts = RaycastOptions {
+                model,
+                ..Default::default()
+            };
+            let t = Instant::now();
+            let cpu = cpu_seconds();
+            let img = rc.render(&tf, &cam, &opts);
+            let cover = img.pixels.iter().filter(|p| p[3] > 0.0).count();
+            eprintln!(
+                "{model:?} {}: first frame {:.3} s wall, {:.2} s CPU ({cover} covered pixels); peak RSS {:.0} MiB",
+                if ortho { "ortho" } else { "persp" },
+                t.elapsed().as_secs_f64(),
+                cpu_seconds() - cpu,
+                peak_rss_mib()
+            );
+            if let Ok(dir) = std::env::var("RAYCAST_BENCH_OUT") {
+                let name = format!(
+                    "{dir}/hex_shell_{model:?}_{}.png",
+                    if ortho { "ortho" } else { "persp" }
+                );
+                let _ = img.write_png(std::path::Path::new(&name), [0.0; 3], false);
+            }
+            if model == FieldModel::Native {
+                continue;
+            }
+            let id = format!("{model:?}_{}_{size}", if ortho { "ortho" } else { "persp" });
+            g.bench_function(id, |b| b.iter(|| rc.render(&tf, &cam, &opts)));
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,102 @@
+//! Renders every dataset in `../shared/data` at 128 x 128 with the `faces`
+//! model: no error, no non-finite pixel, something visible.
+//!
+//! Skips cleanly when the shared data is absent, and (while the readers are
+//! placeholders) for every file the reader cannot read yet.
+
+mod raycast_util;
+
+use raycast_util::TestMaterial;
+use zoovr::camera::{Camera, CameraParams};
+use zoovr::field::{select_field, Association};
+use zoovr::io::{self, ReadOptions};
+use zoovr::mesh::topology::Topology;
+use zoovr::raycast::{render, RaycastOptions, Scalars, Scene};
+
+const FILES: &[&str] = &[
+    "angular_sector/AngularSector.vtk",
+    "blood_vessels_pvtu/blood_vessels/T0000000500.pvtu",
+    "bluntfin/bluntfin_converted.vts",
+    "bluntfin/bluntfin_converted_legacy42_binary.vtk",
+    "bluntfin/bluntfinxyz.bin",
+    "can_crush/can.vtu",
+    "can_crush/series/can_series.pvd",
+    "disk_out_ref/disk_out_ref_converted.vtu",
+    "disk_out_ref/disk_out_ref_converted_legacy51_binary.vtk",
+    "fea_bracket_qtet/kiefer_bracket.vtu",
+    "fire_room/fire_ug.vtu",
+    "notch/notch_disp.vtu",
+    "notch/notch_stress.vtk",
+    "office_kitchen/kitchen.vtk",
+    "office_kitchen/office.binary.vtk",
+    "prisms_zoo/PentaHexa.vtk",
+    "prisms_zoo/hexa.vtk",
+    "prisms_zoo/uGridEx.vtk",
+    "su2_sphere_hybrid/sphere_hybrid_converted.vtu",
+    "su2_sphere_hybrid/sphere_hybrid_converted_legacy42_ascii.vtk",
+    "synthetic/hex_shell_zlib.vtu",
+    "synthetic/mixed.vtk",
+    "tets_small/CylinderLinear.vtk",
+    "tets_small/tetraMesh.vtk",
+];
+
+#[test]
+fn render_every_shared_dataset_at_128() {
+    let mut rendered = 0;
+    for rel in FILES {
+        let Some(path) = zoovr::testdata::shared_file(rel) else {
+            continue;
+        };
+        let mut opts = ReadOptions::default();
+        if rel.ends_with("xyz.bin") {
+            opts.q_file = zoovr::testdata::shared_file("bluntfin/bluntfinq.bin");
+        }
+        let mesh = match io::read(&path, &opts) {
+            Ok(m) => m,
+            Err(e) => {
+                eprintln!("skipping {rel}: cannot read it yet ({e})");
+                continue;
+            }
+        };
+        let field = select_field(&mesh, None).unwrap_or(None);
+        let (lo, hi) = field.as_ref().map_or((0.0, 1.0), |f| f.range);
+        let scalars = match &field {
+            Some(f) if f.association == Association::Point => Scalars::Point(&f.values),
+            Some(f) => Scalars::Cell(&f.values),
+            None => Scalars::Constant(1.0),
+        };
+        // The default-TF shape: opacity ramp 0..1 over the range, unit
+        // distance = diagonal / 10.
+        let unit = (mesh.diagonal() / 10.0).max(1e-300);
+        let hi = if hi > lo { hi } else { lo + 1.0 };
+        let m = TestMaterial {
+            s: vec![lo, hi],
+            tau: vec![0.0, 1.0 / unit],
+            color: vec![[0.27, 0.0, 0.33], [0.99, 0.91, 0.14]],
+        };
+        let topology = Topology::build(&mesh.cells);
+        let scene = Scene {
+            mesh: &mesh,
+            topology: &topology,
+            scalars,
+        };
+        let p = CameraParams {
+            width: 128,
+            height: 128,
+            azimuth: 20.0,
+            elevation: 35.0,
+            ..Default::default()
+        };
+        let cam = Camera::fit(mesh.bounds(), &p);
+        let img = render(&scene, &m, &cam, &RaycastOptions::default())
+            .unwrap_or_else(|e| panic!("{rel}: {e}"));
+        assert_eq!(img.count_non_finite(), 0, "{rel}");
+        let visible = img.pixels.iter().filter(|p| p[3] > 1e-3).count();
+        assert!(
+            visible > 0 || mesh.cells.is_empty(),
+            "{rel}: nothing visible"
+        );
+        rendered += 1;
+    }
+    eprintln!("rendered {rendered} of {} datasets", FILES.len());
+}
