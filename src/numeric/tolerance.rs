@@ -18,3 +18,16 @@ pub const DEGENERATE_VOLUME_REL: f64 = 1e-12;
 /// merged by the optional coincident-point merge (exactly equal coordinates
 /// are always merged; this allows for ASCII round-off).
 pub const MERGE_POINTS_REL: f64 = 1e-12;
+
+/// Error bound factor (times `f64::EPSILON`) of the visibility sort's float
+/// filter for plane-side tests: `|n . eye - d|` is trusted when it exceeds
+/// `PLANE_FILTER_EPS * m * (|eye|_inf + |a|_inf)` (`m` bounds `|n|`), else the
+/// exact predicate decides. Not a tolerance on the answer: a generous bound on
+/// the rounding of a 3x3 determinant, so the filter never changes a sign.
+pub const PLANE_FILTER_EPS: f64 = 256.0 * f64::EPSILON;
+
+/// Margin in pixels of the non-convex rasteriser's float edge functions: a
+/// pixel centre farther than this from every edge line of a projected
+/// triangle is classified in floating point (projection rounding is about
+/// 1e-12 pixel); closer ones go to the exact ray-triangle test.
+pub const RASTER_FILTER_PX: f64 = 1e-6;
