@@ -75,7 +75,7 @@ mod validate;
 use std::ops::Range;
 use std::time::Duration;
 
-pub use sorter::Sorter;
+pub use sorter::{NonConvex, Sorter};
 pub use validate::{sample_pixels, validate, Violation, Violations};
 
 /// Rounds of "split the whole cells of every cycle, then sort again" before

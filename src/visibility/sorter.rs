@@ -58,6 +58,19 @@ fn sign(s: Side) -> i8 {
     }
 }
 
+/// How the constraints between cells that see each other through empty space
+/// are found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum NonConvex {
+    /// Exact at image resolution: boundary crossings along every pixel-centre
+    /// ray (the default).
+    #[default]
+    PixelConstraints,
+    /// APPROXIMATE: adjacency graph only (MPVO). Wrong wherever the mesh
+    /// sees itself across a gap; for comparisons and tests only.
+    IgnoreApproximate,
+}
+
 /// Built once per geometry; call [`Sorter::order`] per view.
 #[derive(Clone, Debug)]
 pub struct Sorter {
@@ -66,6 +79,8 @@ pub struct Sorter {
     geom: Geometry,
     pool: SplitPool,
     invalid: Option<VisibilityError>,
+    /// How non-convex meshes are handled (default: exact pixel constraints).
+    pub nonconvex: NonConvex,
     // Per-view scratch.
     tri_sign: Vec<i8>,
     face_target: Vec<u32>,
@@ -112,6 +127,7 @@ impl Sorter {
             mesh: geo_mesh,
             pool: SplitPool::new(if invalid.is_some() { 0 } else { n }),
             invalid,
+            nonconvex: NonConvex::PixelConstraints,
             tri_sign: vec![0; nt],
             face_target: vec![NONE; nf],
             want: Vec::new(),
@@ -172,7 +188,7 @@ impl Sorter {
 
         // 2. Non-convex constraints at triangle level (once per view).
         let t1 = Instant::now();
-        let tri_pairs = if self.geom.convex {
+        let tri_pairs = if self.geom.convex || self.nonconvex == NonConvex::IgnoreApproximate {
             Vec::new()
         } else {
             let crossings = rasterize(camera, &self.mesh.points, &self.geom.boundary, |i| {
@@ -470,9 +486,9 @@ impl Sorter {
         cons.dedup();
         let count = cons.len();
         let mut edges: Vec<(u32, u32)> = Vec::with_capacity(extra.to.len() + count);
-        for v in 0..extra.pieces {
-            for &w in &extra.to[extra.off[v] as usize..extra.off[v + 1] as usize] {
-                edges.push((v as u32, w));
+        for v in 0..extra.pieces as u32 {
+            for &w in self.extra_out(extra, v) {
+                edges.push((v, w));
             }
         }
         edges.extend(cons);
