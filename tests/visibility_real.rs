@@ -39,6 +39,20 @@ impl Rng {
 
 /// Sorts `views` random views (alternating projections) and validates each.
 fn check(rel: &str, views: usize, size: u32, samples: usize, split_all: bool) {
+    check_with(rel, views, size, samples, split_all, false)
+}
+
+/// `allow_on_overlap`: the mesh intersects itself (crushed can): violations
+/// are tolerated only on rays that also cross intersecting pieces, where no
+/// drawing order is right; everywhere else the order must be exact.
+fn check_with(
+    rel: &str,
+    views: usize,
+    size: u32,
+    samples: usize,
+    split_all: bool,
+    allow_on_overlap: bool,
+) {
     let Some(mesh) = load(rel) else {
         return;
     };
@@ -66,7 +80,7 @@ fn check(rel: &str, views: usize, size: u32, samples: usize, split_all: bool) {
         let px = sample_pixels(&cam, samples, v as u64);
         let viol = validate(&mesh, &order, &cam, &px);
         eprintln!(
-            "{rel} view {v}: pieces {} split {} groups {} constraints {} | rays {} degenerate {} pairs {} group pairs {} violations {}",
+            "{rel} view {v}: pieces {} split {} groups {} constraints {} | rays {} degenerate {} pairs {} group pairs {} overlap pairs {} violations {} (on overlap rays {})",
             order.pieces.len(),
             order.stats.split_cells,
             order.stats.cycle_groups,
@@ -75,10 +89,17 @@ fn check(rel: &str, views: usize, size: u32, samples: usize, split_all: bool) {
             viol.degenerate_rays,
             viol.pairs,
             viol.group_pairs,
-            viol.count
+            viol.overlap_pairs,
+            viol.count,
+            viol.violations_on_overlap_rays
         );
+        let counted = if allow_on_overlap {
+            viol.count - viol.violations_on_overlap_rays
+        } else {
+            viol.count
+        };
         assert!(
-            viol.ok(),
+            counted == 0,
             "{rel} view {v}: {} violations, e.g. {:?}",
             viol.count,
             &viol.examples[..viol.examples.len().min(3)]
@@ -95,13 +116,20 @@ fn fea_bracket_genus_9() {
 #[test]
 #[ignore = "slow in debug builds"]
 fn can_crush() {
-    check("can_crush/can.vtu", 20, 128, 4000, false);
+    check_with("can_crush/can.vtu", 20, 128, 4000, false, true);
+}
+
+#[test]
+#[ignore = "slow in debug builds"]
+fn can_crush_series_first_steps_exact() {
+    check("can_crush/series/can_t0_converted.vtu", 20, 128, 4000, false);
+    check("can_crush/series/can_t1_converted.vtu", 20, 128, 4000, false);
 }
 
 #[test]
 #[ignore = "slow in debug builds"]
 fn can_crush_split_all() {
-    check("can_crush/can.vtu", 4, 96, 2000, true);
+    check_with("can_crush/can.vtu", 4, 96, 2000, true, true);
 }
 
 #[test]

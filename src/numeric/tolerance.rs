@@ -31,3 +31,9 @@ pub const PLANE_FILTER_EPS: f64 = 256.0 * f64::EPSILON;
 /// triangle is classified in floating point (projection rounding is about
 /// 1e-12 pixel); closer ones go to the exact ray-triangle test.
 pub const RASTER_FILTER_PX: f64 = 1e-6;
+
+/// Relative depth (of the ray parameter) by which two consecutive pieces'
+/// segments along a validation ray must overlap before the validator calls
+/// them intersecting pieces (inverted cells) rather than neighbours whose
+/// shared face depth differs by rounding (~1e-16 relative).
+pub const VALIDATE_OVERLAP_REL: f64 = 1e-9;

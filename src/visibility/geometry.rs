@@ -44,6 +44,33 @@ pub struct Geometry {
     pub boundary: Vec<BoundaryTri>,
     /// Whether the boundary is one closed convex surface.
     pub convex: bool,
+    /// Cells that are non-convex beyond their face diagonals (a vertex
+    /// outside the plane of a face triangle it is not on the face of):
+    /// always drawn as tets.
+    pub nonconvex_cells: Vec<u32>,
+}
+
+/// Whether some vertex of cell `c` that is not on a face lies strictly
+/// outside the outward plane of one of that face's triangles.
+fn cell_nonconvex(mesh: &Mesh, c: usize, negative: bool) -> bool {
+    let p = &mesh.points;
+    let nodes = mesh.cells.nodes(c);
+    let outside = if negative { Side::Negative } else { Side::Positive };
+    let mut bad = false;
+    mesh.cells.for_each_face(c, |_, face| {
+        if bad {
+            return;
+        }
+        triangulate_face(face, |t| {
+            let [a, b, cc] = t.map(|i| p[i as usize]);
+            for &v in nodes {
+                if !face.contains(&v) && orient3d(a, b, cc, p[v as usize]) == outside {
+                    bad = true;
+                }
+            }
+        });
+    });
+    bad
 }
 
 fn round_up(x: f64) -> f32 {
@@ -131,6 +158,11 @@ impl Geometry {
             g.face_flags.push(flags);
             g.tri_off.push(g.planes.len() as u32);
         }
+        g.nonconvex_cells = (0..mesh.cells.len())
+            .filter(|&c| mesh.cells.kinds[c] != crate::mesh::CellKind::Tetra)
+            .filter(|&c| cell_nonconvex(mesh, c, vol[c] < 0.0))
+            .map(|c| c as u32)
+            .collect();
         g.convex = topo.nonmanifold_faces == 0 && boundary_convex(p, &g.boundary);
         g
     }

@@ -24,7 +24,9 @@
 //!    become **problem cells** and are split into consistent tets. A
 //!    boundary quad is a problem face when its triangles disagree and the
 //!    cell is concave along the diagonal (a ray can leave and re-enter it).
-//!    The neighbour of a split cell keeps its geometry: its edges across the
+//!    Cells that are non-convex beyond their face diagonals (a vertex outside
+//!    the plane of another face's triangle: badly distorted cells) are split
+//!    in every view. The neighbour of a split cell keeps its geometry: its edges across the
 //!    face are per triangle, to the tet owning that triangle.
 //! 3. **Non-convex meshes** (boundary not convex): XMPVO sampled at image
 //!    resolution ([`raster`]). Every boundary triangle is rasterised at the
@@ -131,6 +133,9 @@ pub struct OrderStats {
     pub problem_cells: usize,
     /// Cells split because their scalar range holds a breakpoint.
     pub breakpoint_cells: usize,
+    /// Cells split because they are non-convex beyond their face diagonals
+    /// (distorted cells; split in every view).
+    pub nonconvex_cells: usize,
     /// Cells split by `--split all`.
     pub all_split_cells: usize,
     /// Cells split to break a cycle.

@@ -29,6 +29,7 @@ const PROBLEM: u8 = 1;
 const BREAKPOINT: u8 = 2;
 const ALL: u8 = 4;
 const CYCLE: u8 = 8;
+const NONCONVEX_CELL: u8 = 16;
 
 /// Where the eye is.
 #[derive(Clone, Copy, Debug)]
@@ -184,6 +185,10 @@ impl Sorter {
         self.want.resize(n, 0);
         self.classify(view, &mut stats);
         self.policy_splits(policy, &mut stats);
+        for &c in &self.geom.nonconvex_cells {
+            self.want[c as usize] |= NONCONVEX_CELL;
+        }
+        stats.nonconvex_cells = self.geom.nonconvex_cells.len();
         stats.time_classify = t0.elapsed();
 
         // 2. Non-convex constraints at triangle level (once per view).

@@ -9,7 +9,9 @@
 //! ray the segments, ordered by their midpoints, must have strictly
 //! decreasing drawing positions (front pieces are drawn later); each pair of
 //! consecutive segments out of order is a [`Violation`], unless both pieces
-//! are in the same per-pixel group of [`Order::groups`].
+//! are in the same per-pixel group of [`Order::groups`], or their segments
+//! overlap (intersecting pieces, from inverted cells: no order is right;
+//! counted in [`Violations::overlap_pairs`]).
 
 use std::collections::HashMap;
 
@@ -20,6 +22,7 @@ use super::{Order, Piece};
 use crate::camera::Camera;
 use crate::mesh::tetra::triangulate_face;
 use crate::mesh::Mesh;
+use crate::numeric::tolerance::VALIDATE_OVERLAP_REL;
 
 /// Two pieces drawn in the wrong order along one pixel ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,6 +48,13 @@ pub struct Violations {
     /// Pieces the ray met an odd number of times (not closed; counted, and the
     /// ray is skipped).
     pub odd_rays: usize,
+    /// Consecutive pairs whose segments overlap along the ray (pieces whose
+    /// interiors intersect: inverted or self-overlapping cells, where no
+    /// drawing order is right); counted, not violations.
+    pub overlap_pairs: usize,
+    /// Violations on rays that also cross intersecting pieces (where the
+    /// mesh overlaps itself; included in `count`).
+    pub violations_on_overlap_rays: usize,
     /// Total number of violations.
     pub count: usize,
     /// The first violations (at most 20).
@@ -121,7 +131,7 @@ pub fn validate(mesh: &Mesh, order: &Order, camera: &Camera, pixels: &[(u32, u32
     }
     let tmin = if camera.ortho { 0.0 } else { camera.near };
     // Per sampled ray: (midpoint t, position in order).
-    let mut segs: HashMap<u32, Vec<(f64, u32)>> = HashMap::new();
+    let mut segs: HashMap<u32, Vec<(f64, f64, u32)>> = HashMap::new();
     let mut bad = vec![false; pixels.len()];
     let mut odd = vec![false; pixels.len()];
     let p = &mesh.points;
@@ -191,7 +201,7 @@ pub fn validate(mesh: &Mesh, order: &Order, camera: &Camera, pixels: &[(u32, u32
                 for s in ts.chunks(2) {
                     let (t0, t1) = (s[0].max(tmin), s[1]);
                     if t1 > t0 {
-                        segs.entry(k).or_default().push((0.5 * (t0 + t1), pos as u32));
+                        segs.entry(k).or_default().push((t0, t1, pos as u32));
                     }
                 }
             }
@@ -215,13 +225,22 @@ pub fn validate(mesh: &Mesh, order: &Order, camera: &Camera, pixels: &[(u32, u32
         }
         let list = segs.get_mut(&k).map(std::mem::take).unwrap_or_default();
         let mut list = list;
-        list.sort_by(|a, b| a.0.total_cmp(&b.0));
+        list.sort_by(|a, b| (a.0 + a.1).total_cmp(&(b.0 + b.1)));
+        let overlap_ray = list.windows(2).any(|pair| {
+            let slack = VALIDATE_OVERLAP_REL * pair[0].1.abs().max(pair[1].0.abs());
+            pair[0].2 != pair[1].2 && pair[1].0 < pair[0].1 - slack
+        });
         for pair in list.windows(2) {
-            let (front, back) = (pair[0].1, pair[1].1);
+            let (front, back) = (pair[0].2, pair[1].2);
             if front == back {
                 continue;
             }
             v.pairs += 1;
+            let slack = VALIDATE_OVERLAP_REL * pair[0].1.abs().max(pair[1].0.abs());
+            if pair[1].0 < pair[0].1 - slack {
+                v.overlap_pairs += 1;
+                continue;
+            }
             let (gf, gb) = (group_of[front as usize], group_of[back as usize]);
             if gf != u32::MAX && gf == gb {
                 v.group_pairs += 1;
@@ -229,6 +248,7 @@ pub fn validate(mesh: &Mesh, order: &Order, camera: &Camera, pixels: &[(u32, u32
             }
             if front < back {
                 v.count += 1;
+                v.violations_on_overlap_rays += overlap_ray as usize;
                 if v.examples.len() < 20 {
                     v.examples.push(Violation {
                         pixel: pixels[k as usize],
