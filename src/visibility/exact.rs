@@ -150,7 +150,11 @@ pub enum RayHit {
 
 /// Exact crossing test of the line through `o, q` with triangle `a, b, c`.
 pub fn ray_triangle(o: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> RayHit {
-    let s = [orient3d(o, q, a, b), orient3d(o, q, b, c), orient3d(o, q, c, a)];
+    let s = [
+        orient3d(o, q, a, b),
+        orient3d(o, q, b, c),
+        orient3d(o, q, c, a),
+    ];
     classify_signs(s)
 }
 
@@ -194,7 +198,8 @@ mod tests {
         let u: Vec<i128> = (0..3).map(|i| (b[i] - a[i]) as i128).collect();
         let v: Vec<i128> = (0..3).map(|i| (c[i] - a[i]) as i128).collect();
         let w: Vec<i128> = d.iter().map(|&x| x as i128).collect();
-        u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])
+        u[0] * (v[1] * w[2] - v[2] * w[1])
+            + u[1] * (v[2] * w[0] - v[0] * w[2])
             + u[2] * (v[0] * w[1] - v[1] * w[0])
     }
 
@@ -240,7 +245,10 @@ mod tests {
             orient_dir(DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.3, 0.9, 0.0)),
             Side::On
         );
-        assert_eq!(orient_dir(a, b, c, DVec3::Z), orient3d(a, b, c, a + DVec3::Z));
+        assert_eq!(
+            orient_dir(a, b, c, DVec3::Z),
+            orient3d(a, b, c, a + DVec3::Z)
+        );
     }
 
     #[test]

@@ -55,7 +55,11 @@ pub struct Geometry {
 fn cell_nonconvex(mesh: &Mesh, c: usize, negative: bool) -> bool {
     let p = &mesh.points;
     let nodes = mesh.cells.nodes(c);
-    let outside = if negative { Side::Negative } else { Side::Positive };
+    let outside = if negative {
+        Side::Negative
+    } else {
+        Side::Positive
+    };
     let mut bad = false;
     mesh.cells.for_each_face(c, |_, face| {
         if bad {
@@ -142,7 +146,11 @@ impl Geometry {
                 m = m.max(2.0 * (b - a).abs().max_element() * (c - a).abs().max_element());
                 amax = amax.max(a.abs().max_element());
                 if c1 == NONE {
-                    let verts = if flags & FLIP != 0 { [t[0], t[2], t[1]] } else { t };
+                    let verts = if flags & FLIP != 0 {
+                        [t[0], t[2], t[1]]
+                    } else {
+                        t
+                    };
                     g.boundary.push(BoundaryTri {
                         face: f as u32,
                         k,

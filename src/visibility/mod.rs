@@ -192,7 +192,11 @@ pub struct Order {
 pub enum VisibilityError {
     /// A cell references a point that does not exist.
     #[error("cell {cell} references point {point}, but the mesh has {points} points")]
-    PointOutOfRange { cell: usize, point: u32, points: usize },
+    PointOutOfRange {
+        cell: usize,
+        point: u32,
+        points: usize,
+    },
     /// The topology does not belong to the mesh.
     #[error("the topology has {topo} cells but the mesh has {mesh}")]
     TopologyMismatch { topo: usize, mesh: usize },

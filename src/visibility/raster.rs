@@ -56,9 +56,9 @@ pub fn rasterize(
         };
         let [a, b, c] = bt.verts.map(|v| points[v as usize]);
         let proj = [a, b, c].map(|p| camera.project(p));
-        let filtered = proj
-            .iter()
-            .all(|q| q.is_some_and(|(x, y, _)| x.abs() < MAX_FILTER_COORD && y.abs() < MAX_FILTER_COORD));
+        let filtered = proj.iter().all(|q| {
+            q.is_some_and(|(x, y, _)| x.abs() < MAX_FILTER_COORD && y.abs() < MAX_FILTER_COORD)
+        });
         let mut emit = |i_px: i64, j_px: i64| {
             let ray = camera.pixel_ray(i_px as u32, j_px as u32);
             let (o, q) = (ray.origin, ray.origin + ray.dir);

@@ -105,11 +105,15 @@ mod tests {
     #[test]
     fn deep_chain_does_not_overflow() {
         let n = 200_000;
-        let comps = tarjan(n, |_| true, |v, out| {
-            if (v as usize) + 1 < n {
-                out.push(v + 1)
-            }
-        });
+        let comps = tarjan(
+            n,
+            |_| true,
+            |v, out| {
+                if (v as usize) + 1 < n {
+                    out.push(v + 1)
+                }
+            },
+        );
         assert_eq!(comps.len(), n);
         assert_eq!(comps[0], vec![n as u32 - 1]);
     }

@@ -115,10 +115,7 @@ impl Sorter {
             ..Default::default()
         };
         let (topo, geom) = if invalid.is_some() {
-            (
-                Topology::build(&Cells::default()),
-                Geometry::default(),
-            )
+            (Topology::build(&Cells::default()), Geometry::default())
         } else {
             (topo.clone(), Geometry::build(mesh, topo))
         };
@@ -284,9 +281,8 @@ impl Sorter {
         for f in 0..nf {
             let r = g.tri_off[f] as usize..g.tri_off[f + 1] as usize;
             let [m, amax] = g.face_err[f];
-            let bound = PLANE_FILTER_EPS
-                * m as f64
-                * if vw == 1.0 { vmag + amax as f64 } else { dmag };
+            let bound =
+                PLANE_FILTER_EPS * m as f64 * if vw == 1.0 { vmag + amax as f64 } else { dmag };
             let mut pos = 0u8;
             let mut neg = 0u8;
             for t in r.clone() {
@@ -340,7 +336,11 @@ impl Sorter {
             } else {
                 // Eye on the normal side: the cell on that side is drawn later.
                 let normal_side_is_c1 = flags & FLIP == 0;
-                self.face_target[f] = if (pos > 0) == normal_side_is_c1 { c1 } else { c0 };
+                self.face_target[f] = if (pos > 0) == normal_side_is_c1 {
+                    c1
+                } else {
+                    c0
+                };
             }
         }
         stats.exact_fallbacks = fallbacks;
@@ -570,7 +570,8 @@ impl Sorter {
                 }
             }
             if !extra.off.is_empty() {
-                for &w in &extra.to[extra.off[v as usize] as usize..extra.off[v as usize + 1] as usize]
+                for &w in
+                    &extra.to[extra.off[v as usize] as usize..extra.off[v as usize + 1] as usize]
                 {
                     let d = &mut self.indeg[w as usize];
                     *d -= 1;
@@ -675,7 +676,10 @@ impl Sorter {
         let (sum, cnt) = match piece {
             Piece::Cell(c) => {
                 let nodes = self.mesh.cells.nodes(*c as usize);
-                (nodes.iter().map(|&v| p[v as usize]).sum::<DVec3>(), nodes.len())
+                (
+                    nodes.iter().map(|&v| p[v as usize]).sum::<DVec3>(),
+                    nodes.len(),
+                )
             }
             Piece::Tet { tet, .. } => (tet.iter().map(|&v| p[v as usize]).sum::<DVec3>(), 4),
         };
@@ -699,7 +703,11 @@ impl Sorter {
                 return Err(format!("active list not increasing at cell {c}"));
             }
             prev = Some(c);
-            let s = *self.pool.slot_of.get(c as usize).ok_or("active cell out of range")?;
+            let s = *self
+                .pool
+                .slot_of
+                .get(c as usize)
+                .ok_or("active cell out of range")?;
             if s == NONE {
                 return Err(format!("active cell {c} has no slot"));
             }
@@ -715,16 +723,23 @@ impl Sorter {
             let mut want = Vec::new();
             crate::mesh::tetra::tetrahedralize_cell(&self.mesh.cells, c as usize, &mut want);
             if want != sc.tets {
-                return Err(format!("cell {c}: stored tets differ from its consistent tets"));
+                return Err(format!(
+                    "cell {c}: stored tets differ from its consistent tets"
+                ));
             }
             for (li, &f) in self.topo.faces_of(c as usize).iter().enumerate() {
                 let mut k = 0;
                 let mut err = None;
                 crate::mesh::tetra::triangulate_face(self.topo.face(f as usize), |t| {
                     let o = sc.owner(li, k) as usize;
-                    let ok = sc.tets.get(o).is_some_and(|tet| t.iter().all(|v| tet.contains(v)));
+                    let ok = sc
+                        .tets
+                        .get(o)
+                        .is_some_and(|tet| t.iter().all(|v| tet.contains(v)));
                     if !ok && sc.unmatched == 0 {
-                        err = Some(format!("cell {c} face {f} triangle {k}: owner tet misses it"));
+                        err = Some(format!(
+                            "cell {c} face {f} triangle {k}: owner tet misses it"
+                        ));
                     }
                     k += 1;
                 });
@@ -739,7 +754,9 @@ impl Sorter {
             }
         }
         let split = self.pool.slot_of.iter().filter(|&&s| s != NONE).count();
-        if split != self.pool.active.len() || self.pool.slot_of.len() != n && n > 0 && self.invalid.is_none() {
+        if split != self.pool.active.len()
+            || self.pool.slot_of.len() != n && n > 0 && self.invalid.is_none()
+        {
             return Err(format!(
                 "{split} cells have slots but {} are active",
                 self.pool.active.len()
@@ -761,7 +778,10 @@ fn check_input(mesh: &Mesh, topo: &Topology) -> Option<VisibilityError> {
         return Some(VisibilityError::TopologyMismatch { topo: 0, mesh: n });
     }
     for c in 0..n {
-        let (a, b) = (mesh.cells.offsets[c] as usize, mesh.cells.offsets[c + 1] as usize);
+        let (a, b) = (
+            mesh.cells.offsets[c] as usize,
+            mesh.cells.offsets[c + 1] as usize,
+        );
         if a > b || b > mesh.cells.conn.len() {
             return Some(VisibilityError::TopologyMismatch { topo: 0, mesh: n });
         }
@@ -776,7 +796,10 @@ fn check_input(mesh: &Mesh, topo: &Topology) -> Option<VisibilityError> {
         }
         if let Some(k) = mesh.cells.kinds[c].corner_count() {
             if b - a != k {
-                return Some(VisibilityError::TopologyMismatch { topo: b - a, mesh: k });
+                return Some(VisibilityError::TopologyMismatch {
+                    topo: b - a,
+                    mesh: k,
+                });
             }
         }
     }
@@ -799,7 +822,10 @@ fn check_input(mesh: &Mesh, topo: &Topology) -> Option<VisibilityError> {
     }
     let nf = topo.face_count();
     let ok = topo.face_offsets.len() == nf + 1
-        && topo.face_offsets.last().is_some_and(|&e| e as usize <= topo.face_verts.len())
+        && topo
+            .face_offsets
+            .last()
+            .is_some_and(|&e| e as usize <= topo.face_verts.len())
         && topo.face_verts.iter().all(|&v| (v as usize) < np)
         && topo.cell_faces.iter().all(|&f| (f as usize) < nf)
         && topo
@@ -820,7 +846,9 @@ fn check_camera(c: &Camera) -> Result<(), VisibilityError> {
         return Err(VisibilityError::BadCamera("empty image"));
     }
     if !c.position.is_finite() || !c.forward.is_finite() || c.forward.length_squared() == 0.0 {
-        return Err(VisibilityError::BadCamera("non-finite position or direction"));
+        return Err(VisibilityError::BadCamera(
+            "non-finite position or direction",
+        ));
     }
     if (c.width as u64) * (c.height as u64) > u32::MAX as u64 {
         return Err(VisibilityError::BadCamera("image too large"));

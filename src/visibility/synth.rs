@@ -94,7 +94,7 @@ pub fn holed_grid(spec: &GridSpec) -> Mesh {
     let [nx, ny, nz] = spec.dims;
     let (hx0, hx1) = (nx * 3 / 8, (nx * 5 / 8).max(nx * 3 / 8 + 1));
     let (hy0, hy1) = (ny * 3 / 8, (ny * 5 / 8).max(ny * 3 / 8 + 1));
-    let cav = |a: usize, n: usize| a >= n / 8 + 1 && a < n / 8 + 1 + (n / 6).max(1);
+    let cav = |a: usize, n: usize| a > n / 8 && a <= n / 8 + (n / 6).max(1);
     grid(spec, |i, j, k| {
         let through = i >= hx0 && i < hx1 && j >= hy0 && j < hy1;
         let cavity = cav(i, nx) && cav(j, ny) && cav(k, nz);
@@ -106,5 +106,7 @@ pub fn holed_grid(spec: &GridSpec) -> Mesh {
 /// itself across empty space.
 pub fn notched_grid(spec: &GridSpec) -> Mesh {
     let [nx, _, nz] = spec.dims;
-    grid(spec, |i, _, k| !(i >= nx / 3 && i < 2 * nx / 3 && k >= nz / 2))
+    grid(spec, |i, _, k| {
+        !(i >= nx / 3 && i < 2 * nx / 3 && k >= nz / 2)
+    })
 }
