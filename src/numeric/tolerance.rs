@@ -22,6 +22,7 @@ pub const MERGE_POINTS_REL: f64 = 1e-12;
 <<<<<<< HEAD
 <<<<<<< HEAD
 <<<<<<< HEAD
+<<<<<<< HEAD
 /// Measured maximum absolute error of the exact mode's exponential table
 /// (`gpu::exptable`, 1024^2 texels, log-warped axes, f32 bilinear filtering)
 /// against the exact `1 - exp(-l tau)` over `l, tau` in `{0} + [1e-8, 1e6]`:
@@ -98,3 +99,23 @@ pub const NATIVE_INTEGRAL_TOL: f64 = 1e-9;
 /// the parametric step is below this (parametric coordinates are O(1)).
 pub const NATIVE_NEWTON_TOL: f64 = 1e-13;
 >>>>>>> raycast
+=======
+/// Error bound factor (times `f64::EPSILON`) of the visibility sort's float
+/// filter for plane-side tests: `|n . eye - d|` is trusted when it exceeds
+/// `PLANE_FILTER_EPS * m * (|eye|_inf + |a|_inf)` (`m` bounds `|n|`), else the
+/// exact predicate decides. Not a tolerance on the answer: a generous bound on
+/// the rounding of a 3x3 determinant, so the filter never changes a sign.
+pub const PLANE_FILTER_EPS: f64 = 256.0 * f64::EPSILON;
+
+/// Margin in pixels of the non-convex rasteriser's float edge functions: a
+/// pixel centre farther than this from every edge line of a projected
+/// triangle is classified in floating point (projection rounding is about
+/// 1e-12 pixel); closer ones go to the exact ray-triangle test.
+pub const RASTER_FILTER_PX: f64 = 1e-6;
+
+/// Relative depth (of the ray parameter) by which two consecutive pieces'
+/// segments along a validation ray must overlap before the validator calls
+/// them intersecting pieces (inverted cells) rather than neighbours whose
+/// shared face depth differs by rounding (~1e-16 relative).
+pub const VALIDATE_OVERLAP_REL: f64 = 1e-9;
+>>>>>>> visibility

@@ -1,1 +1,215 @@
 //! Exact back-to-front visibility order of drawable pieces (issue 5).
+//!
+//! # What it produces
+//! [`Sorter::order`] lists the [`Piece`]s of a mesh back to front for one
+//! [`Camera`]: whole cells, or the consistent tetrahedra
+//! ([`crate::mesh::tetra`]) of cells that must be split. A piece is drawn
+//! after every piece it occludes at the image's pixel centres.
+//!
+//! # How it works
+//! 1. **Per geometry** ([`Sorter::new`]): every unique face is split into its
+//!    smallest-vertex triangles (`tetra::triangulate_face`) and each
+//!    triangle's plane equation is stored with a floating-point error bound;
+//!    each cell's orientation (sign of its volume) tells which side of a face
+//!    it lies on; the boundary surface is checked for convexity (every
+//!    boundary edge's dihedral angle tested with exact `orient3d`; a single
+//!    closed manifold component).
+//! 2. **Per view, MPVO**: the side of every face triangle's plane the eye is
+//!    on (perspective: the eye position; orthographic: the sign of
+//!    `n . forward`), by the float filter with exact fallback
+//!    (`numeric::predicates::orient3d` / [`exact::orient_dir`]). An interior
+//!    face whose triangles agree directs the adjacency edge between its two
+//!    cells (the cell on the eye's side is drawn later). A quad whose two
+//!    triangles disagree is a **problem face** (MWS section V); both its cells
+//!    become **problem cells** and are split into consistent tets. A
+//!    boundary quad is a problem face when its triangles disagree and the
+//!    cell is concave along the diagonal (a ray can leave and re-enter it).
+//!    Cells that are non-convex beyond their face diagonals (a vertex outside
+//!    the plane of another face's triangle: badly distorted cells) are split
+//!    in every view. The neighbour of a split cell keeps its geometry: its edges across the
+//!    face are per triangle, to the tet owning that triangle.
+//! 3. **Non-convex meshes** (boundary not convex): XMPVO sampled at image
+//!    resolution ([`raster`]). Every boundary triangle is rasterised at the
+//!    pixel-centre rays of [`Camera::pixel_ray`] (a float edge-function filter
+//!    with a margin, exact [`exact::ray_triangle`] inside the margin). Per
+//!    pixel the boundary crossings are sorted by depth; every exit from piece
+//!    `X` followed directly by an entry into piece `Y` adds the constraint "`Y`
+//!    before `X`". Along every pixel ray, consecutive pieces are then related
+//!    by an adjacency edge or such a constraint, which makes the order exact
+//!    at image resolution.
+//! 4. **Topological sort** (Kahn) back to front.
+//! 5. **Cycles**: pieces Kahn cannot emit are grouped into strongly connected
+//!    components (Tarjan, [`scc`]). Whole cells in a cycle are split into
+//!    consistent tets and everything is re-sorted (at most
+//!    [`MAX_SPLIT_ROUNDS`] rounds). A cycle that remains (tets only, or after
+//!    the last round) is emitted as one **group**: a range of
+//!    [`Order::pieces`] listed in [`Order::groups`] that the renderer must
+//!    composite with per-pixel depth sorting; the order between the group and
+//!    every other piece is still exact. Cutting tets with planes through a
+//!    cycle member (MWS) is not implemented; groups replace it. The sort
+//!    always terminates.
+//!
+//! Subdivisions persist between views inside the [`Sorter`] (a pool of split
+//! cells); cells that stop needing a split are restored. [`Sorter::sanity_check`]
+//! verifies that bookkeeping.
+//!
+//! # Tie rule at pixel centres
+//! A pixel-centre ray through a triangle's edge or vertex (exactly, by exact
+//! predicates) counts as crossing *every* triangle it touches when constraints
+//! are generated (conservative: constraints for all interpretations); the
+//! validator ([`validate`]) skips such rays and counts them as degenerate.
+//!
+//! # Validation
+//! [`validate`] is a brute-force check for tests: for sampled pixel-centre
+//! rays it intersects the ray exactly with every piece's triangles, orders the
+//! pieces met by depth and checks that they are drawn back to front.
+
+pub mod exact;
+mod geometry;
+mod raster;
+pub mod scc;
+mod sorter;
+mod split;
+#[doc(hidden)]
+pub mod synth;
+mod validate;
+
+use std::ops::Range;
+use std::time::Duration;
+
+pub use sorter::{NonConvex, Sorter};
+pub use validate::{sample_pixels, validate, Violation, Violations};
+
+/// Rounds of "split the whole cells of every cycle, then sort again" before
+/// the remaining cycles are emitted as per-pixel groups.
+pub const MAX_SPLIT_ROUNDS: usize = 4;
+
+/// One drawable piece.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Piece {
+    /// A whole cell (quad faces are their two smallest-vertex triangles).
+    Cell(u32),
+    /// One consistent tetrahedron of a split cell (global point ids, in the
+    /// orientation `tetra::tetrahedralize_cell` gives).
+    Tet { cell: u32, tet: [u32; 4] },
+}
+
+impl Piece {
+    /// The cell the piece belongs to.
+    pub fn cell(&self) -> u32 {
+        match *self {
+            Piece::Cell(c) => c,
+            Piece::Tet { cell, .. } => cell,
+        }
+    }
+}
+
+/// Which cells to split beyond the problem cells of the view.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SplitPolicy<'a> {
+    /// `--split all`: every cell is drawn as its consistent tets.
+    pub all: bool,
+    /// Transfer-function breakpoints.
+    pub breakpoints: &'a [f64],
+    /// Nodal scalars; cells whose nodal range strictly contains a breakpoint
+    /// are split into tets.
+    pub point_scalars: Option<&'a [f64]>,
+}
+
+/// What one call of [`Sorter::order`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OrderStats {
+    /// Cells of the mesh.
+    pub cells: usize,
+    /// Pieces in the order.
+    pub pieces: usize,
+    /// Cells drawn as tets in this view (all reasons).
+    pub split_cells: usize,
+    /// Tets emitted.
+    pub tets: usize,
+    /// Problem faces (interior and boundary) in this view.
+    pub problem_faces: usize,
+    /// Cells split because of a problem face.
+    pub problem_cells: usize,
+    /// Cells split because their scalar range holds a breakpoint.
+    pub breakpoint_cells: usize,
+    /// Cells split because they are non-convex beyond their face diagonals
+    /// (distorted cells; split in every view).
+    pub nonconvex_cells: usize,
+    /// Cells split by `--split all`.
+    pub all_split_cells: usize,
+    /// Cells split to break a cycle.
+    pub cycle_split_cells: usize,
+    /// Cells newly split in this view (not split in the previous one).
+    pub newly_split: usize,
+    /// Cells restored to whole cells (split in the previous view only).
+    pub restored: usize,
+    /// Nontrivial strongly connected components met (all rounds).
+    pub cycles_found: usize,
+    /// Of those, the ones resolved by splitting cells into tets.
+    pub cycles_resolved_by_split: usize,
+    /// Cycles left as per-pixel groups ([`Order::groups`]).
+    pub cycle_groups: usize,
+    /// Pieces inside those groups.
+    pub pieces_in_groups: usize,
+    /// Sort rounds (1 without cycles).
+    pub rounds: usize,
+    /// Whether the boundary is convex (no non-convex constraints needed).
+    pub convex_boundary: bool,
+    /// Boundary crossings found by the pixel rasteriser.
+    pub boundary_crossings: usize,
+    /// Distinct non-convex constraints added (last round).
+    pub nonconvex_constraints: usize,
+    /// Plane tests the float filter could not decide (exact fallback).
+    pub exact_fallbacks: usize,
+    /// Time to classify faces (plane tests, problem faces).
+    pub time_classify: Duration,
+    /// Time to split / restore cells and build the split-cell edges.
+    pub time_split: Duration,
+    /// Time for the non-convex constraints (rasterisation included).
+    pub time_nonconvex: Duration,
+    /// Time for the topological sorts and cycle handling.
+    pub time_sort: Duration,
+    /// Total time of the call.
+    pub time_total: Duration,
+}
+
+/// A back-to-front order for one view.
+#[derive(Clone, Debug, Default)]
+pub struct Order {
+    /// Pieces back to front (draw in this order with "over").
+    pub pieces: Vec<Piece>,
+    /// Ranges of `pieces` that form unresolved visibility cycles: the pieces
+    /// of one range must be composited together with per-pixel depth sorting.
+    /// Every piece outside a range is correctly ordered against the range.
+    pub groups: Vec<Range<usize>>,
+    /// What the sort did.
+    pub stats: OrderStats,
+}
+
+/// Errors of the visibility sort (bad input; the sort itself cannot fail).
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
+pub enum VisibilityError {
+    /// A cell references a point that does not exist.
+    #[error("cell {cell} references point {point}, but the mesh has {points} points")]
+    PointOutOfRange {
+        cell: usize,
+        point: u32,
+        points: usize,
+    },
+    /// The topology does not belong to the mesh.
+    #[error("the topology has {topo} cells but the mesh has {mesh}")]
+    TopologyMismatch { topo: usize, mesh: usize },
+    /// A point coordinate is NaN or infinite.
+    #[error("point {0} has a non-finite coordinate")]
+    NonFinitePoint(usize),
+    /// The camera has a non-finite position or direction, or an empty image.
+    #[error("invalid camera: {0}")]
+    BadCamera(&'static str),
+    /// The nodal scalars do not cover every point.
+    #[error("{got} nodal scalars given for {points} points")]
+    ScalarCount { got: usize, points: usize },
+    /// The mesh has more pieces than 32-bit ids can address.
+    #[error("too many pieces ({0}) for 32-bit ids")]
+    TooManyPieces(usize),
+}

@@ -1,0 +1,90 @@
+//! Visibility sort time per view on a generated 1M-hex grid (100^3, jittered
+//! interior so faces are nonplanar), convex (planar boundary) and non-convex
+//! (through-hole and cavity), with the problem-cell subdivision the view
+//! needs, and without nonplanarity (no jitter: no problem cells); bluntfin
+//! when the readers can load it. Fixed seeds; the views are fixed camera
+//! angles at 512x512.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use zoovr::camera::{Camera, CameraParams};
+use zoovr::mesh::topology::Topology;
+use zoovr::mesh::Mesh;
+use zoovr::visibility::synth::{grid, holed_grid, GridSpec};
+use zoovr::visibility::{Sorter, SplitPolicy};
+
+fn camera(mesh: &Mesh, k: usize, ortho: bool) -> Camera {
+    let p = CameraParams {
+        azimuth: 17.0 + 37.0 * k as f64,
+        elevation: 23.0 - 11.0 * k as f64,
+        ortho,
+        ..Default::default()
+    };
+    Camera::fit(mesh.bounds(), &p)
+}
+
+fn bench_mesh(c: &mut Criterion, name: &str, mesh: &Mesh) {
+    let topo = Topology::build(&mesh.cells);
+    let mut sorter = Sorter::new(mesh, &topo);
+    let policy = SplitPolicy::default();
+    // One report line with the stats of a typical view.
+    let o = sorter.order(&camera(mesh, 0, false), &policy).expect("order");
+    let s = &o.stats;
+    eprintln!(
+        "{name}: cells {} convex {} split {} problem faces {} nonconvex constraints {} \
+         crossings {} fallbacks {} | classify {:?} split {:?} nonconvex {:?} sort {:?} total {:?}",
+        s.cells,
+        s.convex_boundary,
+        s.split_cells,
+        s.problem_faces,
+        s.nonconvex_constraints,
+        s.boundary_crossings,
+        s.exact_fallbacks,
+        s.time_classify,
+        s.time_split,
+        s.time_nonconvex,
+        s.time_sort,
+        s.time_total
+    );
+    let mut g = c.benchmark_group(name);
+    g.sample_size(10);
+    let mut k = 0usize;
+    g.bench_function("order_per_view", |b| {
+        b.iter(|| {
+            k += 1;
+            sorter
+                .order(&camera(mesh, k % 6, k % 2 == 1), &policy)
+                .expect("order")
+        })
+    });
+    g.finish();
+}
+
+fn visibility(c: &mut Criterion) {
+    let n = std::env::var("ZOOVR_BENCH_N")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(100usize);
+    let planar = GridSpec {
+        dims: [n, n, n],
+        jitter: 0.0,
+        seed: 1,
+        planar_boundary: true,
+    };
+    let warped = GridSpec {
+        jitter: 0.2,
+        ..planar
+    };
+    bench_mesh(c, "grid_convex_planar_faces", &grid(&planar, |_, _, _| true));
+    bench_mesh(c, "grid_convex_warped", &grid(&warped, |_, _, _| true));
+    bench_mesh(c, "grid_nonconvex_planar_faces", &holed_grid(&planar));
+    bench_mesh(c, "grid_nonconvex_warped", &holed_grid(&warped));
+    if let Some(path) = zoovr::testdata::shared_file("bluntfin/bluntfin_converted.vts") {
+        match zoovr::io::read(&path, &Default::default()) {
+            Ok(mesh) => bench_mesh(c, "bluntfin", &mesh),
+            Err(e) => eprintln!("skipping bluntfin: {e}"),
+        }
+    }
+}
+
+criterion_group!(benches, visibility);
+criterion_main!(benches);

@@ -1,0 +1,857 @@
+//! The per-view sort: face classification, splitting, constraints, Kahn's
+//! topological sort and cycle handling (see the module docs of
+//! [`crate::visibility`] for the method).
+//!
+//! Piece ids: whole cell `c` is id `c`; the tets of the split cells follow,
+//! id `cells + base(slot) + k`. Interior faces between two whole cells are
+//! edges through `face_target` (the cell drawn later, or `NONE`); every other
+//! edge (per triangle next to a split cell, inside a split cell, non-convex
+//! constraints) is an "extra" edge in a CSR list rebuilt per round.
+
+use std::time::Instant;
+
+use glam::DVec3;
+
+use super::exact::orient_dir;
+use super::geometry::{Geometry, BOUNDARY, CONCAVE, FLIP};
+use super::raster::{exit_entry_pairs, rasterize};
+use super::scc::tarjan;
+use super::split::SplitPool;
+use super::{Order, OrderStats, Piece, SplitPolicy, VisibilityError, MAX_SPLIT_ROUNDS};
+use crate::camera::Camera;
+use crate::mesh::topology::Topology;
+use crate::mesh::{Cells, Mesh, NONE};
+use crate::numeric::predicates::{orient3d, Side};
+use crate::numeric::tolerance::PLANE_FILTER_EPS;
+
+/// Split reasons (bits of `want`).
+const PROBLEM: u8 = 1;
+const BREAKPOINT: u8 = 2;
+const ALL: u8 = 4;
+const CYCLE: u8 = 8;
+const NONCONVEX_CELL: u8 = 16;
+
+/// Where the eye is.
+#[derive(Clone, Copy, Debug)]
+enum View {
+    /// Perspective: the eye position.
+    Eye(DVec3),
+    /// Orthographic: the direction of projection.
+    Dir(DVec3),
+}
+
+impl View {
+    /// Exact side of the eye relative to the plane of `a, b, c`.
+    fn side(&self, a: DVec3, b: DVec3, c: DVec3) -> Side {
+        match *self {
+            View::Eye(e) => orient3d(a, b, c, e),
+            // The eye is at infinity behind the image: direction -dir.
+            View::Dir(d) => orient_dir(a, b, c, -d),
+        }
+    }
+}
+
+fn sign(s: Side) -> i8 {
+    match s {
+        Side::Positive => 1,
+        Side::Negative => -1,
+        Side::On => 0,
+    }
+}
+
+/// How the constraints between cells that see each other through empty space
+/// are found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum NonConvex {
+    /// Exact at image resolution: boundary crossings along every pixel-centre
+    /// ray (the default).
+    #[default]
+    PixelConstraints,
+    /// APPROXIMATE: adjacency graph only (MPVO). Wrong wherever the mesh
+    /// sees itself across a gap; for comparisons and tests only.
+    IgnoreApproximate,
+}
+
+/// Built once per geometry; call [`Sorter::order`] per view.
+#[derive(Clone, Debug)]
+pub struct Sorter {
+    mesh: Mesh,
+    topo: Topology,
+    geom: Geometry,
+    pool: SplitPool,
+    invalid: Option<VisibilityError>,
+    /// How non-convex meshes are handled (default: exact pixel constraints).
+    pub nonconvex: NonConvex,
+    // Per-view scratch.
+    tri_sign: Vec<i8>,
+    face_target: Vec<u32>,
+    want: Vec<u8>,
+    indeg: Vec<u32>,
+}
+
+/// Per-round graph data besides `face_target`.
+#[derive(Default)]
+struct Extra {
+    /// `base[k]`: first tet id of `pool.active[k]`.
+    base: Vec<u32>,
+    /// Per tet id (offset by `cells`): index into `pool.active`.
+    tet_slot: Vec<u32>,
+    /// CSR over piece ids.
+    off: Vec<u32>,
+    to: Vec<u32>,
+    pieces: usize,
+}
+
+impl Sorter {
+    /// Prepares the plane equations and adjacency of `mesh` (whose topology
+    /// is `topo`). Invalid input (point ids out of range, non-finite points,
+    /// a topology of another mesh) is reported by [`Sorter::order`].
+    pub fn new(mesh: &Mesh, topo: &Topology) -> Sorter {
+        let n = mesh.cells.len();
+        let invalid = check_input(mesh, topo);
+        let geo_mesh = Mesh {
+            points: mesh.points.clone(),
+            cells: mesh.cells.clone(),
+            ..Default::default()
+        };
+        let (topo, geom) = if invalid.is_some() {
+            (Topology::build(&Cells::default()), Geometry::default())
+        } else {
+            (topo.clone(), Geometry::build(mesh, topo))
+        };
+        let nf = topo.face_count();
+        let nt = geom.planes.len();
+        Sorter {
+            mesh: geo_mesh,
+            pool: SplitPool::new(if invalid.is_some() { 0 } else { n }),
+            invalid,
+            nonconvex: NonConvex::PixelConstraints,
+            tri_sign: vec![0; nt],
+            face_target: vec![NONE; nf],
+            want: Vec::new(),
+            indeg: Vec::new(),
+            topo,
+            geom,
+        }
+    }
+
+    /// Whether the boundary of the mesh is convex (no pixel constraints).
+    pub fn convex_boundary(&self) -> bool {
+        self.geom.convex
+    }
+
+    /// Number of cells currently split into tets.
+    pub fn split_count(&self) -> usize {
+        self.pool.active.len()
+    }
+
+    /// The back-to-front order of pieces for `camera`.
+    pub fn order(
+        &mut self,
+        camera: &Camera,
+        policy: &SplitPolicy,
+    ) -> Result<Order, VisibilityError> {
+        let t_start = Instant::now();
+        if let Some(e) = &self.invalid {
+            return Err(e.clone());
+        }
+        check_camera(camera)?;
+        let n = self.mesh.cells.len();
+        if let Some(s) = policy.point_scalars {
+            if s.len() < self.mesh.points.len() {
+                return Err(VisibilityError::ScalarCount {
+                    got: s.len(),
+                    points: self.mesh.points.len(),
+                });
+            }
+        }
+        let view = if camera.ortho {
+            View::Dir(camera.forward)
+        } else {
+            View::Eye(camera.position)
+        };
+        let mut stats = OrderStats {
+            cells: n,
+            convex_boundary: self.geom.convex,
+            ..Default::default()
+        };
+
+        // 1. Classify faces.
+        let t0 = Instant::now();
+        self.want.clear();
+        self.want.resize(n, 0);
+        self.classify(view, &mut stats);
+        self.policy_splits(policy, &mut stats);
+        for &c in &self.geom.nonconvex_cells {
+            self.want[c as usize] |= NONCONVEX_CELL;
+        }
+        stats.nonconvex_cells = self.geom.nonconvex_cells.len();
+        stats.time_classify = t0.elapsed();
+
+        // 2. Non-convex constraints at triangle level (once per view).
+        let t1 = Instant::now();
+        let tri_pairs = if self.geom.convex || self.nonconvex == NonConvex::IgnoreApproximate {
+            Vec::new()
+        } else {
+            let crossings = rasterize(camera, &self.mesh.points, &self.geom.boundary, |i| {
+                let bt = &self.geom.boundary[i];
+                let t = self.geom.tri_off[bt.face as usize] as usize + bt.k as usize;
+                let s = self.tri_sign[t];
+                let flip = self.geom.face_flags[bt.face as usize] & FLIP != 0;
+                // Outward side seen: enter.
+                (s != 0).then_some((s > 0) != flip)
+            });
+            stats.boundary_crossings = crossings.len();
+            exit_entry_pairs(&crossings)
+        };
+        stats.time_nonconvex = t1.elapsed();
+
+        // 3. Rounds of split + sort.
+        let mut first_round = true;
+        loop {
+            stats.rounds += 1;
+            let ts = Instant::now();
+            let change = self.pool.update(&self.mesh, &self.topo, &self.want);
+            if first_round {
+                stats.newly_split = change.newly_split;
+                stats.restored = change.restored;
+                first_round = false;
+            } else {
+                stats.newly_split += change.newly_split;
+            }
+            let mut extra = self.build_extra(view)?;
+            stats.time_split += ts.elapsed();
+            let tn = Instant::now();
+            let nc = self.add_nonconvex(&tri_pairs, &mut extra);
+            stats.nonconvex_constraints = nc;
+            stats.time_nonconvex += tn.elapsed();
+
+            let tk = Instant::now();
+            let emitted = self.kahn(&extra);
+            let total_alive = n - self.pool.active.len() + (extra.pieces - n);
+            if emitted.len() == total_alive {
+                let order = self.finish(emitted, Vec::new(), &extra, camera, &mut stats);
+                stats.time_sort += tk.elapsed();
+                stats.time_total = t_start.elapsed();
+                return Ok(Order { stats, ..order });
+            }
+            // Cycles: strongly connected components of what is left.
+            let comps = self.components(&extra, &emitted);
+            let cycles: Vec<&Vec<u32>> = comps.iter().filter(|c| c.len() > 1).collect();
+            stats.cycles_found += cycles.len();
+            let mut new_split = 0;
+            if stats.rounds <= MAX_SPLIT_ROUNDS {
+                for comp in &cycles {
+                    let mut any = false;
+                    for &p in comp.iter() {
+                        if (p as usize) < n && self.want[p as usize] == 0 {
+                            self.want[p as usize] = CYCLE;
+                            new_split += 1;
+                            any = true;
+                        }
+                    }
+                    if any {
+                        stats.cycles_resolved_by_split += 1;
+                    }
+                }
+            }
+            stats.cycle_split_cells += new_split;
+            if new_split == 0 {
+                let order = self.finish(emitted, comps, &extra, camera, &mut stats);
+                stats.time_sort += tk.elapsed();
+                stats.time_total = t_start.elapsed();
+                return Ok(Order { stats, ..order });
+            }
+            stats.time_sort += tk.elapsed();
+        }
+    }
+
+    /// Plane tests for every face triangle; face targets; problem faces.
+    fn classify(&mut self, view: View, stats: &mut OrderStats) {
+        let g = &self.geom;
+        let p = &self.mesh.points;
+        let (vx, vw, vmag) = match view {
+            View::Eye(e) => (e, 1.0, e.abs().max_element()),
+            View::Dir(d) => (d, 0.0, 0.0),
+        };
+        let dmag = vx.abs().max_element();
+        let nf = self.topo.face_count();
+        let mut fallbacks = 0usize;
+        let mut problems = 0usize;
+        for f in 0..nf {
+            let r = g.tri_off[f] as usize..g.tri_off[f + 1] as usize;
+            let [m, amax] = g.face_err[f];
+            let bound =
+                PLANE_FILTER_EPS * m as f64 * if vw == 1.0 { vmag + amax as f64 } else { dmag };
+            let mut pos = 0u8;
+            let mut neg = 0u8;
+            for t in r.clone() {
+                let pl = &g.planes[t];
+                // Perspective: n . eye - d; orthographic: n . (-dir).
+                let s = if vw == 1.0 {
+                    pl[0] * vx.x + pl[1] * vx.y + pl[2] * vx.z - pl[3]
+                } else {
+                    -(pl[0] * vx.x + pl[1] * vx.y + pl[2] * vx.z)
+                };
+                let sg = if s > bound {
+                    1
+                } else if s < -bound {
+                    -1
+                } else {
+                    fallbacks += 1;
+                    let k = t - r.start;
+                    let mut verts = [0u32; 3];
+                    let mut idx = 0;
+                    crate::mesh::tetra::triangulate_face(self.topo.face(f), |tri| {
+                        if idx == k {
+                            verts = tri;
+                        }
+                        idx += 1;
+                    });
+                    let [a, b, c] = verts.map(|v| p[v as usize]);
+                    sign(view.side(a, b, c))
+                };
+                self.tri_sign[t] = sg;
+                pos += (sg > 0) as u8;
+                neg += (sg < 0) as u8;
+            }
+            let flags = g.face_flags[f];
+            let [c0, c1] = self.topo.face_cells[f];
+            let problem = pos > 0 && neg > 0;
+            if flags & BOUNDARY != 0 {
+                self.face_target[f] = NONE;
+                if problem && flags & CONCAVE != 0 {
+                    problems += 1;
+                    self.want[c0 as usize] |= PROBLEM;
+                }
+                continue;
+            }
+            if problem {
+                problems += 1;
+                self.want[c0 as usize] |= PROBLEM;
+                self.want[c1 as usize] |= PROBLEM;
+                self.face_target[f] = NONE;
+            } else if pos == 0 && neg == 0 {
+                self.face_target[f] = NONE;
+            } else {
+                // Eye on the normal side: the cell on that side is drawn later.
+                let normal_side_is_c1 = flags & FLIP == 0;
+                self.face_target[f] = if (pos > 0) == normal_side_is_c1 {
+                    c1
+                } else {
+                    c0
+                };
+            }
+        }
+        stats.exact_fallbacks = fallbacks;
+        stats.problem_faces = problems;
+        stats.problem_cells = self.want.iter().filter(|&&w| w & PROBLEM != 0).count();
+    }
+
+    /// Breakpoint and `--split all` reasons.
+    fn policy_splits(&mut self, policy: &SplitPolicy, stats: &mut OrderStats) {
+        let n = self.mesh.cells.len();
+        if policy.all {
+            for w in self.want.iter_mut() {
+                *w |= ALL;
+            }
+            stats.all_split_cells = n;
+        }
+        if let (Some(s), false) = (policy.point_scalars, policy.breakpoints.is_empty()) {
+            let mut count = 0;
+            for c in 0..n {
+                let mut lo = f64::INFINITY;
+                let mut hi = f64::NEG_INFINITY;
+                for &v in self.mesh.cells.nodes(c) {
+                    let x = s[v as usize];
+                    lo = lo.min(x);
+                    hi = hi.max(x);
+                }
+                if policy.breakpoints.iter().any(|&b| lo < b && b < hi) {
+                    self.want[c] |= BREAKPOINT;
+                    count += 1;
+                }
+            }
+            stats.breakpoint_cells = count;
+        }
+    }
+
+    /// Piece id of the owner of triangle `k` of face `f` on cell `c`'s side.
+    #[inline]
+    fn piece_on(&self, extra: &Extra, c: u32, f: u32, k: usize) -> u32 {
+        let n = self.mesh.cells.len() as u32;
+        let Some(sc) = self.pool.get(c) else {
+            return c;
+        };
+        let li = self
+            .topo
+            .faces_of(c as usize)
+            .iter()
+            .position(|&g| g == f)
+            .unwrap_or(0);
+        let slot = self.pool.active.binary_search(&c).unwrap_or(0);
+        n + extra.base[slot] + sc.owner(li, k)
+    }
+
+    /// Tet ids, per-triangle edges next to split cells, edges inside split
+    /// cells. Clears `face_target` of faces touching split cells.
+    fn build_extra(&mut self, view: View) -> Result<Extra, VisibilityError> {
+        let n = self.mesh.cells.len();
+        let mut extra = Extra::default();
+        let mut next = 0u32;
+        for (k, &c) in self.pool.active.iter().enumerate() {
+            extra.base.push(next);
+            let sc = self.pool.get(c).map_or(0, |s| s.tets.len());
+            for _ in 0..sc {
+                extra.tet_slot.push(k as u32);
+            }
+            next = next
+                .checked_add(sc as u32)
+                .ok_or(VisibilityError::TooManyPieces(usize::MAX))?;
+        }
+        let pieces = n + next as usize;
+        if pieces > (u32::MAX - 1) as usize {
+            return Err(VisibilityError::TooManyPieces(pieces));
+        }
+        extra.pieces = pieces;
+        let mut edges: Vec<(u32, u32)> = Vec::new();
+        let p = &self.mesh.points;
+        for &c in &self.pool.active {
+            let faces = self.topo.faces_of(c as usize);
+            for &f in faces {
+                let fu = f as usize;
+                self.face_target[fu] = NONE;
+                let [c0, c1] = self.topo.face_cells[fu];
+                if c1 == NONE {
+                    continue;
+                }
+                let other = if c0 == c { c1 } else { c0 };
+                // Handle a face between two split cells once (from c0).
+                if self.pool.get(other).is_some() && c != c0 {
+                    continue;
+                }
+                let flip = self.geom.face_flags[fu] & FLIP != 0;
+                for (k, t) in self.geom.tris(fu).enumerate() {
+                    let s = self.tri_sign[t];
+                    if s == 0 {
+                        continue;
+                    }
+                    let p0 = self.piece_on(&extra, c0, f, k);
+                    let p1 = self.piece_on(&extra, c1, f, k);
+                    // Eye on c1's side: c1's piece is drawn later.
+                    if (s > 0) != flip {
+                        edges.push((p0, p1));
+                    } else {
+                        edges.push((p1, p0));
+                    }
+                }
+            }
+            if let Some(sc) = self.pool.get(c) {
+                let slot = self.pool.active.binary_search(&c).unwrap_or(0);
+                let b = n as u32 + extra.base[slot];
+                for it in &sc.internal {
+                    let [a, bb, cc] = it.tri.map(|v| p[v as usize]);
+                    let se = view.side(a, bb, cc);
+                    if se == Side::On || it.side_i == Side::On {
+                        continue;
+                    }
+                    let (pi, pj) = (b + it.i, b + it.j);
+                    // Eye on tet i's side: i occludes j, j first.
+                    if se == it.side_i {
+                        edges.push((pj, pi));
+                    } else {
+                        edges.push((pi, pj));
+                    }
+                }
+            }
+        }
+        extra.to = Vec::new();
+        extra.off = Vec::new();
+        self.set_edges(&mut extra, edges);
+        Ok(extra)
+    }
+
+    /// Appends the non-convex constraints (mapped to pieces); returns their
+    /// number.
+    fn add_nonconvex(&self, tri_pairs: &[(u32, u32)], extra: &mut Extra) -> usize {
+        if tri_pairs.is_empty() {
+            return 0;
+        }
+        let owner = |i: u32| {
+            let bt = &self.geom.boundary[i as usize];
+            let c0 = self.topo.face_cells[bt.face as usize][0];
+            self.piece_on(extra, c0, bt.face, bt.k as usize)
+        };
+        let mut cons: Vec<(u32, u32)> = tri_pairs
+            .iter()
+            .map(|&(exit, entry)| (owner(entry), owner(exit)))
+            .filter(|(a, b)| a != b)
+            .collect();
+        cons.sort_unstable();
+        cons.dedup();
+        let count = cons.len();
+        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(extra.to.len() + count);
+        for v in 0..extra.pieces as u32 {
+            for &w in self.extra_out(extra, v) {
+                edges.push((v, w));
+            }
+        }
+        edges.extend(cons);
+        self.set_edges(extra, edges);
+        count
+    }
+
+    /// Stores `edges` as the CSR of `extra`.
+    fn set_edges(&self, extra: &mut Extra, edges: Vec<(u32, u32)>) {
+        if edges.is_empty() {
+            extra.off.clear();
+            extra.to.clear();
+            return;
+        }
+        let mut off = vec![0u32; extra.pieces + 1];
+        for &(a, _) in &edges {
+            off[a as usize + 1] += 1;
+        }
+        for i in 0..extra.pieces {
+            off[i + 1] += off[i];
+        }
+        let mut fill = off.clone();
+        let mut to = vec![0u32; edges.len()];
+        for &(a, b) in &edges {
+            to[fill[a as usize] as usize] = b;
+            fill[a as usize] += 1;
+        }
+        extra.off = off;
+        extra.to = to;
+    }
+
+    #[inline]
+    fn extra_out<'a>(&self, extra: &'a Extra, v: u32) -> &'a [u32] {
+        if extra.off.is_empty() {
+            return &[];
+        }
+        &extra.to[extra.off[v as usize] as usize..extra.off[v as usize + 1] as usize]
+    }
+
+    /// Kahn's algorithm; returns the emitted piece ids (back to front).
+    fn kahn(&mut self, extra: &Extra) -> Vec<u32> {
+        let n = self.mesh.cells.len();
+        let pieces = extra.pieces;
+        self.indeg.clear();
+        self.indeg.resize(pieces, 0);
+        for &t in &self.face_target {
+            if t != NONE {
+                self.indeg[t as usize] += 1;
+            }
+        }
+        for &t in &extra.to {
+            self.indeg[t as usize] += 1;
+        }
+        let mut out: Vec<u32> = Vec::with_capacity(pieces);
+        for v in 0..pieces {
+            if self.indeg[v] == 0 && (v >= n || self.pool.slot_of[v] == NONE) {
+                out.push(v as u32);
+            }
+        }
+        let mut head = 0;
+        while head < out.len() {
+            let v = out[head];
+            head += 1;
+            if (v as usize) < n {
+                for &f in self.topo.faces_of(v as usize) {
+                    let t = self.face_target[f as usize];
+                    if t != NONE && t != v {
+                        let d = &mut self.indeg[t as usize];
+                        *d -= 1;
+                        if *d == 0 {
+                            out.push(t);
+                        }
+                    }
+                }
+            }
+            if !extra.off.is_empty() {
+                for &w in
+                    &extra.to[extra.off[v as usize] as usize..extra.off[v as usize + 1] as usize]
+                {
+                    let d = &mut self.indeg[w as usize];
+                    *d -= 1;
+                    if *d == 0 {
+                        out.push(w);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Strongly connected components of the pieces Kahn left (sinks first).
+    fn components(&self, extra: &Extra, emitted: &[u32]) -> Vec<Vec<u32>> {
+        let n = self.mesh.cells.len();
+        let mut done = vec![false; extra.pieces];
+        for &v in emitted {
+            done[v as usize] = true;
+        }
+        for &c in &self.pool.active {
+            done[c as usize] = true;
+        }
+        tarjan(
+            extra.pieces,
+            |v| !done[v as usize],
+            |v, out| {
+                if (v as usize) < n {
+                    for &f in self.topo.faces_of(v as usize) {
+                        let t = self.face_target[f as usize];
+                        if t != NONE && t != v {
+                            out.push(t);
+                        }
+                    }
+                }
+                out.extend_from_slice(self.extra_out(extra, v));
+            },
+        )
+    }
+
+    /// Converts ids to pieces; appends the leftover components (topological
+    /// order, cycles as groups).
+    fn finish(
+        &self,
+        emitted: Vec<u32>,
+        comps: Vec<Vec<u32>>,
+        extra: &Extra,
+        camera: &Camera,
+        stats: &mut OrderStats,
+    ) -> Order {
+        let mut pieces: Vec<Piece> = Vec::with_capacity(extra.pieces);
+        for &v in &emitted {
+            pieces.push(self.piece(extra, v));
+        }
+        let mut groups = Vec::new();
+        for comp in comps.into_iter().rev() {
+            if comp.len() == 1 {
+                pieces.push(self.piece(extra, comp[0]));
+                continue;
+            }
+            let start = pieces.len();
+            let mut members: Vec<(f64, Piece)> = comp
+                .iter()
+                .map(|&v| {
+                    let pc = self.piece(extra, v);
+                    (self.depth(&pc, camera), pc)
+                })
+                .collect();
+            members.sort_by(|a, b| b.0.total_cmp(&a.0));
+            pieces.extend(members.into_iter().map(|m| m.1));
+            groups.push(start..pieces.len());
+        }
+        stats.cycle_groups = groups.len();
+        stats.pieces_in_groups = groups.iter().map(|g| g.len()).sum();
+        stats.pieces = pieces.len();
+        stats.split_cells = self.pool.active.len();
+        stats.tets = extra.pieces - self.mesh.cells.len();
+        Order {
+            pieces,
+            groups,
+            stats: OrderStats::default(),
+        }
+    }
+
+    fn piece(&self, extra: &Extra, v: u32) -> Piece {
+        let n = self.mesh.cells.len() as u32;
+        if v < n {
+            return Piece::Cell(v);
+        }
+        let k = (v - n) as usize;
+        let slot = extra.tet_slot[k] as usize;
+        let c = self.pool.active[slot];
+        let local = k - extra.base[slot] as usize;
+        match self.pool.get(c).and_then(|s| s.tets.get(local)) {
+            Some(&tet) => Piece::Tet { cell: c, tet },
+            None => Piece::Cell(c),
+        }
+    }
+
+    /// Depth of a piece's vertex centroid (for ordering inside groups).
+    fn depth(&self, piece: &Piece, camera: &Camera) -> f64 {
+        let p = &self.mesh.points;
+        let (sum, cnt) = match piece {
+            Piece::Cell(c) => {
+                let nodes = self.mesh.cells.nodes(*c as usize);
+                (
+                    nodes.iter().map(|&v| p[v as usize]).sum::<DVec3>(),
+                    nodes.len(),
+                )
+            }
+            Piece::Tet { tet, .. } => (tet.iter().map(|&v| p[v as usize]).sum::<DVec3>(), 4),
+        };
+        let centre = sum / cnt.max(1) as f64;
+        if camera.ortho {
+            (centre - camera.position).dot(camera.forward)
+        } else {
+            (centre - camera.position).length()
+        }
+    }
+
+    /// Verifies the split bookkeeping: every active cell has a slot holding
+    /// its own tets, slots are not shared, free slots are not in use, every
+    /// face triangle of a split cell has an owning tet that contains it.
+    pub fn sanity_check(&self) -> Result<(), String> {
+        let n = self.mesh.cells.len();
+        let mut used = vec![false; self.pool.slots.len()];
+        let mut prev: Option<u32> = None;
+        for &c in &self.pool.active {
+            if prev.is_some_and(|p| p >= c) {
+                return Err(format!("active list not increasing at cell {c}"));
+            }
+            prev = Some(c);
+            let s = *self
+                .pool
+                .slot_of
+                .get(c as usize)
+                .ok_or("active cell out of range")?;
+            if s == NONE {
+                return Err(format!("active cell {c} has no slot"));
+            }
+            let su = s as usize;
+            if su >= used.len() || used[su] {
+                return Err(format!("slot {s} of cell {c} invalid or shared"));
+            }
+            used[su] = true;
+            let sc = &self.pool.slots[su];
+            if sc.cell != c {
+                return Err(format!("slot {s} holds cell {} not {c}", sc.cell));
+            }
+            let mut want = Vec::new();
+            crate::mesh::tetra::tetrahedralize_cell(&self.mesh.cells, c as usize, &mut want);
+            if want != sc.tets {
+                return Err(format!(
+                    "cell {c}: stored tets differ from its consistent tets"
+                ));
+            }
+            for (li, &f) in self.topo.faces_of(c as usize).iter().enumerate() {
+                let mut k = 0;
+                let mut err = None;
+                crate::mesh::tetra::triangulate_face(self.topo.face(f as usize), |t| {
+                    let o = sc.owner(li, k) as usize;
+                    let ok = sc
+                        .tets
+                        .get(o)
+                        .is_some_and(|tet| t.iter().all(|v| tet.contains(v)));
+                    if !ok && sc.unmatched == 0 {
+                        err = Some(format!(
+                            "cell {c} face {f} triangle {k}: owner tet misses it"
+                        ));
+                    }
+                    k += 1;
+                });
+                if let Some(e) = err {
+                    return Err(e);
+                }
+            }
+        }
+        for &s in &self.pool.free {
+            if used.get(s as usize).copied().unwrap_or(true) {
+                return Err(format!("free slot {s} is in use or out of range"));
+            }
+        }
+        let split = self.pool.slot_of.iter().filter(|&&s| s != NONE).count();
+        if split != self.pool.active.len()
+            || self.pool.slot_of.len() != n && n > 0 && self.invalid.is_none()
+        {
+            return Err(format!(
+                "{split} cells have slots but {} are active",
+                self.pool.active.len()
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn check_input(mesh: &Mesh, topo: &Topology) -> Option<VisibilityError> {
+    let np = mesh.points.len();
+    for (i, p) in mesh.points.iter().enumerate() {
+        if !p.is_finite() {
+            return Some(VisibilityError::NonFinitePoint(i));
+        }
+    }
+    let n = mesh.cells.len();
+    if mesh.cells.offsets.len() != n + 1 && n > 0 {
+        return Some(VisibilityError::TopologyMismatch { topo: 0, mesh: n });
+    }
+    for c in 0..n {
+        let (a, b) = (
+            mesh.cells.offsets[c] as usize,
+            mesh.cells.offsets[c + 1] as usize,
+        );
+        if a > b || b > mesh.cells.conn.len() {
+            return Some(VisibilityError::TopologyMismatch { topo: 0, mesh: n });
+        }
+        for &v in &mesh.cells.conn[a..b] {
+            if v as usize >= np {
+                return Some(VisibilityError::PointOutOfRange {
+                    cell: c,
+                    point: v,
+                    points: np,
+                });
+            }
+        }
+        if let Some(k) = mesh.cells.kinds[c].corner_count() {
+            if b - a != k {
+                return Some(VisibilityError::TopologyMismatch {
+                    topo: b - a,
+                    mesh: k,
+                });
+            }
+        }
+    }
+    for faces in mesh.cells.poly_faces.values() {
+        for &v in faces.iter().flatten() {
+            if v as usize >= np {
+                return Some(VisibilityError::PointOutOfRange {
+                    cell: 0,
+                    point: v,
+                    points: np,
+                });
+            }
+        }
+    }
+    if topo.cell_face_offsets.len() != n + 1 && !(n == 0 && topo.cell_face_offsets.len() <= 1) {
+        return Some(VisibilityError::TopologyMismatch {
+            topo: topo.cell_face_offsets.len().saturating_sub(1),
+            mesh: n,
+        });
+    }
+    let nf = topo.face_count();
+    let ok = topo.face_offsets.len() == nf + 1
+        && topo
+            .face_offsets
+            .last()
+            .is_some_and(|&e| e as usize <= topo.face_verts.len())
+        && topo.face_verts.iter().all(|&v| (v as usize) < np)
+        && topo.cell_faces.iter().all(|&f| (f as usize) < nf)
+        && topo
+            .face_cells
+            .iter()
+            .all(|&[a, b]| (a as usize) < n && (b == NONE || (b as usize) < n));
+    if !ok {
+        return Some(VisibilityError::TopologyMismatch {
+            topo: topo.cell_face_offsets.len().saturating_sub(1),
+            mesh: n,
+        });
+    }
+    None
+}
+
+fn check_camera(c: &Camera) -> Result<(), VisibilityError> {
+    if c.width == 0 || c.height == 0 {
+        return Err(VisibilityError::BadCamera("empty image"));
+    }
+    if !c.position.is_finite() || !c.forward.is_finite() || c.forward.length_squared() == 0.0 {
+        return Err(VisibilityError::BadCamera(
+            "non-finite position or direction",
+        ));
+    }
+    if (c.width as u64) * (c.height as u64) > u32::MAX as u64 {
+        return Err(VisibilityError::BadCamera("image too large"));
+    }
+    Ok(())
+}
