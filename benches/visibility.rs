@@ -27,7 +27,9 @@ fn bench_mesh(c: &mut Criterion, name: &str, mesh: &Mesh) {
     let mut sorter = Sorter::new(mesh, &topo);
     let policy = SplitPolicy::default();
     // One report line with the stats of a typical view.
-    let o = sorter.order(&camera(mesh, 0, false), &policy).expect("order");
+    let o = sorter
+        .order(&camera(mesh, 0, false), &policy)
+        .expect("order");
     let s = &o.stats;
     eprintln!(
         "{name}: cells {} convex {} split {} problem faces {} nonconvex constraints {} \
@@ -74,7 +76,11 @@ fn visibility(c: &mut Criterion) {
         jitter: 0.2,
         ..planar
     };
-    bench_mesh(c, "grid_convex_planar_faces", &grid(&planar, |_, _, _| true));
+    bench_mesh(
+        c,
+        "grid_convex_planar_faces",
+        &grid(&planar, |_, _, _| true),
+    );
     bench_mesh(c, "grid_convex_warped", &grid(&warped, |_, _, _| true));
     bench_mesh(c, "grid_nonconvex_planar_faces", &holed_grid(&planar));
     bench_mesh(c, "grid_nonconvex_warped", &holed_grid(&warped));

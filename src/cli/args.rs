@@ -6,13 +6,21 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WxH, e.g. 512x512, got '{s}'"))?;
-    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
-    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in '{s}'"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad width in '{s}'"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad height in '{s}'"))?;
     if w == 0 || h == 0 {
         return Err(format!("image size must be positive, got '{s}'"));
     }
     if w > 16384 || h > 16384 {
-        return Err(format!("image size '{s}' is larger than 16384 in one dimension"));
+        return Err(format!(
+            "image size '{s}' is larger than 16384 in one dimension"
+        ));
     }
     Ok((w, h))
 }
@@ -40,7 +48,10 @@ pub fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
 
 /// Parses a finite float.
 pub fn parse_finite(s: &str) -> Result<f64, String> {
-    let v: f64 = s.trim().parse().map_err(|_| format!("not a number: '{s}'"))?;
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("not a number: '{s}'"))?;
     if !v.is_finite() {
         return Err(format!("not a finite number: '{s}'"));
     }

@@ -1,11 +1,8 @@
 //! Command-line parsing and dispatch. Each command lives in its own file;
 //! `anyhow` is used only here, at the edge.
 
-<<<<<<< HEAD
 mod args;
-=======
 mod compare;
->>>>>>> raycast
 mod info;
 mod render;
 
@@ -24,15 +21,12 @@ enum Command {
     /// Print what a file holds: cells by kind, points, bounds, arrays, time
     /// steps, topology and cell-quality counts.
     Info(info::InfoArgs),
-<<<<<<< HEAD
     /// Render one image of a dataset (exact mode through wgpu, or the CPU
     /// reference ray caster).
     Render(render::RenderArgs),
-=======
     /// Compare two images: max absolute, RMS and PSNR over pixels and
     /// channels (float values for two EXR files, else PNG display values).
     Compare(compare::CompareArgs),
->>>>>>> raycast
 }
 
 /// Parses the arguments, runs the command and returns the exit code.
@@ -47,11 +41,8 @@ pub fn run() -> i32 {
     };
     let result = match cli.command {
         Command::Info(args) => info::run(&args),
-<<<<<<< HEAD
         Command::Render(args) => render::run(&args),
-=======
         Command::Compare(args) => compare::run(&args),
->>>>>>> raycast
     };
     match result {
         Ok(()) => 0,

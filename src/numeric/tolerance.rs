@@ -19,10 +19,6 @@ pub const DEGENERATE_VOLUME_REL: f64 = 1e-12;
 /// are always merged; this allows for ASCII round-off).
 pub const MERGE_POINTS_REL: f64 = 1e-12;
 
-<<<<<<< HEAD
-<<<<<<< HEAD
-<<<<<<< HEAD
-<<<<<<< HEAD
 /// Measured maximum absolute error of the exact mode's exponential table
 /// (`gpu::exptable`, 1024^2 texels, log-warped axes, f32 bilinear filtering)
 /// against the exact `1 - exp(-l tau)` over `l, tau` in `{0} + [1e-8, 1e6]`:
@@ -42,15 +38,12 @@ pub const COLOR_REFINE_TOL: f64 = 0.02;
 /// Exact mode: at most this many levels of midpoint refinement per region
 /// triangle for colour accuracy (each level splits a triangle in up to 4).
 pub const COLOR_REFINE_MAX_DEPTH: u32 = 3;
-=======
 /// Integral-function table fills (`integrate::fast`): below this fraction of
 /// the table's scalar range, `|s_b - s_f|` is too small for the difference
 /// quotients `(T(s_b) - T(s_f)) / (s_b - s_f)` (they lose
 /// `log10(|T| / |T_b - T_f|)` digits, math README 8.4) and the point values
 /// at the midpoint scalar are used instead (error O(ds) there).
 pub const INTEGRAL_FUNCTION_MIN_DS_REL: f64 = 1e-7;
->>>>>>> integrate
-=======
 /// Projection (perspective): pieces are clipped at `near * NEAR_CLIP_SCALE`
 /// rather than at the camera's near plane itself, so every clipped point lies
 /// strictly in front of the near plane and projects to a finite pixel
@@ -67,8 +60,6 @@ pub const NEAR_CLIP_SCALE: f64 = 2.0;
 /// thickness below ~1e-3 of the piece's range/diameter (measured: <= 1.2e-3
 /// in close-up wide-angle views) while leaving ordinary views unrefined.
 pub const PERSPECTIVE_INTERP_REL: f64 = 1e-3;
->>>>>>> projection
-=======
 /// Safety factor of the floating-point filter in front of the exact
 /// ray/edge predicate (`raycast::geometry`): the 2D cross product of two
 /// projected vertices is trusted when it exceeds `K eps |a - o| |b - o|`
@@ -98,8 +89,6 @@ pub const NATIVE_INTEGRAL_TOL: f64 = 1e-9;
 /// Native field model: Newton inversion of the iso-parametric map stops when
 /// the parametric step is below this (parametric coordinates are O(1)).
 pub const NATIVE_NEWTON_TOL: f64 = 1e-13;
->>>>>>> raycast
-=======
 /// Error bound factor (times `f64::EPSILON`) of the visibility sort's float
 /// filter for plane-side tests: `|n . eye - d|` is trusted when it exceeds
 /// `PLANE_FILTER_EPS * m * (|eye|_inf + |a|_inf)` (`m` bounds `|n|`), else the
@@ -118,4 +107,3 @@ pub const RASTER_FILTER_PX: f64 = 1e-6;
 /// them intersecting pieces (inverted cells) rather than neighbours whose
 /// shared face depth differs by rounding (~1e-16 relative).
 pub const VALIDATE_OVERLAP_REL: f64 = 1e-9;
->>>>>>> visibility

@@ -42,9 +42,9 @@ use crate::mesh::Mesh;
 use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL};
 use crate::projection::{refine, slice_tet, Polyhedron, Projected, Projector};
 use crate::tf::TransferFunction;
-use crate::visibility::{Piece, SplitPolicy, Sorter};
+use crate::visibility::{Piece, Sorter, SplitPolicy};
 
-use super::scene::{Scene, ScalarsRef};
+use super::scene::{ScalarsRef, Scene};
 use super::RenderError;
 
 /// Pieces processed per parallel chunk.
@@ -159,15 +159,24 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
         match *piece {
             Piece::Cell(c) => {
                 let nodes = ctx.mesh.cells.nodes(c as usize);
-                let (lo, hi) = nodes.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &n| {
-                    let s = ctx.scalar(c, n);
-                    (lo.min(s), hi.max(s))
-                });
+                let (lo, hi) =
+                    nodes
+                        .iter()
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &n| {
+                            let s = ctx.scalar(c, n);
+                            (lo.min(s), hi.max(s))
+                        });
                 if ctx.invisible(lo, hi) {
                     out.culled += 1;
                     continue;
                 }
-                if let Err(e) = poly.set_cell(&ctx.mesh.cells, c as usize, pts, |n| ctx.scalar(c, n), ctx.camera) {
+                if let Err(e) = poly.set_cell(
+                    &ctx.mesh.cells,
+                    c as usize,
+                    pts,
+                    |n| ctx.scalar(c, n),
+                    ctx.camera,
+                ) {
                     out.error = Some(format!("cell {c}: {e}"));
                     return out;
                 }
@@ -253,7 +262,10 @@ pub fn render_exact(
     let total = order.pieces.len();
     for (wi, win) in order.pieces.chunks(window).enumerate() {
         let tp = Instant::now();
-        let outs: Vec<ChunkOut> = win.par_chunks(CHUNK).map(|c| process_chunk(&ctx, c)).collect();
+        let outs: Vec<ChunkOut> = win
+            .par_chunks(CHUNK)
+            .map(|c| process_chunk(&ctx, c))
+            .collect();
         project_s += tp.elapsed().as_secs_f64();
         for out in outs {
             if let Some(e) = out.error {

@@ -23,7 +23,7 @@ use crate::raycast::{self, FieldModel, RaycastOptions, Raycaster};
 use crate::visibility::{Sorter, VisibilityError};
 
 pub use exact::ExactStats;
-pub use scene::{Scene, SceneSpec, ScalarsRef};
+pub use scene::{ScalarsRef, Scene, SceneSpec};
 
 /// The rendering modes that exist.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -51,7 +51,10 @@ impl std::str::FromStr for Mode {
         match s {
             "exact" => Ok(Mode::Exact),
             "raycast" => Ok(Mode::Raycast),
-            _ => Err(format!("unknown mode '{s}' (available: {})", Mode::NAMES.join(", "))),
+            _ => Err(format!(
+                "unknown mode '{s}' (available: {})",
+                Mode::NAMES.join(", ")
+            )),
         }
     }
 }

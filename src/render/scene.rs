@@ -78,12 +78,12 @@ impl Scene {
             1.0
         };
         let file_tf = match &spec.tf_file {
-            Some(p) => Some(TransferFunction::from_json_file(p, default_unit).map_err(|e| {
-                RenderError::Tf {
+            Some(p) => Some(
+                TransferFunction::from_json_file(p, default_unit).map_err(|e| RenderError::Tf {
                     path: p.display().to_string(),
                     msg: e.to_string(),
-                }
-            })?),
+                })?,
+            ),
             None => None,
         };
         let field_name = spec

@@ -55,7 +55,11 @@ const VIRIDIS: Poly = [
     [-5.435455855934631, 4.645852612178535, 26.3124352495832],
 ];
 const INFERNO: Poly = [
-    [0.0002189403691192265, 0.001651004631001012, -0.01948089843709184],
+    [
+        0.0002189403691192265,
+        0.001651004631001012,
+        -0.01948089843709184,
+    ],
     [0.1065134194856116, 0.5639564367884091, 3.932712388889277],
     [11.60249308247187, -3.972853965665698, -15.9423941062914],
     [-41.70399613139459, 17.43639888205313, 44.35414519872813],
@@ -64,7 +68,11 @@ const INFERNO: Poly = [
     [25.13112622477341, -12.24266895238567, -23.07032500287172],
 ];
 const MAGMA: Poly = [
-    [-0.002136485053939582, -0.000749655052795221, -0.005386127855323933],
+    [
+        -0.002136485053939582,
+        -0.000749655052795221,
+        -0.005386127855323933,
+    ],
     [0.2516605407371642, 0.6775232436837668, 2.494026599312351],
     [8.353717279216625, -3.577719514958484, 0.3144679030132573],
     [-27.66873308576866, 14.26473078096533, -13.64921318813922],
@@ -201,7 +209,10 @@ pub fn preset(
             });
         }
     }
-    let tau: Vec<(f64, [f64; 1])> = op.iter().map(|&(x, o)| (at(x), [o / unit_distance])).collect();
+    let tau: Vec<(f64, [f64; 1])> = op
+        .iter()
+        .map(|&(x, o)| (at(x), [o / unit_distance]))
+        .collect();
     let mut tf = TransferFunction::from_channels(&tau, &col, None, EmissionModel::Glow)?;
     tf.unit_distance = Some(unit_distance);
     Ok(tf)
@@ -258,8 +269,14 @@ mod tests {
         let c0 = v.color_at(0.0);
         let c1 = v.color_at(1.0);
         // matplotlib viridis ends: (0.267, 0.005, 0.329) and (0.993, 0.906, 0.144).
-        assert!((c0[0] - 0.267).abs() < 0.02 && (c0[2] - 0.329).abs() < 0.02, "{c0:?}");
-        assert!((c1[0] - 0.993).abs() < 0.02 && (c1[1] - 0.906).abs() < 0.02, "{c1:?}");
+        assert!(
+            (c0[0] - 0.267).abs() < 0.02 && (c0[2] - 0.329).abs() < 0.02,
+            "{c0:?}"
+        );
+        assert!(
+            (c1[0] - 0.993).abs() < 0.02 && (c1[1] - 0.906).abs() < 0.02,
+            "{c1:?}"
+        );
         let cw = preset("cool-warm", (0.0, 1.0), 1.0, Opacity::Ramp).unwrap();
         let mid = cw.color_at(0.5);
         assert!((mid[0] - 0.865).abs() < 1e-9, "{mid:?}");
@@ -271,7 +288,16 @@ mod tests {
 
     #[test]
     fn step_opacity_is_a_jump_and_default_handles_empty_range() {
-        let tf = preset("grayscale", (0.0, 4.0), 0.5, Opacity::Step { at: 0.5, opacity: 0.8 }).unwrap();
+        let tf = preset(
+            "grayscale",
+            (0.0, 4.0),
+            0.5,
+            Opacity::Step {
+                at: 0.5,
+                opacity: 0.8,
+            },
+        )
+        .unwrap();
         assert_eq!(tf.tau_at(1.999), 0.0);
         assert!((tf.tau_at(2.0) - 1.6).abs() < 1e-15);
         let d = TransferFunction::default_for((3.0, 3.0), 20.0);
