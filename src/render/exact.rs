@@ -219,6 +219,53 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
     out
 }
 
+/// The scalar values at which pieces must be split for the per-pixel opacity
+/// to be exact: every breakpoint of the extinction (a kink or a jump) and
+/// every jump of the colour. Colour kinks alone are not split: vertex values
+/// stay exact there and the interpolated `C/alpha` is bounded by the colour
+/// refinement ([`COLOR_REFINE_TOL`]).
+pub fn split_points(tf: &TransferFunction) -> Vec<f64> {
+    let nodes = tf.nodes();
+    let mut out: Vec<f64> = Vec::new();
+    let slope = |a: &crate::tf::Node, b: &crate::tf::Node| -> Option<f64> {
+        let ds = b.s - a.s;
+        (ds > 0.0).then(|| (b.tau - a.tau) / ds)
+    };
+    for i in 0..nodes.len() {
+        let n = &nodes[i];
+        if i + 1 < nodes.len() && nodes[i + 1].s == n.s {
+            // A jump: two nodes at one scalar.
+            let m = &nodes[i + 1];
+            let colour_jump = (0..3).any(|k| n.color[k] != m.color[k] || n.emission[k] != m.emission[k]);
+            if n.tau != m.tau || colour_jump {
+                out.push(n.s);
+            }
+            continue;
+        }
+        if i == 0 || i + 1 >= nodes.len() || nodes[i - 1].s == n.s {
+            // Ends of the node range, or the right node of a jump (handled).
+            if i > 0 && i + 1 < nodes.len() && nodes[i - 1].s == n.s {
+                continue;
+            }
+            // The TF is constant outside the node range: a kink at each end
+            // when the extinction slopes inside.
+            let inner = if i == 0 { nodes.get(1) } else { nodes.get(i.wrapping_sub(1)) };
+            if let Some(m) = inner {
+                if m.tau != n.tau {
+                    out.push(n.s);
+                }
+            }
+            continue;
+        }
+        let (l, r) = (slope(&nodes[i - 1], n), slope(n, &nodes[i + 1]));
+        if l != r {
+            out.push(n.s);
+        }
+    }
+    out.dedup();
+    out
+}
+
 /// Renders the scene in the exact mode through `ctx`.
 pub fn render_exact(
     scene: &Scene,
@@ -230,7 +277,7 @@ pub fn render_exact(
     mut progress: impl FnMut(usize, usize),
 ) -> Result<(Image, ExactStats), RenderError> {
     let mut stats = ExactStats::default();
-    let breakpoints = scene.tf.breakpoints().to_vec();
+    let breakpoints = split_points(&scene.tf);
     let point_scalars = match scene.scalars() {
         ScalarsRef::Point(v) => Some(v),
         _ => None,
