@@ -33,7 +33,12 @@ impl Rng {
 }
 
 fn jump_tf() -> TransferFunction {
-    let n = |s, tau, c: [f64; 3]| Node { s, tau, color: c, emission: [0.0; 3] };
+    let n = |s, tau, c: [f64; 3]| Node {
+        s,
+        tau,
+        color: c,
+        emission: [0.0; 3],
+    };
     TransferFunction::from_nodes(
         &[
             n(0.0, 0.0, [1.0, 0.0, 0.0]),
@@ -67,7 +72,11 @@ struct CpuTime {
 
 impl CpuTime {
     fn new(clock: Clock) -> Self {
-        Self { clock, wall: WallTime, origin: Instant::now() }
+        Self {
+            clock,
+            wall: WallTime,
+            origin: Instant::now(),
+        }
     }
 
     #[cfg(unix)]
@@ -76,7 +85,10 @@ impl CpuTime {
             Clock::Thread => libc::CLOCK_THREAD_CPUTIME_ID,
             Clock::Process => libc::CLOCK_PROCESS_CPUTIME_ID,
         };
-        let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+        let mut ts = libc::timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
         // SAFETY: clock_gettime writes one timespec through a valid pointer.
         if unsafe { libc::clock_gettime(id, &mut ts) } == 0 {
             ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
@@ -128,15 +140,30 @@ fn segments(c: &mut Criterion<CpuTime>) {
             let p = (r.next() * (br.len() - 1) as f64) as usize;
             let (lo, hi) = (br[p], br[p + 1]);
             let sf = lo + (hi - lo) * r.next();
-            let sb = if i % 8 == 0 { sf } else { lo + (hi - lo) * r.next() };
+            let sb = if i % 8 == 0 {
+                sf
+            } else {
+                lo + (hi - lo) * r.next()
+            };
             (10f64.powf(r.next() * 3.0 - 2.0), sf, sb)
         })
         .collect();
     let crossing: Vec<(f64, f64, f64)> = (0..BATCH)
-        .map(|_| (10f64.powf(r.next() * 3.0 - 2.0), 0.3 * r.next(), 0.7 + 0.3 * r.next()))
+        .map(|_| {
+            (
+                10f64.powf(r.next() * 3.0 - 2.0),
+                0.3 * r.next(),
+                0.7 + 0.3 * r.next(),
+            )
+        })
         .collect();
     let ab: Vec<(f64, f64)> = (0..BATCH)
-        .map(|_| (10f64.powf(r.next() * 5.0 - 2.0), 10f64.powf(r.next() * 5.0 - 2.0)))
+        .map(|_| {
+            (
+                10f64.powf(r.next() * 5.0 - 2.0),
+                10f64.powf(r.next() * 5.0 - 2.0),
+            )
+        })
         .collect();
 
     let mut g = c.benchmark_group("segment");
@@ -184,17 +211,26 @@ fn tables(c: &mut Criterion<CpuTime>) {
     let tf = jump_tf();
     let mut g = c.benchmark_group("table");
     g.sample_size(10);
-    for (ns, nl) in [(128usize, 64usize)] {
-        g.bench_with_input(BenchmarkId::new("3d_exact", format!("{ns}x{ns}x{nl}")), &(ns, nl), |b, &(ns, nl)| {
-            b.iter(|| Table3d::exact(&tf, ns, nl, (0.0, 1.0), 1.0).expect("table"))
-        });
-        g.bench_with_input(BenchmarkId::new("3d_integral_functions", format!("{ns}x{ns}x{nl}")), &(ns, nl), |b, &(ns, nl)| {
-            b.iter(|| Table3d::fast(&tf, ns, nl, (0.0, 1.0), 1.0, FastColour::MeanGlow).expect("table"))
-        });
-    }
+    let (ns, nl) = (128usize, 64usize);
+    g.bench_with_input(
+        BenchmarkId::new("3d_exact", format!("{ns}x{ns}x{nl}")),
+        &(ns, nl),
+        |b, &(ns, nl)| b.iter(|| Table3d::exact(&tf, ns, nl, (0.0, 1.0), 1.0).expect("table")),
+    );
+    g.bench_with_input(
+        BenchmarkId::new("3d_integral_functions", format!("{ns}x{ns}x{nl}")),
+        &(ns, nl),
+        |b, &(ns, nl)| {
+            b.iter(|| {
+                Table3d::fast(&tf, ns, nl, (0.0, 1.0), 1.0, FastColour::MeanGlow).expect("table")
+            })
+        },
+    );
     // A TF edit confined to [0.9, 1.0] touches about 19% of the (s_f, s_b) pairs.
     let mut t = Table3d::exact(&tf, 128, 64, (0.0, 1.0), 1.0).expect("table");
-    g.bench_function("3d_exact_local_update_0.9_1.0", |b| b.iter(|| t.update(&tf, 0.9, 1.0)));
+    g.bench_function("3d_exact_local_update_0.9_1.0", |b| {
+        b.iter(|| t.update(&tf, 0.9, 1.0))
+    });
     g.bench_function("cylinder_exact_64x64x256", |b| {
         b.iter(|| CylinderTable::new(&tf, 64, 256, (0.0, 1.0), 1.0).expect("table"))
     });

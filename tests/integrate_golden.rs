@@ -3,6 +3,9 @@
 //! and through a two-node transfer function) and 10 whole rays, within the
 //! file's recommended tolerances. Skips when the shared folder is absent.
 
+// Channels are compared across parallel arrays by index.
+#![allow(clippy::needless_range_loop)]
+
 use serde_json::Value;
 use zoovr::integrate::{self, weights};
 use zoovr::tf::{EmissionModel, Node, TransferFunction};
@@ -44,7 +47,12 @@ fn golden_segments() {
         let inp = &seg["inputs"];
         let exp = &seg["expected"];
         let (l, tf_, tb) = (f(&inp["l"]), f(&inp["tau_f"]), f(&inp["tau_b"]));
-        let (cf, cb, ef, eb) = (rgb(&inp["c_f"]), rgb(&inp["c_b"]), rgb(&inp["E_f"]), rgb(&inp["E_b"]));
+        let (cf, cb, ef, eb) = (
+            rgb(&inp["c_f"]),
+            rgb(&inp["c_b"]),
+            rgb(&inp["E_f"]),
+            rgb(&inp["E_b"]),
+        );
         let (a, b) = (tf_ * l, tb * l);
         let w = weights(a, b);
         for (name, got) in [
@@ -64,14 +72,29 @@ fn golden_segments() {
         let ce = rgb(&exp["C_emission"]);
         for k in 0..3 {
             close(cf[k] * w.w_f + cb[k] * w.w_b, ca[k], "C_associated", id);
-            close(l * (ef[k] * w.phi_f + eb[k] * w.phi_b), ce[k], "C_emission", id);
+            close(
+                l * (ef[k] * w.phi_f + eb[k] * w.phi_b),
+                ce[k],
+                "C_emission",
+                id,
+            );
         }
         // The same segment through a transfer function (scalar 0 -> 1 over
         // one linear piece), both models.
         for (model, expected) in [(EmissionModel::Glow, ca), (EmissionModel::Independent, ce)] {
             let nodes = [
-                Node { s: 0.0, tau: tf_, color: cf, emission: ef },
-                Node { s: 1.0, tau: tb, color: cb, emission: eb },
+                Node {
+                    s: 0.0,
+                    tau: tf_,
+                    color: cf,
+                    emission: ef,
+                },
+                Node {
+                    s: 1.0,
+                    tau: tb,
+                    color: cb,
+                    emission: eb,
+                },
             ];
             let tf = TransferFunction::from_nodes(&nodes, model).expect("valid");
             let v = integrate::segment(&tf, l, 0.0, 1.0);
@@ -89,7 +112,12 @@ fn ray_tf(tf: &Value, model: EmissionModel) -> TransferFunction {
     let c: Vec<[f64; 3]> = tf["c"].as_array().expect("c").iter().map(rgb).collect();
     let e: Vec<[f64; 3]> = tf["E"].as_array().expect("E").iter().map(rgb).collect();
     let nodes: Vec<Node> = (0..s.len())
-        .map(|i| Node { s: s[i], tau: tau[i], color: c[i], emission: e[i] })
+        .map(|i| Node {
+            s: s[i],
+            tau: tau[i],
+            color: c[i],
+            emission: e[i],
+        })
         .collect();
     TransferFunction::from_nodes(&nodes, model).expect("valid golden TF")
 }
@@ -107,7 +135,10 @@ fn golden_rays() {
             .iter()
             .map(|c| (f(&c[0]), f(&c[1]), f(&c[2])))
             .collect();
-        for (model, key) in [(EmissionModel::Glow, "associated"), (EmissionModel::Independent, "emission")] {
+        for (model, key) in [
+            (EmissionModel::Glow, "associated"),
+            (EmissionModel::Independent, "emission"),
+        ] {
             let tf = ray_tf(&ray["tf"], model);
             let (c, alpha) = integrate::ray(&tf, &cells);
             let exp = &ray["expected"][key];

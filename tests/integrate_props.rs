@@ -3,6 +3,9 @@
 //! (composite 5-point Gauss-Legendre on panels adapted to the optical depth,
 //! no special functions, no series).
 
+// Channels are compared across parallel arrays by index.
+#![allow(clippy::needless_range_loop)]
+
 use proptest::prelude::*;
 use zoovr::integrate::{self, weights, RayAccumulator, RayMaterial};
 use zoovr::tf::{EmissionModel, Node, TransferFunction};
@@ -11,7 +14,13 @@ use zoovr::tf::{EmissionModel, Node, TransferFunction};
 fn arb_tf() -> impl Strategy<Value = TransferFunction> {
     (
         prop::collection::vec(
-            (0.0f64..1.0, 0.0f64..1.0, prop::array::uniform3(0.0f64..1.0), prop::array::uniform3(0.0f64..2.0), any::<bool>()),
+            (
+                0.0f64..1.0,
+                0.0f64..1.0,
+                prop::array::uniform3(0.0f64..1.0),
+                prop::array::uniform3(0.0f64..2.0),
+                any::<bool>(),
+            ),
             2..7,
         ),
         -3.0f64..3.0,
@@ -23,12 +32,26 @@ fn arb_tf() -> impl Strategy<Value = TransferFunction> {
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut nodes = Vec::new();
             for (i, (s, t, c, e, jump)) in pts.iter().enumerate() {
-                nodes.push(Node { s: *s, tau: t * scale, color: *c, emission: *e });
+                nodes.push(Node {
+                    s: *s,
+                    tau: t * scale,
+                    color: *c,
+                    emission: *e,
+                });
                 if *jump && i > 0 && i + 1 < pts.len() {
-                    nodes.push(Node { s: *s, tau: (1.0 - t) * scale, color: [c[2], c[0], c[1]], emission: *e });
+                    nodes.push(Node {
+                        s: *s,
+                        tau: (1.0 - t) * scale,
+                        color: [c[2], c[0], c[1]],
+                        emission: *e,
+                    });
                 }
             }
-            let model = if independent { EmissionModel::Independent } else { EmissionModel::Glow };
+            let model = if independent {
+                EmissionModel::Independent
+            } else {
+                EmissionModel::Glow
+            };
             TransferFunction::from_nodes(&nodes, model).expect("valid random TF")
         })
 }
@@ -137,7 +160,9 @@ fn reference(a: f64, b: f64) -> [f64; 5] {
         // Panel: depth grows by at most ~0.2 (rate taken at the panel end
         // too, for increasing extinction).
         let rate = a + d * x;
-        let h0 = (0.2 / rate.max(1e-300)).min(0.3 / sq.max(1e-300)).min(0.125);
+        let h0 = (0.2 / rate.max(1e-300))
+            .min(0.3 / sq.max(1e-300))
+            .min(0.125);
         let h = h0.min(0.2 / (a + d * (x + h0)).max(1e-300)).min(1.0 - x);
         for &(t, w) in &GL5 {
             let xi = x + 0.5 * h * (t + 1.0);
@@ -190,7 +215,7 @@ fn sample(r: &mut Rng) -> (f64, f64) {
             (l * r.log_uniform(-2.0, 3.0), l * r.log_uniform(-2.0, 3.0))
         }
         8 => (1.5 + r.next(), 3.0 * r.next()), // around the small-depth switch
-        _ => (r.log_uniform(-8.0, -2.0), r.log_uniform(0.0, 6.0)),   // steep
+        _ => (r.log_uniform(-8.0, -2.0), r.log_uniform(0.0, 6.0)), // steep
     }
 }
 
@@ -203,10 +228,16 @@ fn stress(n: usize) {
         let w = weights(a, b);
         let got = [w.psi, w.phi_f, w.phi_b, w.w_f, w.w_b];
         assert!(
-            got.iter().chain([w.alpha, w.t].iter()).all(|v| v.is_finite()),
+            got.iter()
+                .chain([w.alpha, w.t].iter())
+                .all(|v| v.is_finite()),
             "non-finite at a={a:e} b={b:e}: {w:?}"
         );
-        assert!((0.0..=1.0).contains(&w.alpha), "alpha {} at {a:e} {b:e}", w.alpha);
+        assert!(
+            (0.0..=1.0).contains(&w.alpha),
+            "alpha {} at {a:e} {b:e}",
+            w.alpha
+        );
         // Check against the reference on a fixed subset (every 4th sample).
         if i % 4 == 0 {
             let re = reference(a, b);
@@ -225,8 +256,10 @@ fn stress(n: usize) {
             }
         }
     }
-    eprintln!("stress n={n}: worst rel err psi {:.1e} phi_f {:.1e} phi_b {:.1e} w_f {:.1e} w_b {:.1e}",
-        worst[0], worst[1], worst[2], worst[3], worst[4]);
+    eprintln!(
+        "stress n={n}: worst rel err psi {:.1e} phi_f {:.1e} phi_b {:.1e} w_f {:.1e} w_b {:.1e}",
+        worst[0], worst[1], worst[2], worst[3], worst[4]
+    );
 }
 
 /// 1e6 samples, reference on every 4th (about 2 s at opt-level 1).
@@ -254,12 +287,20 @@ fn stress_transfer_function_segments_stay_finite() {
                 emission: [r.next(), r.next(), r.next()],
             })
             .collect();
-        let model = if t % 2 == 0 { EmissionModel::Glow } else { EmissionModel::Independent };
+        let model = if t % 2 == 0 {
+            EmissionModel::Glow
+        } else {
+            EmissionModel::Independent
+        };
         let tf = TransferFunction::from_nodes(&nodes, model).expect("valid");
         let m = tf.max_source();
         for _ in 0..500 {
             let sf = r.next() * 1.4 - 0.2;
-            let sb = if r.next() < 0.3 { sf + (r.next() - 0.5) * 1e-12 } else { r.next() * 1.4 - 0.2 };
+            let sb = if r.next() < 0.3 {
+                sf + (r.next() - 0.5) * 1e-12
+            } else {
+                r.next() * 1.4 - 0.2
+            };
             let l = r.log_uniform(-15.0, 0.0);
             let v = tf.segment(l, sf, sb);
             assert!(v.alpha.is_finite() && (0.0..=1.0).contains(&v.alpha));
@@ -287,9 +328,11 @@ fn hostile_inputs_do_not_produce_nan() {
         (1.0, -1e308, 1e308),
     ] {
         let v = tf.segment(l, sf, sb);
-        assert!(v.alpha.is_finite() && v.color.iter().all(|c| c.is_finite()), "{l} {sf} {sb}: {v:?}");
+        assert!(
+            v.alpha.is_finite() && v.color.iter().all(|c| c.is_finite()),
+            "{l} {sf} {sb}: {v:?}"
+        );
         let vv = integrate::vertex_values(&tf, l, sf, sb);
         assert!(vv.glow.iter().all(|c| c.is_finite()) && vv.tau_mean.is_finite());
     }
 }
-

@@ -3,6 +3,9 @@
 //! against the exact integral over a dense random sample, as a function of
 //! resolution (printed with `--nocapture`; thresholds asserted).
 
+// Channels are compared across parallel arrays by index.
+#![allow(clippy::needless_range_loop)]
+
 use zoovr::integrate::cylinder::{cyl_to_table, CylinderTable};
 use zoovr::integrate::fast::FastColour;
 use zoovr::integrate::table2d::{Table2d, Table2dKind};
@@ -11,7 +14,12 @@ use zoovr::integrate::{self, TableError};
 use zoovr::tf::{EmissionModel, Node, TransferFunction};
 
 fn node(s: f64, tau: f64, c: [f64; 3]) -> Node {
-    Node { s, tau, color: c, emission: [0.0; 3] }
+    Node {
+        s,
+        tau,
+        color: c,
+        emission: [0.0; 3],
+    }
 }
 
 /// Smooth TF (no jumps), extinction up to 6.
@@ -58,7 +66,12 @@ impl Rng {
 
 /// `(C rms, C max, alpha rms, alpha max)` of a lookup against the exact
 /// integral over `n` random segments, `s in [0, 1]`, `l in [0, l_max]`.
-fn measure(tf: &TransferFunction, l_max: f64, n: usize, lookup: impl Fn(f64, f64, f64) -> [f64; 4]) -> [f64; 4] {
+fn measure(
+    tf: &TransferFunction,
+    l_max: f64,
+    n: usize,
+    lookup: impl Fn(f64, f64, f64) -> [f64; 4],
+) -> [f64; 4] {
     let mut r = Rng(0xDEAD_BEEF_1234_5678);
     let (mut c2, mut cm, mut a2, mut am) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for _ in 0..n {
@@ -78,7 +91,10 @@ fn measure(tf: &TransferFunction, l_max: f64, n: usize, lookup: impl Fn(f64, f64
 }
 
 fn row(name: &str, res: &str, e: [f64; 4]) {
-    eprintln!("| {name} | {res} | {:.1e} | {:.1e} | {:.1e} | {:.1e} |", e[0], e[1], e[2], e[3]);
+    eprintln!(
+        "| {name} | {res} | {:.1e} | {:.1e} | {:.1e} | {:.1e} |",
+        e[0], e[1], e[2], e[3]
+    );
 }
 
 #[test]
@@ -138,7 +154,12 @@ fn fast_fill_has_exact_opacity_and_bounded_colour() {
             for k in 0..9 {
                 let e = integrate::segment(&tf, k as f64 / 8.0, i as f64 / 32.0, j as f64 / 32.0);
                 let tx = f.texel(i, j, k);
-                assert!((tx[3] - e.alpha).abs() < 1e-6, "alpha {} vs {}", tx[3], e.alpha);
+                assert!(
+                    (tx[3] - e.alpha).abs() < 1e-6,
+                    "alpha {} vs {}",
+                    tx[3],
+                    e.alpha
+                );
                 // Mean glow x alpha: bounded by the colour range (<= 1).
                 assert!(tx[..3].iter().all(|&c| (0.0..=1.0 + 1e-6).contains(&c)));
             }
@@ -184,10 +205,22 @@ fn table_error_report() {
 
 fn error_tables(full: bool) {
     let n = if full { 4000 } else { 1500 };
-    let res3: &[(usize, usize)] = if full { &[(16, 16), (32, 16), (64, 32), (128, 64)] } else { &[(16, 16), (32, 16), (64, 32)] };
-    let res_fast: &[(usize, usize)] = if full { &[(64, 32), (128, 64)] } else { &[(64, 32)] };
+    let res3: &[(usize, usize)] = if full {
+        &[(16, 16), (32, 16), (64, 32), (128, 64)]
+    } else {
+        &[(16, 16), (32, 16), (64, 32)]
+    };
+    let res_fast: &[(usize, usize)] = if full {
+        &[(64, 32), (128, 64)]
+    } else {
+        &[(64, 32)]
+    };
     let res2: &[usize] = if full { &[64, 256] } else { &[64] };
-    let res_cyl: &[(usize, usize)] = if full { &[(32, 32), (64, 64), (64, 256), (128, 128), (128, 512)] } else { &[(32, 32), (64, 128)] };
+    let res_cyl: &[(usize, usize)] = if full {
+        &[(32, 32), (64, 64), (64, 256), (128, 128), (128, 512)]
+    } else {
+        &[(32, 32), (64, 128)]
+    };
     let l_max = 1.0;
     eprintln!("| table | resolution | C rms | C max | alpha rms | alpha max |");
     eprintln!("| --- | --- | --- | --- | --- | --- |");
@@ -196,7 +229,11 @@ fn error_tables(full: bool) {
         for &(ns, nl) in res3 {
             let t = Table3d::exact(&tf, ns, nl, (0.0, 1.0), l_max).unwrap();
             let e = measure(&tf, l_max, n, |a, b, l| t.lookup(a, b, l));
-            row(&format!("3D exact, {tf_name}"), &format!("{ns}x{ns}x{nl}"), e);
+            row(
+                &format!("3D exact, {tf_name}"),
+                &format!("{ns}x{ns}x{nl}"),
+                e,
+            );
             assert!(e[0] < prev_rms, "3D error must fall with resolution");
             prev_rms = e[0];
             if ns == 64 && tf_name == "smooth" {
@@ -206,23 +243,43 @@ fn error_tables(full: bool) {
         for &(ns, nl) in res_fast {
             let t = Table3d::fast(&tf, ns, nl, (0.0, 1.0), l_max, FastColour::MeanGlow).unwrap();
             let e = measure(&tf, l_max, n, |a, b, l| t.lookup(a, b, l));
-            row(&format!("3D integral functions (mean glow), {tf_name}"), &format!("{ns}x{ns}x{nl}"), e);
-            let t = Table3d::fast(&tf, ns, nl, (0.0, 1.0), l_max, FastColour::NoAttenuation).unwrap();
+            row(
+                &format!("3D integral functions (mean glow), {tf_name}"),
+                &format!("{ns}x{ns}x{nl}"),
+                e,
+            );
+            let t =
+                Table3d::fast(&tf, ns, nl, (0.0, 1.0), l_max, FastColour::NoAttenuation).unwrap();
             let e2 = measure(&tf, l_max, n, |a, b, l| t.lookup(a, b, l));
-            row(&format!("3D integral functions (no attenuation), {tf_name}"), &format!("{ns}x{ns}x{nl}"), e2);
+            row(
+                &format!("3D integral functions (no attenuation), {tf_name}"),
+                &format!("{ns}x{ns}x{nl}"),
+                e2,
+            );
             assert!(e[0] < e2[0], "mean glow beats no attenuation");
         }
         for &ns in res2 {
-            for (kind, name) in [(Table2dKind::LinearInL, "2D linear in l"), (Table2dKind::DepthGlow, "2D depth + glow")] {
+            for (kind, name) in [
+                (Table2dKind::LinearInL, "2D linear in l"),
+                (Table2dKind::DepthGlow, "2D depth + glow"),
+            ] {
                 let t = Table2d::new(&tf, ns, (0.0, 1.0), 0.5 * l_max, kind).unwrap();
                 let e = measure(&tf, l_max, n, |a, b, l| t.lookup(a, b, l));
-                row(&format!("{name}, {tf_name}"), &format!("{ns}x{ns}, l_ref = 0.5"), e);
+                row(
+                    &format!("{name}, {tf_name}"),
+                    &format!("{ns}x{ns}, l_ref = 0.5"),
+                    e,
+                );
             }
         }
         for &(ns, planes) in res_cyl {
             let t = CylinderTable::new(&tf, ns, planes, (0.0, 1.0), l_max).unwrap();
             let e = measure(&tf, l_max, n, |a, b, l| t.lookup(a, b, l));
-            row(&format!("cylindrical, {tf_name}"), &format!("{ns}x{ns}x{planes} planes"), e);
+            row(
+                &format!("cylindrical, {tf_name}"),
+                &format!("{ns}x{ns}x{planes} planes"),
+                e,
+            );
             if tf_name == "smooth" && ns == 64 {
                 assert!(e[1] < 0.03 && e[3] < 0.03, "{e:?}");
             }

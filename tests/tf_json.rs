@@ -7,7 +7,9 @@ use zoovr::tf::{EmissionModel, TfError, TransferFunction};
 
 #[test]
 fn bench_tf_loads_as_is() {
-    let Some(p) = zoovr::testdata::shared_file("synthetic/bench_tf.json") else { return };
+    let Some(p) = zoovr::testdata::shared_file("synthetic/bench_tf.json") else {
+        return;
+    };
     let tf = TransferFunction::from_json_file(&p, 123.0).expect("bench_tf.json loads");
     assert_eq!(tf.scalar.as_deref(), Some("f"));
     assert_eq!(tf.unit_distance, Some(0.5));
@@ -93,7 +95,8 @@ fn paraview_colour_maps() {
     let mid = tf.color_at(0.5);
     assert!((mid[0] - mid[2]).abs() < 0.15, "{mid:?}");
     // Non-default midpoint/sharpness: resampled, stays within the end values.
-    let sharp = r#"{ "RGBPoints": [0, 1, 1, 1, 1, 1, 1, 1], "Points": [0, 0, 0.3, 0.5, 1, 1, 0.5, 0] }"#;
+    let sharp =
+        r#"{ "RGBPoints": [0, 1, 1, 1, 1, 1, 1, 1], "Points": [0, 0, 0.3, 0.5, 1, 1, 0.5, 0] }"#;
     let tf = TransferFunction::from_json_str(sharp, 1.0).expect("loads");
     assert_eq!(tf.breakpoints().len(), 33);
     assert!((0.0..=1.0).contains(&tf.tau_at(0.3)));
@@ -111,14 +114,19 @@ fn bad_files_give_typed_errors() {
         e => panic!("{e}"),
     }
     // NaN is not JSON.
-    assert!(matches!(err(r#"{"points": [{"s": NaN, "tau": 1, "rgb": [0,0,0]}]}"#), TfError::Json { .. }));
+    assert!(matches!(
+        err(r#"{"points": [{"s": NaN, "tau": 1, "rgb": [0,0,0]}]}"#),
+        TfError::Json { .. }
+    ));
     // Type error also located.
     match err("{\n \"points\": [{\"s\": \"zero\", \"tau\": 1, \"rgb\": [0,0,0]}]}") {
         TfError::Json { line, .. } => assert_eq!(line, 2),
         e => panic!("{e}"),
     }
     assert!(matches!(
-        err(r#"{"points": [{"s": 1, "tau": 1, "rgb": [0,0,0]}, {"s": 0, "tau": 1, "rgb": [0,0,0]}]}"#),
+        err(
+            r#"{"points": [{"s": 1, "tau": 1, "rgb": [0,0,0]}, {"s": 0, "tau": 1, "rgb": [0,0,0]}]}"#
+        ),
         TfError::Unsorted { index: 1, .. }
     ));
     assert!(matches!(
@@ -130,16 +138,28 @@ fn bad_files_give_typed_errors() {
         err(r#"{"points": [{"s": 0, "tau": 1e150, "rgb": [0,0,0]}]}"#),
         TfError::OutOfRange { .. }
     ));
-    assert!(matches!(err(r#"{"zoovr_tf": 2, "points": []}"#), TfError::Version(2)));
+    assert!(matches!(
+        err(r#"{"zoovr_tf": 2, "points": []}"#),
+        TfError::Version(2)
+    ));
     assert!(matches!(
         err(r#"{"points": [{"s": 0, "opacity": 1.5, "rgb": [0,0,0]}]}"#),
         TfError::OpacityRange { .. }
     ));
     assert!(matches!(err(r#"{"pionts": []}"#), TfError::Json { .. }));
-    assert!(matches!(err(r#"{"points": [{"s": 0, "rgb": [0,0,0]}]}"#), TfError::Format(_)));
-    assert!(matches!(err(r#"{"RGBPoints": [0, 1, 1]}"#), TfError::Format(_)));
+    assert!(matches!(
+        err(r#"{"points": [{"s": 0, "rgb": [0,0,0]}]}"#),
+        TfError::Format(_)
+    ));
+    assert!(matches!(
+        err(r#"{"RGBPoints": [0, 1, 1]}"#),
+        TfError::Format(_)
+    ));
     assert!(matches!(err(r#"[]"#), TfError::Empty));
-    assert!(matches!(err(r#"{"RGBPoints": [1, 0, 0, 0, 0, 1, 1, 1]}"#), TfError::Unsorted { .. }));
+    assert!(matches!(
+        err(r#"{"RGBPoints": [1, 0, 0, 0, 0, 1, 1, 1]}"#),
+        TfError::Unsorted { .. }
+    ));
     assert!(matches!(
         TransferFunction::from_json_str(PROJECT.replace("0.5,\n", "-1,\n").as_str(), 1.0),
         Err(TfError::UnitDistance(_))

@@ -115,7 +115,14 @@ fn source(tau: f64, c: [f64; 3], glow: bool) -> [f64; 3] {
 /// Integral of `tau` and of the source over one linear piece of width `h`
 /// (Simpson: exact for the quadratic `tau c`).
 #[inline]
-fn piece_integral(h: f64, t0: f64, t1: f64, c0: [f64; 3], c1: [f64; 3], glow: bool) -> (f64, [f64; 3]) {
+fn piece_integral(
+    h: f64,
+    t0: f64,
+    t1: f64,
+    c0: [f64; 3],
+    c1: [f64; 3],
+    glow: bool,
+) -> (f64, [f64; 3]) {
     let dt = 0.5 * h * (t0 + t1);
     let dk = if glow {
         let tm = 0.5 * (t0 + t1);
@@ -154,7 +161,10 @@ pub(crate) fn approx_rgba(
     let (tau_mean, g_mean) = if ds.abs() > min_ds {
         let ((tf, kf), (tb, kb)) = ends;
         let inv = 1.0 / ds;
-        (((tb - tf) * inv).max(0.0), std::array::from_fn(|k| ((kb[k] - kf[k]) * inv).max(0.0)))
+        (
+            ((tb - tf) * inv).max(0.0),
+            std::array::from_fn(|k| ((kb[k] - kf[k]) * inv).max(0.0)),
+        )
     } else {
         mid()
     };
@@ -181,10 +191,30 @@ mod tests {
     #[test]
     fn integral_functions_match_quadrature() {
         let nodes = [
-            Node { s: 0.0, tau: 1.0, color: [0.0, 1.0, 0.5], emission: [0.0; 3] },
-            Node { s: 1.0, tau: 3.0, color: [1.0, 0.0, 0.5], emission: [0.0; 3] },
-            Node { s: 1.0, tau: 0.5, color: [0.2, 0.2, 0.2], emission: [0.0; 3] },
-            Node { s: 2.5, tau: 2.0, color: [0.9, 0.1, 0.4], emission: [0.0; 3] },
+            Node {
+                s: 0.0,
+                tau: 1.0,
+                color: [0.0, 1.0, 0.5],
+                emission: [0.0; 3],
+            },
+            Node {
+                s: 1.0,
+                tau: 3.0,
+                color: [1.0, 0.0, 0.5],
+                emission: [0.0; 3],
+            },
+            Node {
+                s: 1.0,
+                tau: 0.5,
+                color: [0.2, 0.2, 0.2],
+                emission: [0.0; 3],
+            },
+            Node {
+                s: 2.5,
+                tau: 2.0,
+                color: [0.9, 0.1, 0.4],
+                emission: [0.0; 3],
+            },
         ];
         let tf = TransferFunction::from_nodes(&nodes, EmissionModel::Glow).unwrap();
         let f = IntegralFunctions::new(&tf);

@@ -18,7 +18,11 @@ pub enum TableError {
     #[error("table dimension {name} = {value} is too large")]
     TooLarge { name: &'static str, value: usize },
     #[error("table range {name} must be finite and non-empty (got {lo}..{hi})")]
-    Range { name: &'static str, lo: f64, hi: f64 },
+    Range {
+        name: &'static str,
+        lo: f64,
+        hi: f64,
+    },
 }
 
 /// Largest table side accepted (a 4096^3 RGBA table would be 1 TiB).
@@ -67,7 +71,7 @@ impl Axis {
     #[inline]
     pub fn locate(&self, v: f64) -> (usize, f64) {
         let x = (v - self.lo) / (self.hi - self.lo) * (self.n - 1) as f64;
-        if !(x > 0.0) {
+        if x.is_nan() || x <= 0.0 {
             return (0, 0.0);
         }
         let top = (self.n - 2) as f64;
@@ -113,7 +117,13 @@ pub(crate) fn texel(data: &[f32], i: usize) -> [f64; 4] {
 
 /// Bilinear lookup in an `nx x ny` RGBA layer starting at texel `base`.
 #[inline]
-pub(crate) fn bilinear(data: &[f32], base: usize, nx: usize, ix: (usize, f64), iy: (usize, f64)) -> [f64; 4] {
+pub(crate) fn bilinear(
+    data: &[f32],
+    base: usize,
+    nx: usize,
+    ix: (usize, f64),
+    iy: (usize, f64),
+) -> [f64; 4] {
     let row = |j: usize| {
         let a = texel(data, base + j * nx + ix.0);
         let b = texel(data, base + j * nx + ix.0 + 1);

@@ -20,8 +20,8 @@ pub mod table3d;
 mod tables_sf;
 pub mod weights;
 
-pub use segment::{ray, segment, vertex_values, VertexValues};
 pub use grid::TableError;
+pub use segment::{ray, segment, vertex_values, VertexValues};
 pub use weights::{weights, Regime, Weights};
 
 /// Colour and opacity of one ray segment: premultiplied colour `C` (the

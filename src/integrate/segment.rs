@@ -93,7 +93,7 @@ fn piece_value(
 /// Cleans inputs; `None` means the empty segment.
 #[inline]
 fn sanitize(l: f64, s_f: f64, s_b: f64) -> Option<(f64, f64, f64)> {
-    if !(l > 0.0) || s_f.is_nan() || s_b.is_nan() {
+    if l.is_nan() || l <= 0.0 || s_f.is_nan() || s_b.is_nan() {
         return None;
     }
     Some((
@@ -182,8 +182,16 @@ pub fn vertex_values(tf: &TransferFunction, l: f64, s_f: f64, s_b: f64) -> Verte
     let seg = segment(tf, l, s_f, s_b);
     // Interval averages (length 1 slicing; shares sum to 1).
     let (sf, sb) = (
-        if s_f.is_nan() { 0.0 } else { s_f.clamp(-MAX_SCALAR, MAX_SCALAR) },
-        if s_b.is_nan() { 0.0 } else { s_b.clamp(-MAX_SCALAR, MAX_SCALAR) },
+        if s_f.is_nan() {
+            0.0
+        } else {
+            s_f.clamp(-MAX_SCALAR, MAX_SCALAR)
+        },
+        if s_b.is_nan() {
+            0.0
+        } else {
+            s_b.clamp(-MAX_SCALAR, MAX_SCALAR)
+        },
     );
     let mut tau_mean = 0.0;
     let mut weighted = [0.0; 3];
@@ -199,7 +207,9 @@ pub fn vertex_values(tf: &TransferFunction, l: f64, s_f: f64, s_b: f64) -> Verte
         std::array::from_fn(|k| seg.color[k] / seg.alpha)
     } else {
         match tf.model() {
-            EmissionModel::Glow if tau_mean > 0.0 => std::array::from_fn(|k| weighted[k] / tau_mean),
+            EmissionModel::Glow if tau_mean > 0.0 => {
+                std::array::from_fn(|k| weighted[k] / tau_mean)
+            }
             EmissionModel::Glow => plain,
             EmissionModel::Independent if tau_mean > 0.0 => {
                 std::array::from_fn(|k| plain[k] / tau_mean)

@@ -71,7 +71,13 @@ impl Table3d {
         Ok(t)
     }
 
-    fn empty(ns: usize, nl: usize, s_range: (f64, f64), l_max: f64, fill: Fill) -> Result<Self, TableError> {
+    fn empty(
+        ns: usize,
+        nl: usize,
+        s_range: (f64, f64),
+        l_max: f64,
+        fill: Fill,
+    ) -> Result<Self, TableError> {
         let s_axis = Axis::new("scalar", s_range.0, s_range.1, ns)?;
         let l_axis = Axis::new("length", 0.0, l_max, nl)?;
         let total = check_total("3D table", &[ns, ns, nl])?;
@@ -178,6 +184,10 @@ impl Table3d {
 
     /// `(width, height, depth)` of the 3D texture.
     pub fn extent(&self) -> (u32, u32, u32) {
-        (self.s_axis.n as u32, self.s_axis.n as u32, self.l_axis.n as u32)
+        (
+            self.s_axis.n as u32,
+            self.s_axis.n as u32,
+            self.l_axis.n as u32,
+        )
     }
 }

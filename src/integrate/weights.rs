@@ -218,7 +218,11 @@ pub fn weights(a: f64, b: f64) -> Weights {
         let alpha = -(-d1).exp_m1();
         let t = 1.0 - alpha;
         // Positive integrands only: no cancellation for any a, b >= 0.
-        let rule: &[(f64, f64)] = if a.max(b) <= SMALL_DEPTH_GL8 { &GL8 } else { &GL12 };
+        let rule: &[(f64, f64)] = if a.max(b) <= SMALL_DEPTH_GL8 {
+            &GL8
+        } else {
+            &GL12
+        };
         let [wf, wb, pf, pb] = gauss(a, b, rule);
         return Weights {
             psi: pf + pb,
@@ -332,7 +336,14 @@ mod tests {
 
     #[test]
     fn weights_identities_hold_in_every_regime() {
-        for &(a, b) in &[(0.5, 1.5), (3.0, 3.0), (1.0, 9.0), (9.0, 1.0), (1e4, 2e4), (0.0, 0.0)] {
+        for &(a, b) in &[
+            (0.5, 1.5),
+            (3.0, 3.0),
+            (1.0, 9.0),
+            (9.0, 1.0),
+            (1e4, 2e4),
+            (0.0, 0.0),
+        ] {
             let w = weights(a, b);
             assert!((w.w_f + w.w_b - w.alpha).abs() < 1e-14, "{a} {b}");
             assert!((w.phi_f + w.phi_b - w.psi).abs() < 1e-14);

@@ -164,26 +164,44 @@ fn check_unit(u: f64) -> Result<(), TfError> {
 }
 
 /// Extinction of a point: `tau`, or `opacity / unit distance`.
-fn extinction(what: &'static str, index: usize, p: &PointIn, unit: Option<f64>) -> Result<f64, TfError> {
+fn extinction(
+    what: &'static str,
+    index: usize,
+    p: &PointIn,
+    unit: Option<f64>,
+) -> Result<f64, TfError> {
     match (p.tau, p.opacity) {
         (Some(t), None) => Ok(t),
         (None, Some(o)) => {
             if !(0.0..=1.0).contains(&o) {
-                return Err(TfError::OpacityRange { what, index, value: o });
+                return Err(TfError::OpacityRange {
+                    what,
+                    index,
+                    value: o,
+                });
             }
             match unit {
                 Some(u) => Ok(o / u),
-                None => Err(TfError::Format(format!("{what}: point {index}: opacity needs a unit distance"))),
+                None => Err(TfError::Format(format!(
+                    "{what}: point {index}: opacity needs a unit distance"
+                ))),
             }
         }
         (Some(_), Some(_)) => Err(TfError::Format(format!(
             "{what}: point {index}: give either tau or opacity, not both"
         ))),
-        (None, None) => Err(TfError::Format(format!("{what}: point {index}: tau or opacity missing"))),
+        (None, None) => Err(TfError::Format(format!(
+            "{what}: point {index}: tau or opacity missing"
+        ))),
     }
 }
 
-fn rgb(what: &'static str, index: usize, v: Option<[f64; 3]>, key: &str) -> Result<[f64; 3], TfError> {
+fn rgb(
+    what: &'static str,
+    index: usize,
+    v: Option<[f64; 3]>,
+    key: &str,
+) -> Result<[f64; 3], TfError> {
     v.ok_or_else(|| TfError::Format(format!("{what}: point {index}: {key} missing")))
 }
 
@@ -245,7 +263,11 @@ fn from_project(f: ProjectFile, fallback_unit: f64) -> Result<TransferFunction, 
                     "give opacity_points or extinction_points, not both".into(),
                 ))
             }
-            (None, None) => return Err(TfError::Format("no points, opacity_points or extinction_points".into())),
+            (None, None) => {
+                return Err(TfError::Format(
+                    "no points, opacity_points or extinction_points".into(),
+                ))
+            }
         };
         let col: Vec<(f64, [f64; 3])> = f
             .color_points

@@ -376,7 +376,12 @@ fn check_sorted(what: &'static str, s: impl Iterator<Item = f64>) -> Result<(), 
     Ok(())
 }
 
-fn check_value(what: &'static str, index: usize, field: &'static str, v: f64) -> Result<(), TfError> {
+fn check_value(
+    what: &'static str,
+    index: usize,
+    field: &'static str,
+    v: f64,
+) -> Result<(), TfError> {
     if !v.is_finite() {
         return Err(TfError::NonFinite { what, index, field });
     }
@@ -425,7 +430,12 @@ mod tests {
     #[test]
     fn evaluation_is_right_continuous_and_clamped() {
         let tf = TransferFunction::from_nodes(
-            &[n(0.0, 1.0, 0.0), n(1.0, 3.0, 1.0), n(1.0, 10.0, 0.5), n(2.0, 0.0, 0.5)],
+            &[
+                n(0.0, 1.0, 0.0),
+                n(1.0, 3.0, 1.0),
+                n(1.0, 10.0, 0.5),
+                n(2.0, 0.0, 0.5),
+            ],
             EmissionModel::Glow,
         )
         .unwrap();
@@ -456,12 +466,17 @@ mod tests {
     fn bad_nodes_are_rejected() {
         let e = TransferFunction::from_nodes(&[], EmissionModel::Glow).unwrap_err();
         assert!(matches!(e, TfError::Empty));
-        let e = TransferFunction::from_nodes(&[n(1.0, 1.0, 0.0), n(0.0, 1.0, 0.0)], EmissionModel::Glow)
-            .unwrap_err();
+        let e = TransferFunction::from_nodes(
+            &[n(1.0, 1.0, 0.0), n(0.0, 1.0, 0.0)],
+            EmissionModel::Glow,
+        )
+        .unwrap_err();
         assert!(matches!(e, TfError::Unsorted { index: 1, .. }), "{e}");
-        let e = TransferFunction::from_nodes(&[n(0.0, -1.0, 0.0)], EmissionModel::Glow).unwrap_err();
+        let e =
+            TransferFunction::from_nodes(&[n(0.0, -1.0, 0.0)], EmissionModel::Glow).unwrap_err();
         assert!(matches!(e, TfError::Negative { .. }), "{e}");
-        let e = TransferFunction::from_nodes(&[n(0.0, f64::NAN, 0.0)], EmissionModel::Glow).unwrap_err();
+        let e = TransferFunction::from_nodes(&[n(0.0, f64::NAN, 0.0)], EmissionModel::Glow)
+            .unwrap_err();
         assert!(matches!(e, TfError::NonFinite { .. }), "{e}");
         let e = TransferFunction::from_nodes(
             &[n(0.0, 1.0, 0.0), n(0.0, 1.0, 0.0), n(0.0, 1.0, 0.0)],

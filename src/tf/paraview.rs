@@ -63,7 +63,10 @@ struct PvMap {
 }
 
 /// Parses a ParaView colour-map JSON value (array or object).
-pub(crate) fn from_value(v: serde_json::Value, unit_distance: f64) -> Result<TransferFunction, TfError> {
+pub(crate) fn from_value(
+    v: serde_json::Value,
+    unit_distance: f64,
+) -> Result<TransferFunction, TfError> {
     let obj = match v {
         serde_json::Value::Array(mut a) => {
             if a.is_empty() {
@@ -87,7 +90,10 @@ pub(crate) fn from_value(v: serde_json::Value, unit_distance: f64) -> Result<Tra
             rgb.len()
         )));
     }
-    let colours: Vec<(f64, [f64; 3])> = rgb.chunks_exact(4).map(|c| (c[0], [c[1], c[2], c[3]])).collect();
+    let colours: Vec<(f64, [f64; 3])> = rgb
+        .chunks_exact(4)
+        .map(|c| (c[0], [c[1], c[2], c[3]]))
+        .collect();
     check_points("RGBPoints", colours.iter().map(|c| c.0))?;
     let space = match &map.color_space {
         Some(s) => ColorSpace::parse(s)?,
@@ -102,7 +108,10 @@ pub(crate) fn from_value(v: serde_json::Value, unit_distance: f64) -> Result<Tra
                     p.len()
                 )));
             }
-            let pts: Vec<[f64; 4]> = p.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+            let pts: Vec<[f64; 4]> = p
+                .chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2], c[3]])
+                .collect();
             check_points("Points", pts.iter().map(|c| c[0]))?;
             for (i, q) in pts.iter().enumerate() {
                 if !(0.0..=1.0).contains(&q[1]) {
@@ -120,7 +129,10 @@ pub(crate) fn from_value(v: serde_json::Value, unit_distance: f64) -> Result<Tra
             vec![(lo, [0.0]), (hi, [1.0])]
         }
     };
-    let tau: Vec<(f64, [f64; 1])> = opacity.iter().map(|&(s, [o])| (s, [o / unit_distance])).collect();
+    let tau: Vec<(f64, [f64; 1])> = opacity
+        .iter()
+        .map(|&(s, [o])| (s, [o / unit_distance]))
+        .collect();
     let mut tf = TransferFunction::from_channels(&tau, &colours, None, EmissionModel::Glow)?;
     tf.unit_distance = Some(unit_distance);
     Ok(tf)
@@ -147,7 +159,11 @@ fn check_points(what: &'static str, xs: impl Iterator<Item = f64>) -> Result<(),
 
 /// Resamples colour points interpolated in `space` into linear RGB pieces
 /// (`pieces` per interval; RGB input is returned unchanged).
-pub(crate) fn resample_colors(p: &[(f64, [f64; 3])], space: ColorSpace, pieces: usize) -> Vec<(f64, [f64; 3])> {
+pub(crate) fn resample_colors(
+    p: &[(f64, [f64; 3])],
+    space: ColorSpace,
+    pieces: usize,
+) -> Vec<(f64, [f64; 3])> {
     if space == ColorSpace::Rgb || p.len() < 2 {
         return p.to_vec();
     }
@@ -167,7 +183,11 @@ pub(crate) fn resample_colors(p: &[(f64, [f64; 3])], space: ColorSpace, pieces: 
         for k in 1..=pieces {
             let t = k as f64 / pieces as f64;
             let x = if k == pieces { x1 } else { x0 + (x1 - x0) * t };
-            let c = if k == pieces { c1 } else { interpolate(c0, c1, t, space) };
+            let c = if k == pieces {
+                c1
+            } else {
+                interpolate(c0, c1, t, space)
+            };
             out.push((x, c.map(|v| v.clamp(0.0, 1.0))));
         }
     }
@@ -249,7 +269,11 @@ fn resample_opacity(p: &[[f64; 4]]) -> Vec<(f64, [f64; 1])> {
         }
         for k in 1..=PIECES_PER_INTERVAL {
             let t = k as f64 / PIECES_PER_INTERVAL as f64;
-            let x = if k == PIECES_PER_INTERVAL { x1 } else { x0 + (x1 - x0) * t };
+            let x = if k == PIECES_PER_INTERVAL {
+                x1
+            } else {
+                x0 + (x1 - x0) * t
+            };
             out.push((x, [midpoint_sharpness(o0, o1, t, mid, sharp)]));
         }
     }
@@ -346,7 +370,11 @@ fn hsv_to_rgb(hsv: [f64; 3]) -> [f64; 3] {
 
 fn lab_to_msh(lab: [f64; 3]) -> [f64; 3] {
     let m = (lab[0] * lab[0] + lab[1] * lab[1] + lab[2] * lab[2]).sqrt();
-    let s = if m > 0.001 { (lab[0] / m).clamp(-1.0, 1.0).acos() } else { 0.0 };
+    let s = if m > 0.001 {
+        (lab[0] / m).clamp(-1.0, 1.0).acos()
+    } else {
+        0.0
+    };
     let h = if s > 0.001 { lab[2].atan2(lab[1]) } else { 0.0 };
     [m, s, h]
 }
@@ -433,7 +461,10 @@ mod tests {
         assert_eq!(r.len(), 33);
         let mid = r[16].1;
         // Moreland: the midpoint of the cool-warm map is a light grey.
-        assert!((mid[0] - mid[1]).abs() < 0.05 && (mid[1] - mid[2]).abs() < 0.05, "{mid:?}");
+        assert!(
+            (mid[0] - mid[1]).abs() < 0.05 && (mid[1] - mid[2]).abs() < 0.05,
+            "{mid:?}"
+        );
         assert!(mid[0] > 0.8, "{mid:?}");
     }
 }
