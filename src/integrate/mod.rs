@@ -6,7 +6,7 @@
 //! front to back with [`RayAccumulator`].
 //!
 //! Submodules: [`weights`] (basis integrals of one linear piece, the ported
-//! closed form), [`segment`](mod@segment) (slicing at breakpoints, whole segments and
+//! closed form), `segment` (slicing at breakpoints, whole segments and
 //! rays, per-vertex values for the exact GPU mode), [`table3d`], [`table2d`]
 //! and [`cylinder`] (pre-integration tables filled from the exact integrals),
 //! [`fast`] (integral functions for approximate fills and local updates).
