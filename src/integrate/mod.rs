@@ -5,7 +5,7 @@
 //! breakpoints, and the material at one scalar value. Segments composite
 //! front to back with [`RayAccumulator`].
 //!
-//! Submodules: [`weights`] (basis integrals of one linear piece, the ported
+//! Submodules: [`weights`](mod@weights) (basis integrals of one linear piece, the ported
 //! closed form), `segment` (slicing at breakpoints, whole segments and
 //! rays, per-vertex values for the exact GPU mode), [`table3d`], [`table2d`]
 //! and [`cylinder`] (pre-integration tables filled from the exact integrals),
@@ -13,7 +13,7 @@
 
 pub mod cylinder;
 pub mod fast;
-mod grid;
+pub mod grid;
 mod segment;
 pub mod table2d;
 pub mod table3d;
