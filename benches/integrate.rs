@@ -228,6 +228,21 @@ fn tables(c: &mut Criterion<CpuTime>) {
             },
         );
     }
+    let (ns, nl) = (128usize, 64usize);
+    g.bench_with_input(
+        BenchmarkId::new("3d_exact", format!("{ns}x{ns}x{nl}")),
+        &(ns, nl),
+        |b, &(ns, nl)| b.iter(|| Table3d::exact(&tf, ns, nl, (0.0, 1.0), 1.0).expect("table")),
+    );
+    g.bench_with_input(
+        BenchmarkId::new("3d_integral_functions", format!("{ns}x{ns}x{nl}")),
+        &(ns, nl),
+        |b, &(ns, nl)| {
+            b.iter(|| {
+                Table3d::fast(&tf, ns, nl, (0.0, 1.0), 1.0, FastColour::MeanGlow).expect("table")
+            })
+        },
+    );
     // A TF edit confined to [0.9, 1.0] touches about 19% of the (s_f, s_b) pairs.
     let mut t = Table3d::exact(&tf, 128, 64, (0.0, 1.0), 1.0).expect("table");
     g.bench_function("3d_exact_local_update_0.9_1.0", |b| {

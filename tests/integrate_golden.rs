@@ -3,6 +3,9 @@
 //! and through a two-node transfer function) and 10 whole rays, within the
 //! file's recommended tolerances. Skips when the shared folder is absent.
 
+// Channels are compared across parallel arrays by index.
+#![allow(clippy::needless_range_loop)]
+
 use serde_json::Value;
 use zoovr::integrate::{self, weights};
 use zoovr::tf::{EmissionModel, Node, TransferFunction};

@@ -3,6 +3,9 @@
 //! (composite 5-point Gauss-Legendre on panels adapted to the optical depth,
 //! no special functions, no series).
 
+// Channels are compared across parallel arrays by index.
+#![allow(clippy::needless_range_loop)]
+
 use proptest::prelude::*;
 use zoovr::integrate::{self, weights, RayAccumulator, RayMaterial};
 use zoovr::tf::{EmissionModel, Node, TransferFunction};

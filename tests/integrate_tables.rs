@@ -3,6 +3,9 @@
 //! against the exact integral over a dense random sample, as a function of
 //! resolution (printed with `--nocapture`; thresholds asserted).
 
+// Channels are compared across parallel arrays by index.
+#![allow(clippy::needless_range_loop)]
+
 use zoovr::integrate::cylinder::{cyl_to_table, CylinderTable};
 use zoovr::integrate::fast::FastColour;
 use zoovr::integrate::table2d::{Table2d, Table2dKind};

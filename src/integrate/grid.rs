@@ -71,7 +71,7 @@ impl Axis {
     #[inline]
     pub fn locate(&self, v: f64) -> (usize, f64) {
         let x = (v - self.lo) / (self.hi - self.lo) * (self.n - 1) as f64;
-        if !(x > 0.0) {
+        if x.is_nan() || x <= 0.0 {
             return (0, 0.0);
         }
         let top = (self.n - 2) as f64;

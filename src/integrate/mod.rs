@@ -5,15 +5,15 @@
 //! breakpoints, and the material at one scalar value. Segments composite
 //! front to back with [`RayAccumulator`].
 //!
-//! Submodules: [`weights`] (basis integrals of one linear piece, the ported
-//! closed form), [`segment`](mod@segment) (slicing at breakpoints, whole segments and
+//! Submodules: [`weights`](mod@weights) (basis integrals of one linear piece, the ported
+//! closed form), `segment` (slicing at breakpoints, whole segments and
 //! rays, per-vertex values for the exact GPU mode), [`table3d`], [`table2d`]
 //! and [`cylinder`] (pre-integration tables filled from the exact integrals),
 //! [`fast`] (integral functions for approximate fills and local updates).
 
 pub mod cylinder;
 pub mod fast;
-mod grid;
+pub mod grid;
 mod segment;
 pub mod table2d;
 pub mod table3d;

@@ -93,7 +93,7 @@ fn piece_value(
 /// Cleans inputs; `None` means the empty segment.
 #[inline]
 fn sanitize(l: f64, s_f: f64, s_b: f64) -> Option<(f64, f64, f64)> {
-    if !(l > 0.0) || s_f.is_nan() || s_b.is_nan() {
+    if l.is_nan() || l <= 0.0 || s_f.is_nan() || s_b.is_nan() {
         return None;
     }
     Some((
