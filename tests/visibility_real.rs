@@ -122,8 +122,20 @@ fn can_crush() {
 #[test]
 #[ignore = "slow in debug builds"]
 fn can_crush_series_first_steps_exact() {
-    check("can_crush/series/can_t0_converted.vtu", 20, 128, 4000, false);
-    check("can_crush/series/can_t1_converted.vtu", 20, 128, 4000, false);
+    check(
+        "can_crush/series/can_t0_converted.vtu",
+        20,
+        128,
+        4000,
+        false,
+    );
+    check(
+        "can_crush/series/can_t1_converted.vtu",
+        20,
+        128,
+        4000,
+        false,
+    );
 }
 
 #[test]
@@ -135,13 +147,25 @@ fn can_crush_split_all() {
 #[test]
 #[ignore = "slow in debug builds"]
 fn disk_out_ref() {
-    check("disk_out_ref/disk_out_ref_converted.vtu", 20, 128, 4000, false);
+    check(
+        "disk_out_ref/disk_out_ref_converted.vtu",
+        20,
+        128,
+        4000,
+        false,
+    );
 }
 
 #[test]
 #[ignore = "slow in debug builds"]
 fn su2_sphere_hybrid() {
-    check("su2_sphere_hybrid/sphere_hybrid_converted.vtu", 20, 128, 4000, false);
+    check(
+        "su2_sphere_hybrid/sphere_hybrid_converted.vtu",
+        20,
+        128,
+        4000,
+        false,
+    );
 }
 
 #[test]

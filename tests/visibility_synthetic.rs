@@ -62,7 +62,11 @@ fn run_views(mesh: &Mesh, views: usize, size: u32, seed: u64, policy: &SplitPoli
         let order = sorter.order(&cam, policy).expect("order");
         sorter.sanity_check().expect("sanity");
         check_cover(mesh, &order);
-        assert!(order.groups.is_empty(), "unresolved cycles: {:?}", order.stats);
+        assert!(
+            order.groups.is_empty(),
+            "unresolved cycles: {:?}",
+            order.stats
+        );
         split_seen += order.stats.split_cells;
         let px = sample_pixels(&cam, usize::MAX, 0);
         let viol = validate(mesh, &order, &cam, &px);
@@ -172,7 +176,11 @@ fn validator_catches_wrong_orders() {
         assert!(validate(&mesh, &order, &cam, &px).ok());
         order.pieces.reverse();
         let bad = validate(&mesh, &order, &cam, &px);
-        assert!(bad.count > 100, "reversed order: only {} violations", bad.count);
+        assert!(
+            bad.count > 100,
+            "reversed order: only {} violations",
+            bad.count
+        );
         sorter.nonconvex = zoovr::visibility::NonConvex::IgnoreApproximate;
         let approx = sorter.order(&cam, &SplitPolicy::default()).unwrap();
         mpvo_only_failures += validate(&mesh, &approx, &cam, &px).count;

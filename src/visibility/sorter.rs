@@ -13,7 +13,7 @@ use std::time::Instant;
 use glam::DVec3;
 
 use super::exact::orient_dir;
-use super::geometry::{Geometry, BOUNDARY, CONCAVE, FLIP};
+use super::geometry::{Geometry, BOUNDARY, CONCAVE, FLIP, PLANAR};
 use super::raster::{exit_entry_pairs, rasterize};
 use super::scc::tarjan;
 use super::split::SplitPool;
@@ -285,7 +285,13 @@ impl Sorter {
                 PLANE_FILTER_EPS * m as f64 * if vw == 1.0 { vmag + amax as f64 } else { dmag };
             let mut pos = 0u8;
             let mut neg = 0u8;
+            let planar = g.face_flags[f] & PLANAR != 0;
+            let mut planar_sign = None;
             for t in r.clone() {
+                if let Some(sg) = planar_sign {
+                    self.tri_sign[t] = sg;
+                    continue;
+                }
                 let pl = &g.planes[t];
                 // Perspective: n . eye - d; orthographic: n . (-dir).
                 let s = if vw == 1.0 {
@@ -314,6 +320,9 @@ impl Sorter {
                 self.tri_sign[t] = sg;
                 pos += (sg > 0) as u8;
                 neg += (sg < 0) as u8;
+                if planar {
+                    planar_sign = Some(sg);
+                }
             }
             let flags = g.face_flags[f];
             let [c0, c1] = self.topo.face_cells[f];
@@ -547,16 +556,19 @@ impl Sorter {
         for &t in &extra.to {
             self.indeg[t as usize] += 1;
         }
+        // A stack rather than a queue: any order Kahn can emit is valid, and
+        // last-in-first-out keeps the work next to the cells just finished
+        // (cache locality on large meshes).
         let mut out: Vec<u32> = Vec::with_capacity(pieces);
-        for v in 0..pieces {
-            if self.indeg[v] == 0 && (v >= n || self.pool.slot_of[v] == NONE) {
-                out.push(v as u32);
-            }
-        }
-        let mut head = 0;
-        while head < out.len() {
-            let v = out[head];
-            head += 1;
+        let mut stack: Vec<u32> = (0..pieces as u32)
+            .rev()
+            .filter(|&v| {
+                self.indeg[v as usize] == 0
+                    && (v as usize >= n || self.pool.slot_of[v as usize] == NONE)
+            })
+            .collect();
+        while let Some(v) = stack.pop() {
+            out.push(v);
             if (v as usize) < n {
                 for &f in self.topo.faces_of(v as usize) {
                     let t = self.face_target[f as usize];
@@ -564,7 +576,7 @@ impl Sorter {
                         let d = &mut self.indeg[t as usize];
                         *d -= 1;
                         if *d == 0 {
-                            out.push(t);
+                            stack.push(t);
                         }
                     }
                 }
@@ -576,7 +588,7 @@ impl Sorter {
                     let d = &mut self.indeg[w as usize];
                     *d -= 1;
                     if *d == 0 {
-                        out.push(w);
+                        stack.push(w);
                     }
                 }
             }
