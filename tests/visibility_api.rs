@@ -68,7 +68,12 @@ fn breakpoint_cells_match_brute_force() {
     let bps = [0.3, 0.75];
     let want = (0..mesh.cells.len())
         .filter(|&c| {
-            let v: Vec<f64> = mesh.cells.nodes(c).iter().map(|&i| scalars[i as usize]).collect();
+            let v: Vec<f64> = mesh
+                .cells
+                .nodes(c)
+                .iter()
+                .map(|&i| scalars[i as usize])
+                .collect();
             let lo = v.iter().cloned().fold(f64::INFINITY, f64::min);
             let hi = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
             bps.iter().any(|&b| lo < b && b < hi)
@@ -100,12 +105,17 @@ fn bad_input_is_a_typed_error() {
     let topo = Topology::build(&mesh.cells);
     let c = cam(&mesh, 0.0, 0.0, false);
     // Point id out of range.
-    let mut bad = Mesh::default();
-    bad.points = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+    let mut bad = Mesh {
+        points: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+        ..Default::default()
+    };
     bad.cells.push(CellKind::Tetra, &[0, 1, 2, 7]);
     let bt = Topology::build(&bad.cells);
     let err = Sorter::new(&bad, &bt).order(&c, &SplitPolicy::default());
-    assert!(matches!(err, Err(VisibilityError::PointOutOfRange { point: 7, .. })));
+    assert!(matches!(
+        err,
+        Err(VisibilityError::PointOutOfRange { point: 7, .. })
+    ));
     // Non-finite point.
     let mut nan = mesh.clone();
     nan.points[5].y = f64::NAN;
@@ -135,6 +145,8 @@ fn bad_input_is_a_typed_error() {
     // An empty mesh sorts to nothing.
     let none = Mesh::default();
     let nt = Topology::build(&none.cells);
-    let o = Sorter::new(&none, &nt).order(&c, &SplitPolicy::default()).unwrap();
+    let o = Sorter::new(&none, &nt)
+        .order(&c, &SplitPolicy::default())
+        .unwrap();
     assert!(o.pieces.is_empty());
 }
