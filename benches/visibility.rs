@@ -33,7 +33,7 @@ fn bench_mesh(c: &mut Criterion, name: &str, mesh: &Mesh) {
     let s = &o.stats;
     eprintln!(
         "{name}: cells {} convex {} split {} problem faces {} nonconvex constraints {} \
-         crossings {} fallbacks {} | classify {:?} split {:?} nonconvex {:?} sort {:?} total {:?}",
+         crossings {} fallbacks {} rounds {} cycles {} groups {} | classify {:?} split {:?} nonconvex {:?} sort {:?} total {:?}",
         s.cells,
         s.convex_boundary,
         s.split_cells,
@@ -41,12 +41,37 @@ fn bench_mesh(c: &mut Criterion, name: &str, mesh: &Mesh) {
         s.nonconvex_constraints,
         s.boundary_crossings,
         s.exact_fallbacks,
+        s.rounds,
+        s.cycles_found,
+        s.cycle_groups,
         s.time_classify,
         s.time_split,
         s.time_nonconvex,
         s.time_sort,
         s.time_total
     );
+    // CPU time of this thread per view (robust against a loaded machine).
+    let views = 6;
+    let cpu0 = thread_cpu_seconds();
+    let wall0 = std::time::Instant::now();
+    let mut split = 0;
+    for k in 0..views {
+        split += sorter
+            .order(&camera(mesh, k, k % 2 == 1), &policy)
+            .expect("order")
+            .stats
+            .split_cells;
+    }
+    if let (Some(a), Some(b)) = (cpu0, thread_cpu_seconds()) {
+        let per = (b - a) / views as f64;
+        eprintln!(
+            "{name}: {views} views, thread CPU {:.1} ms/view ({:.2} M cells/s), wall {:.1} ms/view, mean split cells {}",
+            per * 1e3,
+            s.cells as f64 / per / 1e6,
+            wall0.elapsed().as_secs_f64() * 1e3 / views as f64,
+            split / views
+        );
+    }
     let mut g = c.benchmark_group(name);
     g.sample_size(10);
     let mut k = 0usize;
@@ -59,6 +84,16 @@ fn bench_mesh(c: &mut Criterion, name: &str, mesh: &Mesh) {
         })
     });
     g.finish();
+}
+
+/// User + system CPU seconds of the calling thread (Linux), if available.
+fn thread_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
+    let after = stat.rsplit_once(')')?.1;
+    let f: Vec<&str> = after.split_whitespace().collect();
+    let utime: f64 = f.get(11)?.parse().ok()?;
+    let stime: f64 = f.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
 }
 
 fn visibility(c: &mut Criterion) {

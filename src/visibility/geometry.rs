@@ -19,6 +19,9 @@ pub const FLIP: u8 = 1;
 pub const CONCAVE: u8 = 2;
 /// Face flag: boundary face.
 pub const BOUNDARY: u8 = 4;
+/// Face flag: a face of several triangles whose vertices are exactly
+/// coplanar (one plane test decides all its triangles).
+pub const PLANAR: u8 = 8;
 
 /// One boundary triangle: its face, its index in the face's triangulation
 /// and its vertices, wound outward.
@@ -159,6 +162,9 @@ impl Geometry {
                 }
                 k += 1;
             });
+            if face.len() > 3 && face_planar(p, face) {
+                flags |= PLANAR;
+            }
             if c1 == NONE && face.len() > 3 && boundary_face_concave(p, face, flags & FLIP != 0) {
                 flags |= CONCAVE;
             }
@@ -180,6 +186,18 @@ impl Geometry {
     pub fn tris(&self, f: usize) -> std::ops::Range<usize> {
         self.tri_off[f] as usize..self.tri_off[f + 1] as usize
     }
+}
+
+/// Whether every vertex of `face` lies exactly on the plane of its first
+/// three vertices (and those are not collinear).
+fn face_planar(p: &[DVec3], face: &[u32]) -> bool {
+    let [a, b, c] = [face[0], face[1], face[2]].map(|i| p[i as usize]);
+    if (b - a).cross(c - a) == DVec3::ZERO {
+        return false;
+    }
+    face[3..]
+        .iter()
+        .all(|&v| orient3d(a, b, c, p[v as usize]) == Side::On)
 }
 
 /// Whether some vertex of a boundary face lies strictly outside the outward

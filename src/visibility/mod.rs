@@ -66,7 +66,9 @@
 
 pub mod exact;
 mod geometry;
+mod input;
 mod raster;
+mod sanity;
 pub mod scc;
 mod sorter;
 mod split;

@@ -13,7 +13,7 @@ use std::time::Instant;
 use glam::DVec3;
 
 use super::exact::orient_dir;
-use super::geometry::{Geometry, BOUNDARY, CONCAVE, FLIP};
+use super::geometry::{Geometry, BOUNDARY, CONCAVE, FLIP, PLANAR};
 use super::raster::{exit_entry_pairs, rasterize};
 use super::scc::tarjan;
 use super::split::SplitPool;
@@ -75,11 +75,11 @@ pub enum NonConvex {
 /// Built once per geometry; call [`Sorter::order`] per view.
 #[derive(Clone, Debug)]
 pub struct Sorter {
-    mesh: Mesh,
-    topo: Topology,
-    geom: Geometry,
-    pool: SplitPool,
-    invalid: Option<VisibilityError>,
+    pub(super) mesh: Mesh,
+    pub(super) topo: Topology,
+    pub(super) geom: Geometry,
+    pub(super) pool: SplitPool,
+    pub(super) invalid: Option<VisibilityError>,
     /// How non-convex meshes are handled (default: exact pixel constraints).
     pub nonconvex: NonConvex,
     // Per-view scratch.
@@ -108,7 +108,7 @@ impl Sorter {
     /// a topology of another mesh) is reported by [`Sorter::order`].
     pub fn new(mesh: &Mesh, topo: &Topology) -> Sorter {
         let n = mesh.cells.len();
-        let invalid = check_input(mesh, topo);
+        let invalid = super::input::check_input(mesh, topo);
         let geo_mesh = Mesh {
             points: mesh.points.clone(),
             cells: mesh.cells.clone(),
@@ -155,7 +155,7 @@ impl Sorter {
         if let Some(e) = &self.invalid {
             return Err(e.clone());
         }
-        check_camera(camera)?;
+        super::input::check_camera(camera)?;
         let n = self.mesh.cells.len();
         if let Some(s) = policy.point_scalars {
             if s.len() < self.mesh.points.len() {
@@ -285,7 +285,13 @@ impl Sorter {
                 PLANE_FILTER_EPS * m as f64 * if vw == 1.0 { vmag + amax as f64 } else { dmag };
             let mut pos = 0u8;
             let mut neg = 0u8;
+            let planar = g.face_flags[f] & PLANAR != 0;
+            let mut planar_sign = None;
             for t in r.clone() {
+                if let Some(sg) = planar_sign {
+                    self.tri_sign[t] = sg;
+                    continue;
+                }
                 let pl = &g.planes[t];
                 // Perspective: n . eye - d; orthographic: n . (-dir).
                 let s = if vw == 1.0 {
@@ -314,6 +320,9 @@ impl Sorter {
                 self.tri_sign[t] = sg;
                 pos += (sg > 0) as u8;
                 neg += (sg < 0) as u8;
+                if planar {
+                    planar_sign = Some(sg);
+                }
             }
             let flags = g.face_flags[f];
             let [c0, c1] = self.topo.face_cells[f];
@@ -547,16 +556,19 @@ impl Sorter {
         for &t in &extra.to {
             self.indeg[t as usize] += 1;
         }
+        // A stack rather than a queue: any order Kahn can emit is valid, and
+        // last-in-first-out keeps the work next to the cells just finished
+        // (cache locality on large meshes).
         let mut out: Vec<u32> = Vec::with_capacity(pieces);
-        for v in 0..pieces {
-            if self.indeg[v] == 0 && (v >= n || self.pool.slot_of[v] == NONE) {
-                out.push(v as u32);
-            }
-        }
-        let mut head = 0;
-        while head < out.len() {
-            let v = out[head];
-            head += 1;
+        let mut stack: Vec<u32> = (0..pieces as u32)
+            .rev()
+            .filter(|&v| {
+                self.indeg[v as usize] == 0
+                    && (v as usize >= n || self.pool.slot_of[v as usize] == NONE)
+            })
+            .collect();
+        while let Some(v) = stack.pop() {
+            out.push(v);
             if (v as usize) < n {
                 for &f in self.topo.faces_of(v as usize) {
                     let t = self.face_target[f as usize];
@@ -564,7 +576,7 @@ impl Sorter {
                         let d = &mut self.indeg[t as usize];
                         *d -= 1;
                         if *d == 0 {
-                            out.push(t);
+                            stack.push(t);
                         }
                     }
                 }
@@ -576,7 +588,7 @@ impl Sorter {
                     let d = &mut self.indeg[w as usize];
                     *d -= 1;
                     if *d == 0 {
-                        out.push(w);
+                        stack.push(w);
                     }
                 }
             }
@@ -690,168 +702,4 @@ impl Sorter {
             (centre - camera.position).length()
         }
     }
-
-    /// Verifies the split bookkeeping: every active cell has a slot holding
-    /// its own tets, slots are not shared, free slots are not in use, every
-    /// face triangle of a split cell has an owning tet that contains it.
-    pub fn sanity_check(&self) -> Result<(), String> {
-        let n = self.mesh.cells.len();
-        let mut used = vec![false; self.pool.slots.len()];
-        let mut prev: Option<u32> = None;
-        for &c in &self.pool.active {
-            if prev.is_some_and(|p| p >= c) {
-                return Err(format!("active list not increasing at cell {c}"));
-            }
-            prev = Some(c);
-            let s = *self
-                .pool
-                .slot_of
-                .get(c as usize)
-                .ok_or("active cell out of range")?;
-            if s == NONE {
-                return Err(format!("active cell {c} has no slot"));
-            }
-            let su = s as usize;
-            if su >= used.len() || used[su] {
-                return Err(format!("slot {s} of cell {c} invalid or shared"));
-            }
-            used[su] = true;
-            let sc = &self.pool.slots[su];
-            if sc.cell != c {
-                return Err(format!("slot {s} holds cell {} not {c}", sc.cell));
-            }
-            let mut want = Vec::new();
-            crate::mesh::tetra::tetrahedralize_cell(&self.mesh.cells, c as usize, &mut want);
-            if want != sc.tets {
-                return Err(format!(
-                    "cell {c}: stored tets differ from its consistent tets"
-                ));
-            }
-            for (li, &f) in self.topo.faces_of(c as usize).iter().enumerate() {
-                let mut k = 0;
-                let mut err = None;
-                crate::mesh::tetra::triangulate_face(self.topo.face(f as usize), |t| {
-                    let o = sc.owner(li, k) as usize;
-                    let ok = sc
-                        .tets
-                        .get(o)
-                        .is_some_and(|tet| t.iter().all(|v| tet.contains(v)));
-                    if !ok && sc.unmatched == 0 {
-                        err = Some(format!(
-                            "cell {c} face {f} triangle {k}: owner tet misses it"
-                        ));
-                    }
-                    k += 1;
-                });
-                if let Some(e) = err {
-                    return Err(e);
-                }
-            }
-        }
-        for &s in &self.pool.free {
-            if used.get(s as usize).copied().unwrap_or(true) {
-                return Err(format!("free slot {s} is in use or out of range"));
-            }
-        }
-        let split = self.pool.slot_of.iter().filter(|&&s| s != NONE).count();
-        if split != self.pool.active.len()
-            || self.pool.slot_of.len() != n && n > 0 && self.invalid.is_none()
-        {
-            return Err(format!(
-                "{split} cells have slots but {} are active",
-                self.pool.active.len()
-            ));
-        }
-        Ok(())
-    }
-}
-
-fn check_input(mesh: &Mesh, topo: &Topology) -> Option<VisibilityError> {
-    let np = mesh.points.len();
-    for (i, p) in mesh.points.iter().enumerate() {
-        if !p.is_finite() {
-            return Some(VisibilityError::NonFinitePoint(i));
-        }
-    }
-    let n = mesh.cells.len();
-    if mesh.cells.offsets.len() != n + 1 && n > 0 {
-        return Some(VisibilityError::TopologyMismatch { topo: 0, mesh: n });
-    }
-    for c in 0..n {
-        let (a, b) = (
-            mesh.cells.offsets[c] as usize,
-            mesh.cells.offsets[c + 1] as usize,
-        );
-        if a > b || b > mesh.cells.conn.len() {
-            return Some(VisibilityError::TopologyMismatch { topo: 0, mesh: n });
-        }
-        for &v in &mesh.cells.conn[a..b] {
-            if v as usize >= np {
-                return Some(VisibilityError::PointOutOfRange {
-                    cell: c,
-                    point: v,
-                    points: np,
-                });
-            }
-        }
-        if let Some(k) = mesh.cells.kinds[c].corner_count() {
-            if b - a != k {
-                return Some(VisibilityError::TopologyMismatch {
-                    topo: b - a,
-                    mesh: k,
-                });
-            }
-        }
-    }
-    for faces in mesh.cells.poly_faces.values() {
-        for &v in faces.iter().flatten() {
-            if v as usize >= np {
-                return Some(VisibilityError::PointOutOfRange {
-                    cell: 0,
-                    point: v,
-                    points: np,
-                });
-            }
-        }
-    }
-    if topo.cell_face_offsets.len() != n + 1 && !(n == 0 && topo.cell_face_offsets.len() <= 1) {
-        return Some(VisibilityError::TopologyMismatch {
-            topo: topo.cell_face_offsets.len().saturating_sub(1),
-            mesh: n,
-        });
-    }
-    let nf = topo.face_count();
-    let ok = topo.face_offsets.len() == nf + 1
-        && topo
-            .face_offsets
-            .last()
-            .is_some_and(|&e| e as usize <= topo.face_verts.len())
-        && topo.face_verts.iter().all(|&v| (v as usize) < np)
-        && topo.cell_faces.iter().all(|&f| (f as usize) < nf)
-        && topo
-            .face_cells
-            .iter()
-            .all(|&[a, b]| (a as usize) < n && (b == NONE || (b as usize) < n));
-    if !ok {
-        return Some(VisibilityError::TopologyMismatch {
-            topo: topo.cell_face_offsets.len().saturating_sub(1),
-            mesh: n,
-        });
-    }
-    None
-}
-
-fn check_camera(c: &Camera) -> Result<(), VisibilityError> {
-    if c.width == 0 || c.height == 0 {
-        return Err(VisibilityError::BadCamera("empty image"));
-    }
-    if !c.position.is_finite() || !c.forward.is_finite() || c.forward.length_squared() == 0.0 {
-        return Err(VisibilityError::BadCamera(
-            "non-finite position or direction",
-        ));
-    }
-    if (c.width as u64) * (c.height as u64) > u32::MAX as u64 {
-        return Err(VisibilityError::BadCamera("image too large"));
-    }
-    Ok(())
 }
