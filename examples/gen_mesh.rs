@@ -210,13 +210,14 @@ fn degenerate() -> Mesh {
     };
     let good = add(&[square(0.0, 0.0), square(1.0, 0.0)].concat());
     let inv = add(&[square(1.0, 2.0), square(0.0, 2.0)].concat());
+    // (0, 1, 2) clockwise seen from (3, 4, 5): inverted
     let wedge = add(&[
         DVec3::new(4., 0., 0.),
-        DVec3::new(5., 0., 0.),
         DVec3::new(4., 1., 0.),
+        DVec3::new(5., 0., 0.),
         DVec3::new(4., 0., 1.),
-        DVec3::new(5., 0., 1.),
         DVec3::new(4., 1., 1.),
+        DVec3::new(5., 0., 1.),
     ]);
     let flat = add(&[square(0.0, 6.0), square(0.0, 6.0)].concat());
     let tet = add(&[

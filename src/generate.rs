@@ -203,9 +203,9 @@ pub fn zoo_grid(n: usize, warp: &Warp) -> Mesh {
                     Some(Block::Hex) | None => mesh.cells.push(CellKind::Hexahedron, &c),
                     Some(Block::Wedges) => {
                         mesh.cells
-                            .push(CellKind::Wedge, &[c[0], c[2], c[1], c[4], c[6], c[5]]);
+                            .push(CellKind::Wedge, &[c[0], c[1], c[2], c[4], c[5], c[6]]);
                         mesh.cells
-                            .push(CellKind::Wedge, &[c[0], c[3], c[2], c[4], c[7], c[6]]);
+                            .push(CellKind::Wedge, &[c[0], c[2], c[3], c[4], c[6], c[7]]);
                     }
                     Some(Block::Pyramids) => {
                         let centre = DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * h;
@@ -341,10 +341,11 @@ pub fn single_cell(kind: CellKind) -> Mesh {
             mesh.points.push(DVec3::new(0.5, 0.5, 1.0));
         }
         CellKind::Wedge => {
-            // VTK: the first triangle's normal points away from the second.
-            mesh.points = vec![DVec3::ZERO, DVec3::Y, DVec3::X];
+            // VTK parametric order: (0, 1, 2) turns counter-clockwise seen
+            // from (3, 4, 5).
+            mesh.points = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
             mesh.points
-                .extend([DVec3::Z, DVec3::new(0., 1., 1.), DVec3::new(1., 0., 1.)]);
+                .extend([DVec3::Z, DVec3::new(1., 0., 1.), DVec3::new(0., 1., 1.)]);
         }
         CellKind::Hexahedron => {
             mesh.points = square(0.0);

@@ -95,14 +95,14 @@ fn zoo_cells() -> Vec<TestCell> {
         DVec3::Y,
         DVec3::new(0.4, 0.5, 0.9),
     ];
-    // VTK wedge: first triangle's normal points away from the second
+    // VTK parametric wedge: the first triangle's normal points at the second
     let wedge = vec![
         DVec3::ZERO,
-        DVec3::Y,
         DVec3::X,
+        DVec3::Y,
         DVec3::Z,
-        DVec3::new(0., 1., 1.),
         DVec3::new(1., 0., 1.),
+        DVec3::new(0., 1., 1.),
     ];
     // Polyhedra: a cube (6 quads), an octahedron, a hexagonal prism.
     let cube_faces: Vec<Vec<u32>> = CellKind::Hexahedron

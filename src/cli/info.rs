@@ -126,7 +126,7 @@ fn print_text(file: &std::path::Path, v: &Value) {
         v["inverted_cells"], v["degenerate_cells"], v["repeated_index_cells"]
     );
     println!(
-        "quad faces:  {} nonplanar (> 1e-3 of the diagonal; max {})",
+        "quad faces:  {} nonplanar (> 1e-3 of the face diagonal; max {})",
         v["nonplanar_faces"], v["max_nonplanarity"]
     );
     println!(

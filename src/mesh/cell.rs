@@ -36,12 +36,17 @@ const HEX_FACES: &[&[u8]] = &[
     &[0, 3, 2, 1],
     &[4, 5, 6, 7],
 ];
+// Positive wedges follow VTK's parametric coordinates (nodes 0, 1, 2 at
+// (0,0,0), (1,0,0), (0,1,0); 3, 4, 5 above them): the normal of (0, 1, 2)
+// points towards (3, 4, 5). With this orientation `../shared/data/README.md`
+// counts su2_sphere_hybrid's 7,950 and notch's 4 wedges as negative. VTK's own
+// wedge face table lists these faces inward; ours lists them outward.
 const WEDGE_FACES: &[&[u8]] = &[
-    &[0, 1, 2],
-    &[3, 5, 4],
-    &[0, 3, 4, 1],
-    &[1, 4, 5, 2],
-    &[2, 5, 3, 0],
+    &[0, 2, 1],
+    &[3, 4, 5],
+    &[0, 1, 4, 3],
+    &[1, 2, 5, 4],
+    &[2, 0, 3, 5],
 ];
 const PYRAMID_FACES: &[&[u8]] = &[
     &[0, 3, 2, 1],

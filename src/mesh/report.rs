@@ -50,9 +50,9 @@ pub struct MeshReport {
     /// Cells that use a point id twice.
     pub repeated_index_cells: usize,
     /// Quad faces (per cell) leaving their plane by more than the report
-    /// tolerance of the bounds diagonal.
+    /// tolerance of the face's longer diagonal.
     pub nonplanar_faces: usize,
-    /// Largest quad-face nonplanarity relative to the bounds diagonal.
+    /// Largest quad-face nonplanarity relative to the face's diagonal.
     pub max_nonplanarity: f64,
     /// Consistent tetrahedra of all cells.
     pub tets: usize,

@@ -5,7 +5,7 @@
 //! [`super::predicates`]. The values here bound *numerical* approximations
 //! and classify data for reporting.
 
-/// Relative deviation (of the bounds diagonal) of a quad face's fourth vertex
+/// Relative deviation (of the face's longer diagonal) of a quad face's fourth vertex
 /// from the plane of the other three above which `info` counts the face as
 /// nonplanar. Matches the figure used in `../shared/data/README.md`.
 pub const NONPLANAR_REPORT_REL: f64 = 1e-3;
