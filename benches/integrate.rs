@@ -211,23 +211,6 @@ fn tables(c: &mut Criterion<CpuTime>) {
     let tf = jump_tf();
     let mut g = c.benchmark_group("table");
     g.sample_size(10);
-    for (ns, nl) in [(128usize, 64usize)] {
-        g.bench_with_input(
-            BenchmarkId::new("3d_exact", format!("{ns}x{ns}x{nl}")),
-            &(ns, nl),
-            |b, &(ns, nl)| b.iter(|| Table3d::exact(&tf, ns, nl, (0.0, 1.0), 1.0).expect("table")),
-        );
-        g.bench_with_input(
-            BenchmarkId::new("3d_integral_functions", format!("{ns}x{ns}x{nl}")),
-            &(ns, nl),
-            |b, &(ns, nl)| {
-                b.iter(|| {
-                    Table3d::fast(&tf, ns, nl, (0.0, 1.0), 1.0, FastColour::MeanGlow)
-                        .expect("table")
-                })
-            },
-        );
-    }
     let (ns, nl) = (128usize, 64usize);
     g.bench_with_input(
         BenchmarkId::new("3d_exact", format!("{ns}x{ns}x{nl}")),
