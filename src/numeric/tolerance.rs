@@ -107,3 +107,9 @@ pub const RASTER_FILTER_PX: f64 = 1e-6;
 /// them intersecting pieces (inverted cells) rather than neighbours whose
 /// shared face depth differs by rounding (~1e-16 relative).
 pub const VALIDATE_OVERLAP_REL: f64 = 1e-9;
+
+/// Exact mode: an extinction node whose left and right slopes agree to this
+/// relative difference is not a kink (nodes inserted where only the colour
+/// changes carry slopes that differ by rounding only). Splitting there would
+/// be exact too, only slower.
+pub const TF_SLOPE_REL: f64 = 1e-9;

@@ -37,9 +37,9 @@ use rayon::prelude::*;
 use crate::camera::Camera;
 use crate::gpu::{AccumFormat, Context, ExactVertex, FrameOptions, FrameStats};
 use crate::image::Image;
-use crate::integrate::{vertex_values, RayMaterial};
+use crate::integrate::{vertex_values, VertexValues};
 use crate::mesh::Mesh;
-use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL};
+use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL, TF_SLOPE_REL};
 use crate::projection::{refine, slice_tet, Polyhedron, Projected, Projector};
 use crate::tf::TransferFunction;
 use crate::visibility::{Piece, Sorter, SplitPolicy};
@@ -114,26 +114,57 @@ impl Ctx<'_> {
     }
 }
 
-fn push_projected(ctx: &Ctx, proj: &mut Projected, out: &mut ChunkOut) {
+fn push_projected(
+    ctx: &Ctx,
+    proj: &mut Projected,
+    vals: &mut Vec<VertexValues>,
+    out: &mut ChunkOut,
+) {
     if proj.triangles.is_empty() {
         return;
     }
     let tf = ctx.tf;
-    let before = proj.triangles.len();
-    refine(proj, COLOR_REFINE_MAX_DEPTH, |a, b| {
-        let va = vertex_values(tf, a.l, a.s_front, a.s_back);
-        let vb = vertex_values(tf, b.l, b.s_front, b.s_back);
-        let depth = va.depth.max(vb.depth).min(1.0);
-        let spread = (0..3)
-            .map(|k| (va.glow[k] - vb.glow[k]).abs())
-            .fold(0.0, f64::max);
-        depth * spread > COLOR_REFINE_TOL
-    });
-    out.refined += proj.triangles.len().saturating_sub(before);
+    vals.clear();
+    vals.extend(
+        proj.vertices
+            .iter()
+            .map(|v| vertex_values(tf, v.l, v.s_front, v.s_back)),
+    );
+    // Refine only pieces whose optical depth and glow spread could make the
+    // interpolated C/alpha err (the common thin or uniform piece skips it).
+    let depth = vals.iter().map(|v| v.depth).fold(0.0, f64::max).min(1.0);
+    let spread = (0..3)
+        .map(|k| {
+            let (lo, hi) = vals
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v.glow[k]), hi.max(v.glow[k]))
+                });
+            hi - lo
+        })
+        .fold(0.0, f64::max);
+    if depth * spread > COLOR_REFINE_TOL {
+        let before = proj.triangles.len();
+        refine(proj, COLOR_REFINE_MAX_DEPTH, |a, b| {
+            let va = vertex_values(tf, a.l, a.s_front, a.s_back);
+            let vb = vertex_values(tf, b.l, b.s_front, b.s_back);
+            let depth = va.depth.max(vb.depth).min(1.0);
+            let spread = (0..3)
+                .map(|k| (va.glow[k] - vb.glow[k]).abs())
+                .fold(0.0, f64::max);
+            depth * spread > COLOR_REFINE_TOL
+        });
+        out.refined += proj.triangles.len().saturating_sub(before);
+        let n = vals.len();
+        vals.extend(
+            proj.vertices[n..]
+                .iter()
+                .map(|v| vertex_values(tf, v.l, v.s_front, v.s_back)),
+        );
+    }
     let (w, h) = (ctx.camera.width as f64, ctx.camera.height as f64);
     let base = out.vertices.len() as u32;
-    for v in &proj.vertices {
-        let vv = vertex_values(tf, v.l, v.s_front, v.s_back);
+    for (v, vv) in proj.vertices.iter().zip(vals.iter()) {
         let x = 2.0 * v.px / w - 1.0;
         let y = 1.0 - 2.0 * v.py / h;
         out.vertices.push(ExactVertex::new(
@@ -153,6 +184,7 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
     let mut projector = Projector::new();
     let mut poly = Polyhedron::default();
     let mut proj = Projected::default();
+    let mut vals = Vec::new();
     let pts = &ctx.mesh.points;
     for piece in pieces {
         let cell = piece.cell();
@@ -184,7 +216,7 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                     out.error = Some(format!("cell {c}: {e}"));
                     return out;
                 }
-                push_projected(ctx, &mut proj, &mut out);
+                push_projected(ctx, &mut proj, &mut vals, &mut out);
             }
             Piece::Tet { tet, .. } => {
                 let p: [DVec3; 4] = tet.map(|n| ctx.camera.to_view(pts[n as usize]));
@@ -201,7 +233,7 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                         out.error = Some(format!("cell {cell}: {e}"));
                         return out;
                     }
-                    push_projected(ctx, &mut proj, &mut out);
+                    push_projected(ctx, &mut proj, &mut vals, &mut out);
                     continue;
                 }
                 let slabs = slice_tet(p, s, ctx.breakpoints, ctx.camera);
@@ -211,7 +243,7 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                         out.error = Some(format!("cell {cell}: {e}"));
                         return out;
                     }
-                    push_projected(ctx, &mut proj, &mut out);
+                    push_projected(ctx, &mut proj, &mut vals, &mut out);
                 }
             }
         }
@@ -236,7 +268,8 @@ pub fn split_points(tf: &TransferFunction) -> Vec<f64> {
         if i + 1 < nodes.len() && nodes[i + 1].s == n.s {
             // A jump: two nodes at one scalar.
             let m = &nodes[i + 1];
-            let colour_jump = (0..3).any(|k| n.color[k] != m.color[k] || n.emission[k] != m.emission[k]);
+            let colour_jump =
+                (0..3).any(|k| n.color[k] != m.color[k] || n.emission[k] != m.emission[k]);
             if n.tau != m.tau || colour_jump {
                 out.push(n.s);
             }
@@ -249,7 +282,11 @@ pub fn split_points(tf: &TransferFunction) -> Vec<f64> {
             }
             // The TF is constant outside the node range: a kink at each end
             // when the extinction slopes inside.
-            let inner = if i == 0 { nodes.get(1) } else { nodes.get(i.wrapping_sub(1)) };
+            let inner = if i == 0 {
+                nodes.get(1)
+            } else {
+                nodes.get(i.wrapping_sub(1))
+            };
             if let Some(m) = inner {
                 if m.tau != n.tau {
                     out.push(n.s);
@@ -258,7 +295,11 @@ pub fn split_points(tf: &TransferFunction) -> Vec<f64> {
             continue;
         }
         let (l, r) = (slope(&nodes[i - 1], n), slope(n, &nodes[i + 1]));
-        if l != r {
+        let kink = match (l, r) {
+            (Some(l), Some(r)) => (l - r).abs() > TF_SLOPE_REL * l.abs().max(r.abs()),
+            _ => true,
+        };
+        if kink {
             out.push(n.s);
         }
     }
