@@ -140,7 +140,7 @@ impl Topology {
             .par_iter()
             .flat_map_iter(|&(c0, c1)| {
                 let mut large = Vec::new();
-                for c in c0..c1 {
+                for (c, &base) in offsets.iter().enumerate().take(c1).skip(c0) {
                     cells.for_each_face(c, |local, verts| {
                         if small(verts) {
                             let m = verts.iter().copied().min().unwrap_or(NONE);
@@ -150,7 +150,7 @@ impl Topology {
                         } else if verts.len() > 4 {
                             let mut v = verts.to_vec();
                             v.sort_unstable();
-                            large.push((v, offsets[c] + local as u32));
+                            large.push((v, base + local as u32));
                         }
                     });
                 }
@@ -168,8 +168,7 @@ impl Topology {
         // 2. Bucket entries (the other three ids and the slot), in slot order.
         let mut entries: Vec<[u32; 4]> = vec![[0; 4]; acc as usize];
         let mut cursor = start.clone();
-        for c in 0..n {
-            let base = cell_face_offsets[c];
+        for (c, &base) in cell_face_offsets.iter().enumerate().take(n) {
             cells.for_each_face(c, |local, verts| {
                 if !small(verts) {
                     return;
