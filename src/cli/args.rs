@@ -31,7 +31,7 @@ pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
     if v.len() != 2 {
         return Err(format!("expected LO,HI, got '{s}'"));
     }
-    if !(v[0] < v[1]) {
+    if v[0] >= v[1] {
         return Err(format!("empty range '{s}': LO must be less than HI"));
     }
     Ok((v[0], v[1]))

@@ -23,7 +23,7 @@ enum Command {
     Info(info::InfoArgs),
     /// Render one image of a dataset (exact mode through wgpu, or the CPU
     /// reference ray caster).
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
     /// Compare two images: max absolute, RMS and PSNR over pixels and
     /// channels (float values for two EXR files, else PNG display values).
     Compare(compare::CompareArgs),
