@@ -76,6 +76,8 @@ pub enum RenderError {
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Raycast(#[from] raycast::RaycastError),
+    #[error("the {0} mode cannot represent independent emission (its per-pixel colour is glow x opacity); use --mode raycast")]
+    Unsupported(&'static str),
 }
 
 /// Per-render options (camera, mode, field model, GPU).
@@ -148,6 +150,9 @@ impl<'s> Renderer<'s> {
         };
         let image = match opts.mode {
             Mode::Exact => {
+                if scene.tf.model() == crate::tf::EmissionModel::Independent {
+                    return Err(RenderError::Unsupported("exact"));
+                }
                 let gpu = match self.gpu.take() {
                     Some(g) => g,
                     None => Context::new(&opts.gpu)?,
