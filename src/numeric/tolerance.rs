@@ -59,7 +59,7 @@ pub const NEAR_CLIP_SCALE: f64 = 2.0;
 /// at their midpoint. 1e-3 keeps the error of the interpolated scalars and
 /// thickness below ~1e-3 of the piece's range/diameter (measured: <= 1.2e-3
 /// in close-up wide-angle views) while leaving ordinary views unrefined.
-pub const PERSPECTIVE_INTERP_REL: f64 = 2.5e-4;
+pub const PERSPECTIVE_INTERP_REL: f64 = 1e-3;
 /// Safety factor of the floating-point filter in front of the exact
 /// ray/edge predicate (`raycast::geometry`): the 2D cross product of two
 /// projected vertices is trusted when it exceeds `K eps |a - o| |b - o|`

@@ -243,9 +243,18 @@ impl Projector {
                 ),
                 |(a, b), &p| (a.min(p), b.max(p)),
             );
+            // A piece whose scalars are constant up to rounding (cell data)
+            // has no scalar interpolation error: rounding noise in the
+            // interpolated values must not drive the refinement.
+            let srange = smax - smin;
+            let srange = if srange <= 1e-12 * smax.abs().max(smin.abs()) {
+                f64::INFINITY
+            } else {
+                srange
+            };
             super::refine::refine_perspective(
                 out,
-                smax - smin,
+                srange,
                 (hi - lo).length(),
                 self.max_refine_depth,
                 &mut self.refine,
