@@ -68,7 +68,13 @@ fn render_every_shared_dataset_at_128() {
         // The default-TF shape: opacity ramp 0..1 over the range, unit
         // distance = diagonal / 10.
         let unit = (mesh.diagonal() / 10.0).max(1e-300);
-        let hi = if hi > lo { hi } else { lo + 1.0 };
+        // A constant field (e.g. plastic strain at t = 0) gets a range around
+        // its value, as the default transfer function does.
+        let (lo, hi) = if hi > lo {
+            (lo, hi)
+        } else {
+            (lo - 1.0, lo + 1.0)
+        };
         let m = TestMaterial {
             s: vec![lo, hi],
             tau: vec![0.0, 1.0 / unit],
