@@ -1,0 +1,151 @@
+//! `zoovr render` through the real binary: outputs, exit codes, messages.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use zoovr::image::Image;
+use zoovr::testdata::mesh_file;
+
+fn zoovr(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_zoovr"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("run zoovr")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn renders_png_and_exr_in_both_modes() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = mesh_file("hexahedron.vtk");
+    let mesh = mesh.to_str().unwrap();
+    let ray_png = dir.path().join("ray.png");
+    let ray_exr = dir.path().join("ray.exr");
+    let o = zoovr(&[
+        "render",
+        mesh,
+        "-o",
+        ray_png.to_str().unwrap(),
+        "--float",
+        ray_exr.to_str().unwrap(),
+        "--size",
+        "64x48",
+        "--mode",
+        "raycast",
+        "--azimuth",
+        "-30",
+        "--elevation",
+        "20",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = Image::read(&ray_png).unwrap();
+    assert_eq!((img.width, img.height), (64, 48));
+    let exr = Image::read(&ray_exr).unwrap();
+    assert!(exr.pixels.iter().any(|p| p[3] > 0.01), "nothing drawn");
+
+    let exact_png = dir.path().join("exact.png");
+    let o = zoovr(&[
+        "render",
+        mesh,
+        "-o",
+        exact_png.to_str().unwrap(),
+        "--size",
+        "64x48",
+        "--azimuth",
+        "-30",
+        "--elevation",
+        "20",
+    ]);
+    if !o.status.success() && stderr(&o).contains("adapter") {
+        eprintln!("skipping the exact mode: {}", stderr(&o));
+        return;
+    }
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = zoovr(&[
+        "compare",
+        exact_png.to_str().unwrap(),
+        ray_png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    let max: f64 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("max_abs:"))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .expect("max_abs line");
+    assert!(max <= 2e-2, "exact vs raycast max {max}\n{text}");
+}
+
+#[test]
+fn errors_exit_1_and_name_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("a.png");
+    let out = out.to_str().unwrap();
+    let mesh = mesh_file("tetra.vtk");
+    let mesh = mesh.to_str().unwrap();
+    let o = zoovr(&["render", "/nonexistent/mesh.vtu", "-o", out]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("/nonexistent/mesh.vtu"),
+        "{}",
+        stderr(&o)
+    );
+
+    let o = zoovr(&[
+        "render", mesh, "-o", out, "--field", "nope", "--mode", "raycast",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("nope"), "{}", stderr(&o));
+
+    let o = zoovr(&[
+        "render",
+        mesh,
+        "-o",
+        "/nonexistent/dir/a.png",
+        "--mode",
+        "raycast",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("/nonexistent/dir/a.png"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!Path::new("/nonexistent/dir/a.png").exists());
+
+    let o = zoovr(&[
+        "render",
+        mesh,
+        "-o",
+        out,
+        "--preset",
+        "nosuchmap",
+        "--mode",
+        "raycast",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("nosuchmap"), "{}", stderr(&o));
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    let mesh = mesh_file("tetra.vtk");
+    let mesh = mesh.to_str().unwrap();
+    for bad in [
+        vec!["render", mesh, "-o", "x.png", "--size", "0x10"],
+        vec!["render", mesh, "-o", "x.png", "--range", "1,1"],
+        vec!["render", mesh, "-o", "x.png", "--range", "nan,1"],
+        vec!["render", mesh, "-o", "x.png", "--mode", "nosuchmode"],
+        vec!["render", mesh, "-o", "x.png", "--split", "some"],
+        vec!["render", mesh, "-o", "x.png", "--zoom", "-1"],
+        vec!["render", mesh, "-o", "x.png", "--background", "2,0,0"],
+    ] {
+        let o = zoovr(&bad);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+    }
+}
