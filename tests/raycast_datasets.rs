@@ -1,8 +1,8 @@
 //! Renders every dataset in `../shared/data` at 128 x 128 with the `faces`
 //! model: no error, no non-finite pixel, something visible.
 //!
-//! Skips cleanly when the shared data is absent, and (while the readers are
-//! placeholders) for every file the reader cannot read yet.
+//! Skips cleanly when the shared data is absent; a file that is present
+//! must read and render.
 
 mod raycast_util;
 
@@ -43,6 +43,7 @@ const FILES: &[&str] = &[
 #[test]
 fn render_every_shared_dataset_at_128() {
     let mut rendered = 0;
+    let mut found = 0;
     for rel in FILES {
         let Some(path) = zoovr::testdata::shared_file(rel) else {
             continue;
@@ -51,13 +52,8 @@ fn render_every_shared_dataset_at_128() {
         if rel.ends_with("xyz.bin") {
             opts.q_file = zoovr::testdata::shared_file("bluntfin/bluntfinq.bin");
         }
-        let mesh = match io::read(&path, &opts) {
-            Ok(m) => m,
-            Err(e) => {
-                eprintln!("skipping {rel}: cannot read it yet ({e})");
-                continue;
-            }
-        };
+        found += 1;
+        let mesh = io::read(&path, &opts).unwrap_or_else(|e| panic!("{rel}: {e}"));
         let field = select_field(&mesh, None).unwrap_or(None);
         let (lo, hi) = field.as_ref().map_or((0.0, 1.0), |f| f.range);
         let scalars = match &field {
@@ -105,4 +101,5 @@ fn render_every_shared_dataset_at_128() {
         rendered += 1;
     }
     eprintln!("rendered {rendered} of {} datasets", FILES.len());
+    assert_eq!(rendered, found, "every dataset present must render");
 }

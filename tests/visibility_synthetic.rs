@@ -94,7 +94,7 @@ fn convex_warped_grid_is_exact() {
     let mesh = grid(&spec, |_, _, _| true);
     let topo = Topology::build(&mesh.cells);
     assert!(Sorter::new(&mesh, &topo).convex_boundary());
-    let split = run_views(&mesh, 8, 48, 11, &SplitPolicy::default());
+    let split = run_views(&mesh, 20, 48, 11, &SplitPolicy::default());
     assert!(split > 0, "the jittered grid should have problem cells");
 }
 
@@ -107,7 +107,7 @@ fn warped_grid_12_cubed_is_exact() {
         planar_boundary: false,
     };
     let mesh = grid(&spec, |_, _, _| true);
-    run_views(&mesh, 4, 40, 12, &SplitPolicy::default());
+    run_views(&mesh, 20, 40, 12, &SplitPolicy::default());
 }
 
 #[test]
@@ -121,7 +121,7 @@ fn grid_with_hole_and_cavity_is_exact() {
     let mesh = holed_grid(&spec);
     let topo = Topology::build(&mesh.cells);
     assert!(!Sorter::new(&mesh, &topo).convex_boundary());
-    run_views(&mesh, 6, 48, 13, &SplitPolicy::default());
+    run_views(&mesh, 20, 48, 13, &SplitPolicy::default());
 }
 
 #[test]
@@ -133,7 +133,7 @@ fn notched_grid_is_exact() {
         planar_boundary: false,
     };
     let mesh = notched_grid(&spec);
-    run_views(&mesh, 6, 48, 14, &SplitPolicy::default());
+    run_views(&mesh, 20, 48, 14, &SplitPolicy::default());
 }
 
 #[test]
