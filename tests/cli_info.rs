@@ -205,3 +205,15 @@ fn usage_errors_exit_2() {
     assert_eq!(zoovr(&["info"]).status.code(), Some(2));
     assert_eq!(zoovr(&["info", "x.vtk", "--bogus"]).status.code(), Some(2));
 }
+
+#[test]
+fn q_solution_on_a_non_plot3d_grid_is_an_error() {
+    let f = mesh_file("tetra.vtk");
+    let out = zoovr(&["info", f.to_str().unwrap(), "--q", "solution.q"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("tetra.vtk") && err.contains("solution.q") && err.contains("PLOT3D"),
+        "{err}"
+    );
+}

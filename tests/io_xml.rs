@@ -995,6 +995,13 @@ fn every_corrupt_xml_file_fails_naming_the_file() {
             e.contains(&name),
             "{name}: error does not name the file: {e}"
         );
+        // The place: a byte offset (XML), a line (.series JSON) or the
+        // entry of a collection.
+        let placed = ["byte ", "line "].iter().any(|k| {
+            e.match_indices(k)
+                .any(|(i, _)| e[i + k.len()..].starts_with(|c: char| c.is_ascii_digit()))
+        }) || e.contains("files[");
+        assert!(placed, "{name}: error does not say where: {e}");
         assert!(
             t.elapsed().as_secs_f64() < 2.0,
             "{name} took {:?}",

@@ -117,6 +117,20 @@ fn sniff(path: &Path) -> Result<Format, IoError> {
 /// Reads one dataset (not a collection: see [`read_series`]).
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<Mesh, IoError> {
     let format = detect_format(path)?;
+    // A solution file only means something for a PLOT3D grid (a collection
+    // passes it on to its steps): refuse it elsewhere rather than ignore it.
+    if let Some(q) = &opts.q_file {
+        if !matches!(format, Format::Plot3d | Format::Pvd | Format::Series) {
+            return Err(IoError::parse(
+                path,
+                Location::None,
+                format!(
+                    "--q {} is a PLOT3D solution, but this is not a PLOT3D grid",
+                    q.display()
+                ),
+            ));
+        }
+    }
     match format {
         Format::Legacy => legacy::read(path),
         Format::XmlUnstructured
