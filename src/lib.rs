@@ -7,6 +7,8 @@
 
 pub mod camera;
 pub mod field;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod generate;
 pub mod gpu;
 pub mod image;

@@ -81,7 +81,13 @@ fn finish(coll: &Path, mut steps: Vec<TimeStep>) -> Result<Vec<TimeStep>, IoErro
 /// Reads a `.pvd` collection.
 pub fn read_pvd(path: &Path) -> Result<Vec<TimeStep>, IoError> {
     let bytes = read_small(path)?;
-    let doc = dom::parse(path, &bytes)?;
+    parse_pvd(path, &bytes)
+}
+
+/// Parses the bytes of a `.pvd` collection found at `path` (entries resolve
+/// relative to it and must exist).
+pub fn parse_pvd(path: &Path, bytes: &[u8]) -> Result<Vec<TimeStep>, IoError> {
+    let doc = dom::parse(path, bytes)?;
     let coll = doc
         .root
         .child("Collection")
@@ -123,7 +129,13 @@ struct SeriesEntry {
 /// Reads a `.series` JSON collection.
 pub fn read_series_json(path: &Path) -> Result<Vec<TimeStep>, IoError> {
     let bytes = read_small(path)?;
-    let s: SeriesFile = serde_json::from_slice(&bytes).map_err(|e| {
+    parse_series_json(path, &bytes)
+}
+
+/// Parses the bytes of a `.series` JSON collection found at `path` (entries
+/// resolve relative to it and must exist).
+pub fn parse_series_json(path: &Path, bytes: &[u8]) -> Result<Vec<TimeStep>, IoError> {
+    let s: SeriesFile = serde_json::from_slice(bytes).map_err(|e| {
         IoError::parse(
             path,
             Location::Line(e.line()),

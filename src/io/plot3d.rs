@@ -123,8 +123,10 @@ struct Layout {
 }
 
 impl Layout {
+    /// Point count, saturating (each dimension is at most 2^24, so a
+    /// product can exceed `usize`; a saturated count fails the size checks).
     fn points(&self) -> usize {
-        self.dims.iter().product()
+        self.dims.iter().fold(1usize, |a, &d| a.saturating_mul(d))
     }
 
     fn real_size(&self) -> usize {
@@ -321,15 +323,19 @@ pub fn looks_like_grid(head: &[u8]) -> bool {
         let Some((dims, off)) = f.header(head) else {
             return false;
         };
-        let n: usize = dims.iter().product();
+        let Some(n) = dims.iter().try_fold(1usize, |a, &d| a.checked_mul(d)) else {
+            return false;
+        };
         if n < 8 || dims.iter().any(|&d| d < 2) {
             return false;
         }
         if f.markers {
             // The data record marker must announce a plausible grid size.
-            return f
-                .int(head, off)
-                .is_some_and(|m| [12, 16, 24, 28].iter().any(|&per| m == (per * n) as i64));
+            return f.int(head, off).is_some_and(|m| {
+                [12usize, 16, 24, 28]
+                    .iter()
+                    .any(|&per| per.checked_mul(n).is_some_and(|b| m == b as i64))
+            });
         }
         // Without markers, the first coordinates must be sane numbers.
         let sane32 = (0..2).all(|i| {

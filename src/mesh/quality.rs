@@ -16,14 +16,18 @@
 //! ([`crate::numeric::tolerance::DEGENERATE_VOLUME_REL`]); **inverted** cells
 //! have a negative volume and are not degenerate.
 //!
-//! **Nonplanarity** of a quad face `(a, b, c, d)` is the distance of `d`
-//! from the plane of `a, b, c`; it is reported relative to the face's longer
-//! diagonal against [`crate::numeric::tolerance::NONPLANAR_REPORT_REL`], for
-//! each quad face of each cell in the cell's local vertex order (a face
-//! shared by two cells counts twice). Relative to the face (not the mesh
-//! bounds) this reproduces bluntfin's 2 faces of `../shared/data/README.md`;
-//! can_crush and disk_out_ref give 27,552 and 4,986 against the README's
-//! 24,569 and 2,316, whose exact definition is not stated.
+//! **Nonplanarity** of a quad face `(a, b, c, d)` is the distance of its
+//! vertices from the face's mean plane: the plane through the centroid with
+//! normal `(c - a) x (d - b)` (the Newell normal of a quad). All four
+//! vertices are at the same distance, `|(b - a) . n| / 2`, half the distance
+//! between the lines of the two diagonals. It is reported relative to the
+//! face's longer diagonal against
+//! [`crate::numeric::tolerance::NONPLANAR_REPORT_REL`], for each quad face of
+//! each cell (a face shared by two cells counts twice). This reproduces the
+//! "np faces" column of `../shared/data/README.md` exactly: bluntfin 2,
+//! disk_out_ref 2,316, angular_sector 0, can_crush 24,569 (the last step of
+//! `can_crush/series/`; `can.vtu`, a different state, gives 24,570: the
+//! 24,570th face sits 1.3e-6 above the threshold).
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -128,18 +132,21 @@ pub fn quad_nonplanarity(points: &[DVec3], q: [u32; 4]) -> f64 {
     (n.dot(d - a) / len).abs()
 }
 
-/// [`quad_nonplanarity`] relative to the quad's longer diagonal (0 for a
-/// quad whose diagonals have zero length).
+/// Distance of the quad's vertices from its mean plane (through the
+/// centroid, normal `(c - a) x (d - b)`), i.e. half the distance between the
+/// lines of its diagonals, relative to the longer diagonal. 0 when the
+/// diagonals are parallel or of zero length.
 pub fn quad_nonplanarity_rel(points: &[DVec3], q: [u32; 4]) -> f64 {
     let p = |i: u32| points.get(i as usize).copied().unwrap_or(DVec3::ZERO);
-    let d = (p(q[2]) - p(q[0]))
-        .length()
-        .max((p(q[3]) - p(q[1])).length());
-    if d > 0.0 && d.is_finite() {
-        quad_nonplanarity(points, q) / d
-    } else {
-        0.0
+    let (a, b, c, d) = (p(q[0]), p(q[1]), p(q[2]), p(q[3]));
+    let (e, f) = (c - a, d - b);
+    let n = e.cross(f);
+    let len = n.length();
+    let diag = e.length().max(f.length());
+    if len == 0.0 || !len.is_finite() || !(diag > 0.0 && diag.is_finite()) {
+        return 0.0;
     }
+    0.5 * (n.dot(b - a) / len).abs() / diag
 }
 
 /// Per-cell counts of the quality checks.
@@ -151,10 +158,10 @@ pub struct QualityCounts {
     pub degenerate: usize,
     /// Cells that use a point id twice.
     pub repeated_index: usize,
-    /// Quad faces of cells (counted per cell) whose nonplanarity exceeds
-    /// [`NONPLANAR_REPORT_REL`] of the face's longer diagonal.
+    /// Quad faces of cells (counted per cell) whose distance from their mean
+    /// plane exceeds [`NONPLANAR_REPORT_REL`] of the face's longer diagonal.
     pub nonplanar_faces: usize,
-    /// Largest quad-face nonplanarity relative to the face's diagonal.
+    /// Largest [`quad_nonplanarity_rel`] over all quad faces.
     pub max_nonplanarity: f64,
     /// Sum of `|V|` over all cells.
     pub total_volume: f64,
