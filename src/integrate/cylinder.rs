@@ -36,6 +36,7 @@ use rayon::prelude::*;
 
 use super::grid::{bilinear, check_total, lerp4, Axis, TableError};
 use super::segment::segment;
+use super::table3d::Table3d;
 use crate::tf::TransferFunction;
 
 /// The cylindrical table (see the module docs).
@@ -83,6 +84,12 @@ pub fn table_to_cyl(sf: f64, sb: f64, l: f64) -> (f64, f64, f64) {
     }
 }
 
+/// The exact segment integral as RGBA (premultiplied colour, opacity).
+fn exact_rgba(tf: &TransferFunction, s_f: f64, s_b: f64, l: f64) -> [f64; 4] {
+    let v = segment(tf, l, s_f, s_b);
+    [v.color[0], v.color[1], v.color[2], v.alpha]
+}
+
 impl CylinderTable {
     /// Exact fill: `planes` planes of `ns x ns` texels for scalars in
     /// `s_range` and lengths in `[0, l_max]`.
@@ -97,10 +104,54 @@ impl CylinderTable {
         Axis::new("length", 0.0, l_max, 2)?;
         Axis::new("planes", 0.0, 1.0, planes)?;
         let total = check_total("cylindrical table", &[ns, ns, planes])?;
-        let mut data = vec![0.0f32; 4 * total];
-        let (lo, w) = (s_range.0, s_range.1 - s_range.0);
+        let mut t = Self {
+            s_axis,
+            l_max,
+            planes,
+            data: vec![0.0f32; 4 * total],
+        };
+        t.fill(|sf, sb, l| Some(exact_rgba(tf, sf, sb, l)));
+        Ok(t)
+    }
+
+    /// The re-mapping of a 3D table (RE section 4): every texel is the 3D
+    /// table's trilinear lookup at its equation-9 coordinates, so the result
+    /// carries the 3D table's values in `planes` 2D layers. Scalars and
+    /// length are those of the 3D table.
+    pub fn from_table3d(t3: &Table3d, planes: usize) -> Result<Self, TableError> {
+        let ns = t3.s_axis.n;
+        Axis::new("planes", 0.0, 1.0, planes)?;
+        let total = check_total("cylindrical table", &[ns, ns, planes])?;
+        let mut t = Self {
+            s_axis: t3.s_axis,
+            l_max: t3.l_axis.hi,
+            planes,
+            data: vec![0.0f32; 4 * total],
+        };
+        t.fill(|sf, sb, l| Some(t3.lookup(sf, sb, l)));
+        Ok(t)
+    }
+
+    /// Local update after a transfer-function change confined to the scalar
+    /// interval `[a, b]` (either order): only texels whose segment's scalar
+    /// interval meets it are recomputed from the exact integral of `tf`.
+    pub fn update(&mut self, tf: &TransferFunction, a: f64, b: f64) {
+        let (a, b) = if a <= b { (a, b) } else { (b, a) };
+        self.fill(|sf, sb, l| {
+            (sf.min(sb) <= b && sf.max(sb) >= a).then(|| exact_rgba(tf, sf, sb, l))
+        });
+    }
+
+    /// Sets every texel for which `value(s_f, s_b, l)` (absolute scalars and
+    /// length at the texel's equation-9 coordinates) gives `Some`.
+    fn fill(&mut self, value: impl Fn(f64, f64, f64) -> Option<[f64; 4]> + Sync) {
+        let ns = self.s_axis.n;
+        let planes = self.planes;
+        let (lo, w) = (self.s_axis.lo, self.s_axis.hi - self.s_axis.lo);
+        let l_max = self.l_max;
         let step = 1.0 / (ns - 1) as f64;
-        data.par_chunks_mut(4 * ns)
+        self.data
+            .par_chunks_mut(4 * ns)
             .enumerate()
             .for_each(|(row, out)| {
                 let p = row / ns;
@@ -109,17 +160,11 @@ impl CylinderTable {
                 for iu in 0..ns {
                     let u = iu as f64 * step;
                     let (sf, sb, l) = cyl_to_table(a, u, v);
-                    let seg = segment(tf, l * l_max, lo + sf * w, lo + sb * w);
-                    let t = [seg.color[0], seg.color[1], seg.color[2], seg.alpha];
-                    out[4 * iu..4 * iu + 4].copy_from_slice(&t.map(|x| x as f32));
+                    if let Some(t) = value(lo + sf * w, lo + sb * w, l * l_max) {
+                        out[4 * iu..4 * iu + 4].copy_from_slice(&t.map(|x| x as f32));
+                    }
                 }
             });
-        Ok(Self {
-            s_axis,
-            l_max,
-            planes,
-            data,
-        })
     }
 
     /// Lookup of a segment: equation 10, then bilinear in each of the two
