@@ -135,15 +135,28 @@ impl<'s> Renderer<'s> {
         }
     }
 
-    /// Renders one image.
+    /// Renders one image with the camera of `opts.camera` (fitted to the
+    /// mesh bounds, DESIGN.md Conventions).
     pub fn render(
         &mut self,
         opts: &RenderOptions,
         progress: impl FnMut(usize, usize),
     ) -> Result<(Image, RenderStats), RenderError> {
+        let camera = Camera::fit(self.scene.mesh.bounds(), &opts.camera);
+        self.render_with_camera(opts, &camera, progress)
+    }
+
+    /// Renders one image from an explicit camera (e.g. an eye moved inside
+    /// the mesh); `opts.camera` is not used.
+    pub fn render_with_camera(
+        &mut self,
+        opts: &RenderOptions,
+        camera: &Camera,
+        progress: impl FnMut(usize, usize),
+    ) -> Result<(Image, RenderStats), RenderError> {
         let t0 = Instant::now();
         let scene = self.scene;
-        let camera = Camera::fit(scene.mesh.bounds(), &opts.camera);
+        let camera = *camera;
         let mut stats = RenderStats {
             mode: Some(opts.mode),
             ..Default::default()
