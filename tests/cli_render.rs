@@ -149,3 +149,51 @@ fn usage_errors_exit_2() {
         assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
     }
 }
+
+#[test]
+fn usage_errors_say_what_is_wrong() {
+    let mesh = mesh_file("tetra.vtk");
+    let mesh = mesh.to_str().unwrap();
+    for (bad, words) in [
+        (vec!["--size", "0x10"], ["--size", "0x10"]),
+        (vec!["--range", "1,1"], ["--range", "1,1"]),
+    ] {
+        let mut args = vec!["render", mesh, "-o", "x.png"];
+        args.extend(bad);
+        let o = zoovr(&args);
+        assert_eq!(o.status.code(), Some(2));
+        let e = stderr(&o);
+        assert!(words.iter().all(|w| e.contains(w)), "{e}");
+    }
+}
+
+/// The ray caster reports its field model and early-termination threshold,
+/// and flags that belong to the other mode are named, not silently dropped.
+#[test]
+fn raycast_stats_and_other_mode_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("r.png");
+    let mesh = mesh_file("hexahedron.vtk");
+    let o = zoovr(&[
+        "render",
+        mesh.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--size",
+        "32x32",
+        "--mode",
+        "raycast",
+        "--model",
+        "tets",
+        "--split",
+        "all",
+        "--stats",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("model tets") && e.contains("transmittance 1e-6"),
+        "{e}"
+    );
+    assert!(e.contains("--split all is the exact mode's"), "{e}");
+}

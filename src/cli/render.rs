@@ -60,9 +60,11 @@ pub struct ViewArgs {
     /// (CPU reference).
     #[arg(long, default_value = "exact")]
     pub mode: Mode,
-    /// Field model of the ray caster: faces, tets or native.
-    #[arg(long, default_value = "faces")]
-    pub model: FieldModel,
+    /// Field model of the ray caster: faces (default), tets or native. The
+    /// exact mode integrates `faces` for whole cells and `tets` with
+    /// `--split all`.
+    #[arg(long)]
+    pub model: Option<FieldModel>,
     /// `--split all`: draw every cell as its consistent tetrahedra.
     #[arg(long, value_parser = ["all"])]
     pub split: Option<String>,
@@ -109,7 +111,7 @@ impl ViewArgs {
                 ..Default::default()
             },
             mode: self.mode,
-            model: self.model,
+            model: self.model.unwrap_or_default(),
             split_all: self.split.is_some(),
             gpu: GpuOptions {
                 backend: self.backend,
@@ -188,6 +190,13 @@ pub fn print_stats(stats: &RenderStats, load_s: f64) {
             e.gpu_total_s, e.gpu.upload_s, e.gpu.gpu_wait_s, e.gpu.readback_s, e.gpu.batches
         );
     }
+    if let Some(r) = &stats.raycast {
+        eprintln!(
+            "raycast      model {}, early ray termination below transmittance {:e}",
+            r.model.name(),
+            r.termination_transmittance
+        );
+    }
     eprintln!("render total {:.3} s", stats.total_s);
 }
 
@@ -200,6 +209,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let load_s = t0.elapsed().as_secs_f64();
     let mut renderer = Renderer::new(&scene);
     let opts = args.view.render_options();
+    match opts.mode {
+        Mode::Exact if args.view.model.is_some_and(|m| m != FieldModel::Faces) => eprintln!(
+            "zoovr: note: --model is the ray caster's; the exact mode integrates the `faces` \
+             field of whole cells, or `tets` with --split all"
+        ),
+        Mode::Raycast if opts.split_all => eprintln!(
+            "zoovr: note: --split all is the exact mode's; the ray caster's field is --model \
+             (`--model tets` integrates the consistent tets)"
+        ),
+        _ => {}
+    }
     let (image, stats) = renderer
         .render(&opts, progress_bar("rendering"))
         .with_context(|| format!("{}", args.file.display()))?;

@@ -35,6 +35,8 @@ pub mod walk;
 
 use std::borrow::Cow;
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use rayon::prelude::*;
 use thiserror::Error;
 
@@ -55,6 +57,17 @@ pub enum FieldModel {
     Faces,
     Tets,
     Native,
+}
+
+impl FieldModel {
+    /// The name `--model` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            FieldModel::Faces => "faces",
+            FieldModel::Tets => "tets",
+            FieldModel::Native => "native",
+        }
+    }
 }
 
 impl std::str::FromStr for FieldModel {
@@ -402,25 +415,56 @@ impl<'a> Raycaster<'a> {
         camera: &Camera,
         opts: &RaycastOptions,
     ) -> Image {
+        self.render_with_progress(material, camera, opts, |_, _| {})
+    }
+
+    /// [`Raycaster::render`], calling `progress(done, total)` (in tiles)
+    /// from the calling thread about ten times a second while the tiles are
+    /// traced on the rayon pool, and once at the end.
+    pub fn render_with_progress<M: RayMaterial>(
+        &self,
+        material: &M,
+        camera: &Camera,
+        opts: &RaycastOptions,
+        mut progress: impl FnMut(usize, usize),
+    ) -> Image {
         let (w, h) = (camera.width, camera.height);
         let tile = opts.tile.max(1);
         let tiles_x = w.div_ceil(tile);
         let tiles_y = h.div_ceil(tile);
+        let total = (tiles_x * tiles_y) as usize;
         let t_near = if camera.ortho { 0.0 } else { camera.near };
-        let tiles: Vec<(u32, u32, Vec<[f32; 4]>)> = (0..tiles_x * tiles_y)
-            .into_par_iter()
-            .map_init(Scratch::default, |scratch, k| {
-                let (tx, ty) = (k % tiles_x, k / tiles_x);
-                let mut px = Vec::with_capacity((tile * tile) as usize);
-                for j in ty * tile..((ty + 1) * tile).min(h) {
-                    for i in tx * tile..((tx + 1) * tile).min(w) {
-                        let ray = camera.pixel_ray(i, j);
-                        px.push(self.trace(material, &ray, t_near, opts, scratch).rgba());
+        let done = AtomicUsize::new(0);
+        let trace_tiles = || -> Vec<(u32, u32, Vec<[f32; 4]>)> {
+            (0..tiles_x * tiles_y)
+                .into_par_iter()
+                .map_init(Scratch::default, |scratch, k| {
+                    let (tx, ty) = (k % tiles_x, k / tiles_x);
+                    let mut px = Vec::with_capacity((tile * tile) as usize);
+                    for j in ty * tile..((ty + 1) * tile).min(h) {
+                        for i in tx * tile..((tx + 1) * tile).min(w) {
+                            let ray = camera.pixel_ray(i, j);
+                            px.push(self.trace(material, &ray, t_near, opts, scratch).rgba());
+                        }
                     }
-                }
-                (tx, ty, px)
-            })
-            .collect();
+                    done.fetch_add(1, Ordering::Relaxed);
+                    (tx, ty, px)
+                })
+                .collect()
+        };
+        let tiles = std::thread::scope(|scope| {
+            let worker = scope.spawn(trace_tiles);
+            while !worker.is_finished() {
+                progress(done.load(Ordering::Relaxed), total);
+                std::thread::sleep(std::time::Duration::from_millis(100));
+            }
+            worker.join()
+        });
+        let tiles = match tiles {
+            Ok(t) => t,
+            Err(panic) => std::panic::resume_unwind(panic),
+        };
+        progress(total, total);
         let mut img = Image::new(w, h);
         for (tx, ty, px) in tiles {
             let mut it = px.into_iter();

@@ -113,7 +113,17 @@ pub struct RenderStats {
     pub total_s: f64,
     pub setup_s: f64,
     pub exact: Option<ExactStats>,
+    pub raycast: Option<RaycastStats>,
     pub gpu_adapter: Option<String>,
+}
+
+/// What a ray-cast render used.
+#[derive(Clone, Copy, Debug)]
+pub struct RaycastStats {
+    pub model: FieldModel,
+    /// Rays stop once their transmittance falls below this (0: never), so
+    /// a pixel's opacity may fall short of the full integral by at most it.
+    pub termination_transmittance: f64,
 }
 
 /// Reusable state for rendering many views of one scene.
@@ -213,7 +223,11 @@ impl<'s> Renderer<'s> {
                     model: opts.model,
                     ..Default::default()
                 };
-                let img = rc.render(&scene.tf, &camera, &ro);
+                stats.raycast = Some(RaycastStats {
+                    model: opts.model,
+                    termination_transmittance: ro.early_termination,
+                });
+                let img = rc.render_with_progress(&scene.tf, &camera, &ro, progress);
                 self.raycaster = Some((opts.model, rc));
                 img
             }
