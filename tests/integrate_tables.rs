@@ -319,11 +319,17 @@ fn cylinder_from_table3d_carries_the_3d_table() {
             let want = t3.lookup(sf, sb, l);
             let o = 4 * ((p * ns + iv) * ns + iu);
             for k in 0..4 {
-                assert!((c.data[o + k] as f64 - want[k]).abs() < 1e-6, "{p} {iu} {iv}");
+                assert!(
+                    (c.data[o + k] as f64 - want[k]).abs() < 1e-6,
+                    "{p} {iu} {iv}"
+                );
             }
         }
     }
     let e3 = measure(&tf, 1.0, 1500, |a, b, l| t3.lookup(a, b, l));
     let ec = measure(&tf, 1.0, 1500, |a, b, l| c.lookup(a, b, l));
-    assert!(ec[0] < 2.0 * e3[0] + 1e-4 && ec[2] < 2.0 * e3[2] + 1e-4, "{ec:?} vs {e3:?}");
+    assert!(
+        ec[0] < 2.0 * e3[0] + 1e-4 && ec[2] < 2.0 * e3[2] + 1e-4,
+        "{ec:?} vs {e3:?}"
+    );
 }
