@@ -36,6 +36,8 @@ pub const TARGETS: &[(&str, fn(&[u8]))] = &[
 pub fn legacy(data: &[u8]) {
     let path = Path::new("fuzz.vtk");
     if let Ok(mesh) = io::legacy::read_bytes(path, data) {
+        mesh.sanity_check()
+            .expect("a mesh a reader returns is well formed");
         let n = mesh.points.len();
         assert!(mesh.cells.conn.iter().all(|&p| (p as usize) < n));
         let c = &mesh.cells;
@@ -52,6 +54,8 @@ pub fn xml(data: &[u8]) {
         Format::XmlImage,
     ] {
         if let Ok(m) = xml::read_bytes(Path::new("fuzz.vtu"), data, format) {
+            m.sanity_check()
+                .expect("a mesh a reader returns is well formed");
             for c in 0..m.cells.len() {
                 assert!(m
                     .cells
@@ -103,6 +107,8 @@ pub fn plot3d(data: &[u8]) {
         (g, Some((Path::new("fuzz.q"), q)))
     };
     if let Ok(mesh) = io::plot3d::read_bytes(path, grid, q) {
+        mesh.sanity_check()
+            .expect("a mesh a reader returns is well formed");
         let n = mesh.points.len();
         assert!(mesh.cells.conn.iter().all(|&p| (p as usize) < n));
     }

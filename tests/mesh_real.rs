@@ -60,6 +60,8 @@ fn shared_datasets_match_the_readme() {
             continue;
         };
         let mesh = read(&path, &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        mesh.sanity_check()
+            .unwrap_or_else(|e| panic!("{file}: {e}"));
         let topo = Topology::build(&mesh.cells);
         topo.sanity_check(&mesh.cells).unwrap();
         let r = MeshReport::compute_with(&mesh, &topo);

@@ -229,3 +229,30 @@ fn million_hexes_connect_quickly() {
     eprintln!("report of 1M hexes: {:?}: {r:?}", t1.elapsed());
     assert_eq!(r.inverted_tets, 0);
 }
+
+/// `Mesh::sanity_check` accepts generated meshes and names each kind of
+/// broken structure.
+#[test]
+fn mesh_sanity_check_catches_broken_structure() {
+    let good = zoovr::generate::zoo_grid(3, &zoovr::generate::Warp::default());
+    good.sanity_check().unwrap();
+    let breakers: Vec<(&str, Box<dyn Fn(&mut zoovr::mesh::Mesh)>)> = vec![
+        ("node id", Box::new(|m| m.cells.conn[3] = 1 << 30)),
+        (
+            "offsets",
+            Box::new(|m| m.cells.offsets.pop().map(|_| ()).unwrap()),
+        ),
+        ("not finite", Box::new(|m| m.points[2].y = f64::NAN)),
+        ("tuples", Box::new(|m| m.points.push(glam::DVec3::ZERO))),
+        (
+            "nodes, expected",
+            Box::new(|m| m.cells.kinds[0] = zoovr::mesh::CellKind::Pyramid),
+        ),
+    ];
+    for (words, f) in breakers {
+        let mut m = good.clone();
+        f(&mut m);
+        let e = m.sanity_check().expect_err(words);
+        assert!(e.contains(words), "{words}: {e}");
+    }
+}

@@ -54,6 +54,7 @@ fn render_every_shared_dataset_at_128() {
         }
         found += 1;
         let mesh = io::read(&path, &opts).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        mesh.sanity_check().unwrap_or_else(|e| panic!("{rel}: {e}"));
         let field = select_field(&mesh, None).unwrap_or(None);
         let (lo, hi) = field.as_ref().map_or((0.0, 1.0), |f| f.range);
         let scalars = match &field {

@@ -176,4 +176,90 @@ impl Mesh {
         let b = self.bounds();
         DVec3::new(b[1] - b[0], b[3] - b[2], b[5] - b[4]).length()
     }
+
+    /// Checks the structure every reader guarantees: CSR offsets start at 0,
+    /// never decrease and end at the connectivity length; each cell has its
+    /// kind's corner count (polyhedra: their faces, whose ids are in range);
+    /// every node id names a point; every point is finite; every array has
+    /// one tuple per point (cell) and a whole number of tuples. Run by the
+    /// reader tests on every file they read.
+    pub fn sanity_check(&self) -> Result<(), String> {
+        let c = &self.cells;
+        let n = c.len();
+        if n == 0 {
+            if !(c.offsets.is_empty() || c.offsets == [0]) || !c.conn.is_empty() {
+                return Err("no cells but offsets or connectivity".into());
+            }
+        } else {
+            if c.offsets.len() != n + 1 {
+                return Err(format!("{} offsets for {n} cells", c.offsets.len()));
+            }
+            if c.offsets[0] != 0 || c.offsets[n] as usize != c.conn.len() {
+                return Err(format!(
+                    "offsets run {}..{} over {} node ids",
+                    c.offsets[0],
+                    c.offsets[n],
+                    c.conn.len()
+                ));
+            }
+            for (cell, w) in c.offsets.windows(2).enumerate() {
+                if w[1] < w[0] {
+                    return Err(format!("cell {cell}: offsets decrease"));
+                }
+                let k = (w[1] - w[0]) as usize;
+                match c.kinds[cell].corner_count() {
+                    Some(want) if want != k => {
+                        return Err(format!(
+                            "cell {cell} ({}) has {k} nodes, expected {want}",
+                            c.kinds[cell].vtk_name()
+                        ))
+                    }
+                    Some(_) => {}
+                    None => {
+                        let faces = c
+                            .poly_faces
+                            .get(&(cell as u32))
+                            .ok_or_else(|| format!("polyhedron {cell} has no faces"))?;
+                        if faces.len() < 4 || faces.iter().any(|f| f.len() < 3) {
+                            return Err(format!("polyhedron {cell}: malformed faces"));
+                        }
+                        let np = self.points.len();
+                        if faces.iter().flatten().any(|&p| p as usize >= np) {
+                            return Err(format!("polyhedron {cell}: face id out of range"));
+                        }
+                    }
+                }
+            }
+        }
+        let np = self.points.len();
+        if let Some(&bad) = c.conn.iter().find(|&&p| p as usize >= np) {
+            return Err(format!("node id {bad} but {np} points"));
+        }
+        if let Some(i) = self.points.iter().position(|p| !p.is_finite()) {
+            return Err(format!("point {i} is not finite"));
+        }
+        for (arrays, want, what) in [
+            (&self.point_data, np, "point"),
+            (&self.cell_data, n, "cell"),
+        ] {
+            for a in arrays {
+                if a.components == 0 || a.data.len() % a.components != 0 {
+                    return Err(format!(
+                        "{what} array '{}': {} values in tuples of {}",
+                        a.name,
+                        a.data.len(),
+                        a.components
+                    ));
+                }
+                if a.tuples() != want {
+                    return Err(format!(
+                        "{what} array '{}' has {} tuples for {want} {what}s",
+                        a.name,
+                        a.tuples()
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
 }
