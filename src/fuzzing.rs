@@ -21,8 +21,11 @@ use crate::tf::TransferFunction;
 use crate::visibility::synth::{grid, holed_grid, GridSpec};
 use crate::visibility::{sample_pixels, validate, Sorter, SplitPolicy};
 
+/// A fuzz target's body.
+pub type Target = fn(&[u8]);
+
 /// The targets by name, as `fuzz/Cargo.toml` lists them.
-pub const TARGETS: &[(&str, fn(&[u8]))] = &[
+pub const TARGETS: &[(&str, Target)] = &[
     ("legacy", legacy),
     ("xml", xml),
     ("collection", collection),

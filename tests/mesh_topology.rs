@@ -236,7 +236,8 @@ fn million_hexes_connect_quickly() {
 fn mesh_sanity_check_catches_broken_structure() {
     let good = zoovr::generate::zoo_grid(3, &zoovr::generate::Warp::default());
     good.sanity_check().unwrap();
-    let breakers: Vec<(&str, Box<dyn Fn(&mut zoovr::mesh::Mesh)>)> = vec![
+    type Breaker = Box<dyn Fn(&mut zoovr::mesh::Mesh)>;
+    let breakers: Vec<(&str, Breaker)> = vec![
         ("node id", Box::new(|m| m.cells.conn[3] = 1 << 30)),
         (
             "offsets",

@@ -347,3 +347,46 @@ fn bad_input_is_an_error() {
     assert!(pr.project(&p, &cam, &mut out).is_err());
     let _ = DVec2::ZERO;
 }
+
+#[test]
+fn fuzz_pentagonal_prism_edge_on_perspective() {
+    // Fuzz input (21 bytes)
+    // 2e 1d 15 00 00 00 3d 1c ff ff 00 00 00 63 ff 0b 1d 2a 1d 1d 1d
+    // (fuzz target `projection`, f(i) = data[i] as i8 / 16): a
+    // pentagonal prism whose pentagon faces contain the view direction, seen
+    // in perspective, so many projected vertices are nearly collinear. Used
+    // to fail with "euler formula violated: V=23 E=48 cycles=23".
+    use glam::DMat3;
+    use zoovr::mesh::{CellKind, Cells};
+    let m = DMat3::from_cols_array(&[
+        1.8125, 1.3125, 0.0, 0.0, 0.0, 3.8125, 1.75, -0.0625, -0.0625,
+    ]);
+    let pts: Vec<DVec3> = (0..10)
+        .map(|i| {
+            let a = std::f64::consts::TAU * (i % 5) as f64 / 5.0;
+            m * DVec3::new(a.cos(), a.sin(), (i / 5) as f64)
+        })
+        .collect();
+    let mut cells = Cells::default();
+    cells.push(CellKind::PentagonalPrism, &(0..10).collect::<Vec<u32>>());
+    let params = CameraParams {
+        width: 64,
+        height: 48,
+        azimuth: 0.0,
+        elevation: 0.0,
+        roll: 0.0,
+        ortho: false,
+        ..Default::default()
+    };
+    let cam = Camera::fit([-8.0, 8.0, -8.0, 8.0, -8.0, 8.0], &params);
+    let f = |b: u8| (b as i8) as f64 / 16.0;
+    let data = [0xffu8, 0x0b, 0x1d, 0x2a, 0x1d, 0x1d];
+    let s: Vec<f64> = (0..10).map(|i| f(data[i % 6])).collect();
+    let poly = Polyhedron::from_cell(&cells, 0, &pts, |i| s[i as usize], &cam).unwrap();
+    let mut pr = projector();
+    let mut out = Projected::default();
+    pr.project(&poly, &cam, &mut out).unwrap();
+    pr.arrangement().sanity_check().unwrap();
+    check_area(&out, &poly, &cam);
+    assert!(out.vertices.iter().all(|v| v.l.is_finite() && v.l >= 0.0));
+}

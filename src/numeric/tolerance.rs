@@ -50,6 +50,15 @@ pub const INTEGRAL_FUNCTION_MIN_DS_REL: f64 = 1e-7;
 /// position. `near` is 1e-9 of the camera distance: the clipped sliver is far
 /// below any pixel.
 pub const NEAR_CLIP_SCALE: f64 = 2.0;
+/// Projection (renderer, [`crate::projection::Projector::clip_to_image`]):
+/// regions reaching beyond the image rectangle grown by this many pixels on
+/// every side are clipped to it. Near-plane caps project to ~1e9 pixels
+/// (`1 / NEAR_CLIP_SCALE` of the inverse near distance), where no bounded
+/// midpoint refinement can make screen-space interpolation accurate on
+/// screen; the rasteriser only samples pixel centres (`0.5 ..= W - 0.5`), so
+/// any margin of at least half a pixel loses nothing. A few pixels keep the
+/// window's own edges well away from every centre.
+pub const IMAGE_CLIP_MARGIN_PX: f64 = 4.0;
 
 /// Projection (perspective): region values are interpolated linearly in
 /// screen space. Region edges whose interpolation error bound (screen-space

@@ -35,6 +35,7 @@
 
 mod arrangement;
 mod clip;
+mod exact;
 mod polyhedron;
 mod project;
 mod refine;

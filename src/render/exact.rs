@@ -31,7 +31,7 @@
 
 use std::time::Instant;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::camera::Camera;
@@ -39,6 +39,7 @@ use crate::gpu::{AccumFormat, Context, ExactVertex, FrameOptions, FrameStats};
 use crate::image::Image;
 use crate::integrate::{vertex_values, VertexValues};
 use crate::mesh::Mesh;
+use crate::numeric::predicates::{orient2d, Side};
 use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL, TF_SLOPE_REL};
 use crate::projection::{refine, slice_tet, Polyhedron, Projected, Projector};
 use crate::tf::TransferFunction;
@@ -73,6 +74,8 @@ struct ChunkOut {
     culled: usize,
     slabs: usize,
     refined: usize,
+    /// Triangles dropped as degenerate in f32 ([`gpu_area_positive`]).
+    degenerate: usize,
     error: Option<String>,
 }
 
@@ -82,6 +85,8 @@ struct Ctx<'a> {
     tf: &'a TransferFunction,
     camera: &'a Camera,
     breakpoints: &'a [f64],
+    /// The frame's length unit ([`FrameOptions::length_unit`]).
+    length_unit: f64,
 }
 
 impl Ctx<'_> {
@@ -164,24 +169,76 @@ fn push_projected(
     }
     let (w, h) = (ctx.camera.width as f64, ctx.camera.height as f64);
     let base = out.vertices.len() as u32;
+    let k = depth_balance(proj, vals, ctx.length_unit);
     for (v, vv) in proj.vertices.iter().zip(vals.iter()) {
         let x = 2.0 * v.px / w - 1.0;
         let y = 1.0 - 2.0 * v.py / h;
         out.vertices.push(ExactVertex::new(
             [x as f32, y as f32, 0.5, 1.0],
-            v.l as f32,
-            vv.tau_mean as f32,
+            (v.l * k) as f32,
+            (vv.tau_mean / k) as f32,
             [vv.glow[0] as f32, vv.glow[1] as f32, vv.glow[2] as f32],
         ));
     }
     for t in &proj.triangles {
-        out.indices.extend(t.iter().map(|&i| base + i));
+        let [a, b, c] = t.map(|i| &out.vertices[(base + i) as usize]);
+        if gpu_area_positive(a, b, c) {
+            out.indices.extend(t.iter().map(|&i| base + i));
+        } else {
+            out.degenerate += 1;
+        }
     }
+}
+
+/// The factor `k` by which one piece's thicknesses are multiplied and its
+/// mean extinctions divided before they reach the GPU.
+///
+/// The fragment's opacity `1 - exp(-l tau)` depends on the product only,
+/// and a constant `k` over a triangle leaves the product of the two
+/// interpolants unchanged at every pixel. But the exponential table
+/// addresses `l' = l / unit` and `tau' = tau unit` on separate axes, each
+/// clamped to [`crate::gpu::exptable::AXIS_MAX`] = 1e6: a piece 1e-12 of
+/// the unit thin with extinction 1e12 per unit (optical depth 1) would
+/// read as depth 1e-6. Balancing the piece's largest `l'` and `tau'` to the
+/// same value, `sqrt(max l' max tau')`, keeps both inside the table for
+/// every optical depth up to 1e12 and puts them where its relative accuracy
+/// is best. `k = 1` when either maximum is zero or not finite.
+fn depth_balance(proj: &Projected, vals: &[VertexValues], unit: f64) -> f64 {
+    let l_max = proj.vertices.iter().map(|v| v.l).fold(0.0, f64::max) / unit;
+    let tau_max = vals.iter().map(|v| v.tau_mean).fold(0.0, f64::max) * unit;
+    let k = (tau_max / l_max).sqrt();
+    if l_max > 0.0 && tau_max > 0.0 && k.is_finite() && k > 0.0 {
+        k
+    } else {
+        1.0
+    }
+}
+
+/// Whether the GPU sees the triangle `a, b, c` (region triangles are CCW in
+/// pixel coordinates, see [`crate::projection`]) with positive area: the
+/// exact orientation of the f32 positions it is given (`w = 1`).
+///
+/// The projection keeps every triangle whose f64 pixel positions have a
+/// positive exact orientation; a sliver region (e.g. next to a face seen
+/// exactly edge-on, its vertices rounded off the common line) can become
+/// collinear or inverted once rounded to f32. Mesa's rasteriser gives NaN
+/// colour on pixel centres along such a zero-area triangle (its attribute
+/// planes divide by the area), and one NaN poisons all blending over it. A
+/// triangle of zero area covers nothing, so dropping it loses nothing; an
+/// inverted one would overlap its neighbours.
+fn gpu_area_positive(a: &ExactVertex, b: &ExactVertex, c: &ExactVertex) -> bool {
+    // NDC y points up, pixel y down: flip y to keep the pixel orientation.
+    let p = |v: &ExactVertex| DVec2::new(v.pos[0] as f64, -(v.pos[1] as f64));
+    orient2d(p(a), p(b), p(c)) == Side::Positive
 }
 
 fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
     let mut out = ChunkOut::default();
     let mut projector = Projector::new();
+    // Pieces cut by the near plane reach ~1e9 pixels off screen: clip their
+    // regions to the image so that screen-space interpolation stays exact
+    // up to the perspective refinement's bound.
+    projector.clip_to_image = true;
     let mut poly = Polyhedron::default();
     let mut proj = Projected::default();
     let mut vals = Vec::new();
@@ -340,6 +397,7 @@ pub fn render_exact(
         tf: &scene.tf,
         camera,
         breakpoints: &breakpoints,
+        length_unit: scene.unit_distance as f32 as f64,
     };
     let mut opts = FrameOptions::new(camera.width, camera.height, format);
     opts.length_unit = scene.unit_distance as f32;
@@ -372,4 +430,84 @@ pub fn render_exact(
     stats.project_s = project_s;
     stats.gpu_total_s = t_gpu.elapsed().as_secs_f64() - project_s;
     Ok((image, stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::CameraParams;
+    use crate::generate::{warped_hex_grid, Warp};
+    use crate::render::SceneSpec;
+    use crate::tf::EmissionModel;
+
+    /// An unwarped grid seen in perspective straight down an axis, every
+    /// cell split into tets: the diagonal faces of the tets in the planes
+    /// through the eye are seen exactly edge-on, and rounding the pixel
+    /// positions leaves sliver regions that are collinear in f32 (Mesa gave
+    /// NaN pixels on them, tests/stress_scenes.rs `edge_on_...`). None may
+    /// reach the GPU.
+    #[test]
+    fn no_triangle_degenerate_in_f32_reaches_the_gpu() {
+        let mesh = warped_hex_grid(
+            2,
+            &Warp {
+                amplitude: 0.0,
+                seed: 7,
+            },
+        );
+        let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        scene.tf = TransferFunction::from_channels(
+            &[(0.0, [0.0]), (0.5, [6.0]), (1.0, [10.0])],
+            &[(0.0, [0.1, 0.2, 0.9]), (1.0, [1.0, 0.5, 0.1])],
+            None,
+            EmissionModel::Glow,
+        )
+        .unwrap();
+        let params = CameraParams {
+            width: 96,
+            height: 96,
+            azimuth: 0.0,
+            elevation: 0.0,
+            ortho: false,
+            ..Default::default()
+        };
+        let camera = Camera::fit(scene.mesh.bounds(), &params);
+        let breakpoints = split_points(&scene.tf);
+        let point_scalars = match scene.scalars() {
+            ScalarsRef::Point(v) => Some(v),
+            _ => None,
+        };
+        let policy = SplitPolicy {
+            all: true,
+            breakpoints: &breakpoints,
+            point_scalars,
+        };
+        let mut sorter = Sorter::new(&scene.mesh, &scene.topology);
+        let order = sorter.order(&camera, &policy).unwrap();
+        let ctx = Ctx {
+            mesh: &scene.mesh,
+            scalars: scene.scalars(),
+            tf: &scene.tf,
+            camera: &camera,
+            breakpoints: &breakpoints,
+            length_unit: scene.unit_distance,
+        };
+        // Piece by piece, up to the first one that makes such a sliver (the
+        // whole view refines into ~1e5 triangles).
+        let mut degenerate = 0;
+        for piece in &order.pieces {
+            let out = process_chunk(&ctx, std::slice::from_ref(piece));
+            assert_eq!(out.error, None);
+            for t in out.indices.chunks(3) {
+                let [a, b, c] = [0, 1, 2].map(|k| &out.vertices[t[k] as usize]);
+                assert!(gpu_area_positive(a, b, c), "{piece:?}: {a:?} {b:?} {c:?}");
+            }
+            degenerate += out.degenerate;
+            if degenerate > 0 {
+                break;
+            }
+        }
+        // The view still makes the case this guards against.
+        assert!(degenerate > 0, "no f32-degenerate sliver in this view");
+    }
 }
