@@ -197,3 +197,77 @@ fn raycast_stats_and_other_mode_flags() {
     );
     assert!(e.contains("--split all is the exact mode's"), "{e}");
 }
+
+/// A full disk (simulated with a file-size limit: writes fail with EFBIG, the
+/// error a full or quota-limited disk gives in kind) and an output path
+/// under a regular file: a clear error naming the file, exit 1, and no file
+/// or temporary left behind.
+#[cfg(unix)]
+#[test]
+fn unwritable_outputs_fail_cleanly_and_leave_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("full.png");
+    let mesh = mesh_file("hexahedron.vtk");
+    let cmd = format!(
+        "trap '' XFSZ; ulimit -f 4; exec '{}' render '{}' -o '{}' --size 256x256 --mode raycast",
+        env!("CARGO_BIN_EXE_zoovr"),
+        mesh.display(),
+        png.display()
+    );
+    let o = Command::new("bash").arg("-c").arg(&cmd).output().unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("full.png"), "{}", stderr(&o));
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+
+    let o = zoovr(&[
+        "render",
+        mesh.to_str().unwrap(),
+        "-o",
+        "/dev/null/x.png",
+        "--size",
+        "16x16",
+        "--mode",
+        "raycast",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("/dev/null/x.png"), "{}", stderr(&o));
+}
+
+/// A render interrupted before it finishes leaves no output file (images are
+/// written to a temporary and renamed only when complete).
+#[cfg(unix)]
+#[test]
+fn interrupted_render_leaves_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("slow.png");
+    let mesh = mesh_file("curvilinear_4x4x4.vtu");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_zoovr"))
+        .args([
+            "render",
+            mesh.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+            "--size",
+            "1500x1500",
+            "--mode",
+            "raycast",
+            "--model",
+            "native",
+        ])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(400));
+    // SAFETY: kill(2) on our own child's pid.
+    unsafe {
+        libc::kill(child.id() as i32, libc::SIGINT);
+    }
+    let status = child.wait().unwrap();
+    assert!(
+        !status.success(),
+        "the render finished before the interrupt"
+    );
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}
