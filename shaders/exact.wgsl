@@ -87,8 +87,23 @@ fn alpha_of(l: f32, tau: f32) -> f32 {
     return r0 * (1.0 - fv) + r1 * fv;
 }
 
+// Whether a value is finite: false for NaN (every comparison with NaN is
+// false) and for infinities.
+fn finite(x: f32) -> bool {
+    return abs(x) <= 3.4028235e38;
+}
+
 @fragment
 fn fs_main(f: VertexOut) -> @location(0) vec4<f32> {
+    // Every vertex the CPU sends is finite, but a rasteriser may still
+    // interpolate garbage on a sliver of almost zero area (its attribute
+    // planes divide by the area: Mesa gives NaN). Such a fragment has no
+    // meaningful value; it contributes nothing rather than poisoning every
+    // layer blended over it.
+    if !(finite(f.thickness) && finite(f.tau) && finite(f.glow.x) && finite(f.glow.y)
+        && finite(f.glow.z)) {
+        return vec4<f32>(0.0);
+    }
     let alpha = alpha_of(f.thickness, f.tau);
     return vec4<f32>(f.glow * alpha, alpha);
 }

@@ -122,3 +122,16 @@ pub const VALIDATE_OVERLAP_REL: f64 = 1e-9;
 /// changes carry slopes that differ by rounding only). Splitting there would
 /// be exact too, only slower.
 pub const TF_SLOPE_REL: f64 = 1e-9;
+
+/// Projection refinement (`projection::refine`): a region triangle narrower
+/// than this many pixels (twice its area over its longest edge) never asks
+/// for a split itself; its edges are split only where a wider neighbour
+/// asks. Faces seen exactly edge-on project, through rounded positions, to
+/// slivers ~1e-14 px wide whose values are meaningless, and refining them
+/// to the depth limit multiplied the triangle count (one prism -> 15k
+/// triangles). Such a triangle can cover only pixel centres within this
+/// distance of a line, which is below the f32 rounding of the vertex
+/// positions the rasteriser receives (~1e-5 px for a 100 px image), so its
+/// coverage is decided by rounding anyway; it still gets drawn, with its
+/// vertices' (well-conditioned) values.
+pub const SLIVER_WIDTH_PX: f64 = 1e-6;

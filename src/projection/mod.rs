@@ -141,6 +141,11 @@ impl ViewMap {
     }
 }
 
+/// For a point shared by several regions: the region whose front triangle,
+/// and the one whose back triangle, is widest ([`FaceTri::width`]), with
+/// those widths.
+pub(crate) type WidestFaces = [(u32, f64); 2];
+
 /// A boundary triangle as seen on screen: pixel positions of its corners
 /// with their depths and scalars.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -164,8 +169,41 @@ impl FaceTri {
         f
     }
 
+    /// Smallest width of the projected triangle (twice its area over its
+    /// longest edge), pixels; 0 when degenerate.
+    ///
+    /// Evaluating the triangle's plane at a point turns an error `d` in the
+    /// point's (or the corners') pixel position into an error of about
+    /// `d / width` of the triangle's depth and scalar variation: faces seen
+    /// (nearly) edge-on have widths of rounding size (~1e-14 px) and give
+    /// meaningless values. Among the triangles known to hold a point (the
+    /// front or back triangles of the regions around a vertex), the widest
+    /// gives the best-conditioned value.
+    pub fn width(&self) -> f64 {
+        let [a, b, c] = self.p;
+        let area2 = (b - a).perp_dot(c - a).abs();
+        let lmax = (b - a)
+            .length_squared()
+            .max((c - b).length_squared())
+            .max((a - c).length_squared())
+            .sqrt();
+        if area2 > 0.0 && lmax > 0.0 {
+            area2 / lmax
+        } else {
+            0.0
+        }
+    }
+
     /// Depth and scalar of the triangle's plane along the ray through pixel
     /// position `q` (exactly the corner's data when `q` is a corner).
+    ///
+    /// `q` is meant to lie in the projected triangle (every caller evaluates
+    /// a region's own triangles at points of the region), where the exact
+    /// depth and scalar lie between the corners' values (linear, or
+    /// perspective-correct, interpolation with weights in `[0, 1]`). The
+    /// results are clamped to those ranges, so rounding in the barycentric
+    /// weights of a thin triangle cannot extrapolate far beyond its
+    /// corners (see [`FaceTri::width`] for choosing a well-conditioned one).
     pub fn eval(&self, view: &ViewMap, q: DVec2) -> (f64, f64) {
         for k in 0..3 {
             if self.p[k] == q {
@@ -181,7 +219,7 @@ impl FaceTri {
         let lc = (b - a).perp_dot(q - a) / den;
         let la = 1.0 - lb - lc;
         let lam = [la, lb, lc];
-        if view.ortho {
+        let (z, s) = if view.ortho {
             let z = lam[0] * self.z[0] + lam[1] * self.z[1] + lam[2] * self.z[2];
             let s = lam[0] * self.s[0] + lam[1] * self.s[1] + lam[2] * self.s[2];
             (z, s)
@@ -191,7 +229,15 @@ impl FaceTri {
             let sw = w[0] + w[1] + w[2];
             let s = (w[0] * self.s[0] + w[1] * self.s[1] + w[2] * self.s[2]) / sw;
             (1.0 / sw, s)
+        };
+        let range = |v: [f64; 3]| (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
+        let ((zl, zh), (sl, sh)) = (range(self.z), range(self.s));
+        // `clamp` keeps a NaN (a degenerate perspective weight sum) as NaN;
+        // fall back to the first corner then, as for `den == 0`.
+        if z.is_nan() || s.is_nan() {
+            return (self.z[0], self.s[0]);
         }
+        (z.clamp(zl, zh), s.clamp(sl, sh))
     }
 }
 

@@ -17,9 +17,13 @@
 //!    front (back) edge, or, when it has none, from a neighbour across an
 //!    edge that is not a front (back) edge (a region inside a triangle);
 //! 6. one [`RegionVertex`] per subdivision vertex: front and back values by
-//!    evaluating the region's triangles at the vertex (the corner's own data
-//!    when the vertex is that corner, so profile vertices get `l = 0`
-//!    exactly); regions are fan-triangulated, skipping triangles whose exact
+//!    evaluating, at the vertex, the widest front and the widest back
+//!    triangle among the regions around it ([`FaceTri::width`]: a face seen
+//!    nearly edge-on projects to a sliver whose plane, evaluated through
+//!    rounded positions, gives meaningless depths; every region around the
+//!    vertex holds it, so any of them gives the same exact value) -- the
+//!    corner's own data when the vertex is that corner, so profile vertices
+//!    get `l = 0` exactly; regions are fan-triangulated, skipping triangles whose exact
 //!    orientation is not positive (zero area); with
 //!    [`Projector::clip_to_image`] the regions are then clipped to the image
 //!    rectangle plus a margin (near-plane caps project ~1e9 pixels away);
@@ -32,7 +36,7 @@ use super::arrangement::{is_outer, Arrangement, Piece};
 use super::clip::{ClipValue, Clipper};
 use super::polyhedron::Polyhedron;
 use super::subdivision::NIL;
-use super::{FaceTri, Projected, ProjectionError, RegionVertex, ViewMap};
+use super::{FaceTri, Projected, ProjectionError, RegionVertex, ViewMap, WidestFaces};
 use crate::camera::Camera;
 use crate::numeric::predicates::{orient2d, Side};
 use crate::numeric::tolerance::{IMAGE_CLIP_MARGIN_PX, NEAR_CLIP_SCALE};
@@ -77,6 +81,9 @@ pub struct Projector {
     face_fb: Vec<[u32; 2]>,
     vmap: Vec<u32>,
     on_hull: Vec<bool>,
+    /// Per subdivision vertex, for its front and back values: the region
+    /// whose triangle is widest, and that width.
+    best: Vec<WidestFaces>,
     refine: super::refine::RefineScratch,
     window: WindowScratch,
 }
@@ -102,6 +109,7 @@ impl Default for Projector {
             face_fb: Vec::new(),
             vmap: Vec::new(),
             on_hull: Vec::new(),
+            best: Vec::new(),
             refine: Default::default(),
             window: Default::default(),
         }
@@ -382,12 +390,36 @@ impl Projector {
                 self.on_hull[sub.origin(h) as usize] = true;
             }
         }
+        // Every region around a vertex holds it under its front and back
+        // triangles, whose planes all give the vertex's values; take them
+        // from the widest ones (best conditioned, `FaceTri::width`), never
+        // from a sliver left by a face seen (nearly) edge-on.
+        self.best.clear();
+        self.best.resize(nv, [(NIL, -1.0); 2]);
         for (f, &h0) in self.face_start.iter().enumerate() {
             let [ft, bt] = self.face_fb[f];
             let front = FaceTri::new(poly, &self.pix, ft);
             let back = FaceTri::new(poly, &self.pix, bt);
-            let r = out.push_region();
+            let w = [front.width(), back.width()];
             out.region_faces.push([front, back]);
+            let mut h = h0;
+            let mut k = 0;
+            loop {
+                let best = &mut self.best[sub.origin(h) as usize];
+                for s in 0..2 {
+                    if w[s] > best[s].1 {
+                        best[s] = (f as u32, w[s]);
+                    }
+                }
+                h = sub.next(h);
+                k += 1;
+                if h == h0 || k > sub.half_edge_count() {
+                    break;
+                }
+            }
+        }
+        for &h0 in &self.face_start {
+            let r = out.push_region();
             let mut h = h0;
             let mut k = 0;
             loop {
@@ -395,10 +427,11 @@ impl Projector {
                 if self.vmap[v as usize] == NIL {
                     self.vmap[v as usize] = out.vertices.len() as u32;
                     let p = self.arr.pos[v as usize];
+                    let [(bf, _), (bb, _)] = self.best[v as usize];
                     let rv = RegionVertex::evaluate(
                         &out.view,
-                        &front,
-                        &back,
+                        &out.region_faces[bf as usize][0],
+                        &out.region_faces[bb as usize][1],
                         p,
                         self.on_hull[v as usize],
                     );
@@ -444,7 +477,9 @@ struct WindowScratch {
     poly: Vec<WinPt>,
     tmp: Vec<WinPt>,
     map: Vec<u32>,
-    keys: Vec<(WinKey, u32)>,
+    /// Shared new points: key, vertex id, and the regions (with widths)
+    /// whose front and back triangles gave its values.
+    keys: Vec<(WinKey, u32, WidestFaces)>,
     verts: Vec<RegionVertex>,
     own: u32,
 }
@@ -584,11 +619,42 @@ impl WindowScratch {
                         }
                         self.map[i as usize]
                     }
-                    key => match self.keys.iter().find(|(k, _)| *k == key) {
-                        Some(&(_, id)) => id,
-                        None => {
-                            let mut v =
-                                RegionVertex::evaluate(&out.view, &front, &back, w.p, false);
+                    key => {
+                        // A point shared by the regions on either side of
+                        // an edge (or around a corner) takes its front
+                        // (back) values from the widest front (back)
+                        // triangle among them (`FaceTri::width`).
+                        let wr = [front.width(), back.width()];
+                        let found = self.keys.iter().position(|e| e.0 == key);
+                        let (id, best, fresh) = match found {
+                            Some(e) => {
+                                let (_, id, mut best) = self.keys[e];
+                                let mut better = false;
+                                for side in 0..2 {
+                                    if wr[side] > best[side].1 {
+                                        best[side] = (r as u32, wr[side]);
+                                        better = true;
+                                    }
+                                }
+                                self.keys[e].2 = best;
+                                (id, best, better)
+                            }
+                            None => {
+                                let id = self.verts.len() as u32;
+                                self.verts.push(RegionVertex::default());
+                                let best = [(r as u32, wr[0]), (r as u32, wr[1])];
+                                self.keys.push((key, id, best));
+                                (id, best, true)
+                            }
+                        };
+                        if fresh {
+                            let mut v = RegionVertex::evaluate(
+                                &out.view,
+                                &out.region_faces[best[0].0 as usize][0],
+                                &out.region_faces[best[1].0 as usize][1],
+                                w.p,
+                                false,
+                            );
                             if let WinKey::Cut(i, j, _) = key {
                                 let (vi, vj) = (out.vertices[i as usize], out.vertices[j as usize]);
                                 if vi.profile && vj.profile {
@@ -599,12 +665,10 @@ impl WindowScratch {
                                     v.profile = true;
                                 }
                             }
-                            let id = self.verts.len() as u32;
-                            self.verts.push(v);
-                            self.keys.push((key, id));
-                            id
+                            self.verts[id as usize] = v;
                         }
-                    },
+                        id
+                    }
                 };
                 if out.regions[r].last() != Some(&id) && out.regions[r].first() != Some(&id) {
                     out.regions[r].push(id);

@@ -6,9 +6,16 @@
 //! carry the same data in both pieces, hence the same decision). A triangle
 //! with one, two or three split edges becomes two, three or four triangles;
 //! a new vertex sits at the pixel midpoint `(a + b) / 2` (bit-identical from
-//! either side) and gets exact values from its region's front and back
-//! triangles, like every other vertex. Levels repeat until no edge asks for a
+//! either side) and gets exact values from the front and back triangles of
+//! the regions on either side of the edge, like every other vertex (the
+//! widest ones, `FaceTri::width`). Levels repeat until no edge asks for a
 //! split or the depth limit is reached.
+//!
+//! Triangles narrower than [`SLIVER_WIDTH_PX`] (slivers of faces seen
+//! edge-on, whose own triangles' values are meaningless) never ask for a
+//! split themselves: their edges are split only where a wider neighbour asks,
+//! which keeps the triangulation conforming without refining a sliver to the
+//! depth limit.
 //!
 //! Two uses:
 //! - perspective views ([`perspective_split`], applied by the projector):
@@ -25,7 +32,7 @@ use glam::DVec2;
 
 use super::subdivision::NIL;
 use super::{Projected, RegionVertex, ViewMap};
-use crate::numeric::tolerance::PERSPECTIVE_INTERP_REL;
+use crate::numeric::tolerance::{PERSPECTIVE_INTERP_REL, SLIVER_WIDTH_PX};
 
 /// Scratch buffers of the refinement.
 #[derive(Clone, Debug, Default)]
@@ -34,6 +41,10 @@ pub struct RefineScratch {
     mids: Vec<u32>,
     tris: Vec<[u32; 3]>,
     regs: Vec<u32>,
+    /// `FaceTri::width` of each region's front and back triangle.
+    widths: Vec<[f64; 2]>,
+    /// Per split edge: the region with the widest front (back) triangle.
+    best: Vec<super::WidestFaces>,
 }
 
 /// Whether the perspective interpolation bound asks to split edge `a`-`b`
@@ -111,9 +122,20 @@ pub(crate) fn refine_with(
     mut split: impl FnMut(&RegionVertex, &RegionVertex) -> bool,
     s: &mut RefineScratch,
 ) {
+    s.widths.clear();
+    s.widths.extend(
+        out.region_faces
+            .iter()
+            .map(|f| [f[0].width(), f[1].width()]),
+    );
     for _ in 0..max_depth {
         s.edges.clear();
         for t in &out.triangles {
+            let [a, b, c] = t.map(|i| out.vertices[i as usize].pos());
+            if triangle_width(a, b, c) < SLIVER_WIDTH_PX {
+                // Negligible: split only where a neighbour asks (conforming).
+                continue;
+            }
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 let key = (a.min(b), a.max(b));
@@ -129,6 +151,26 @@ pub(crate) fn refine_with(
         s.edges.dedup();
         s.mids.clear();
         s.mids.resize(s.edges.len(), NIL);
+        // Front and back values of a midpoint come from the widest front
+        // (back) triangle of the regions on either side of its edge (see
+        // `FaceTri::width`).
+        s.best.clear();
+        s.best.resize(s.edges.len(), [(NIL, -1.0); 2]);
+        for ti in 0..out.triangles.len() {
+            let t = out.triangles[ti];
+            let r = out.triangle_region[ti];
+            let w = s.widths[r as usize];
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if let Ok(i) = s.edges.binary_search(&(a.min(b), a.max(b))) {
+                    for (best, &ws) in s.best[i].iter_mut().zip(&w) {
+                        if ws > best.1 {
+                            *best = (r, ws);
+                        }
+                    }
+                }
+            }
+        }
         s.tris.clear();
         s.regs.clear();
         for ti in 0..out.triangles.len() {
@@ -139,7 +181,8 @@ pub(crate) fn refine_with(
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 if let Ok(i) = s.edges.binary_search(&(a.min(b), a.max(b))) {
                     if s.mids[i] == NIL {
-                        s.mids[i] = midpoint(out, r, a.min(b), a.max(b));
+                        let [(rf, _), (rb, _)] = s.best[i];
+                        s.mids[i] = midpoint(out, [rf, rb], a.min(b), a.max(b));
                     }
                     m[k] = s.mids[i];
                 }
@@ -151,11 +194,29 @@ pub(crate) fn refine_with(
     }
 }
 
-/// Creates the midpoint vertex of edge `a`-`b` in region `r`.
-fn midpoint(out: &mut Projected, r: u32, a: u32, b: u32) -> u32 {
+/// Twice the area over the longest edge: the triangle's smallest width.
+fn triangle_width(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    let area2 = (b - a).perp_dot(c - a).abs();
+    let lmax = (b - a)
+        .length_squared()
+        .max((c - b).length_squared())
+        .max((a - c).length_squared())
+        .sqrt();
+    if lmax > 0.0 {
+        area2 / lmax
+    } else {
+        0.0
+    }
+}
+
+/// Creates the midpoint vertex of edge `a`-`b`, with its front values from
+/// region `r[0]`'s front triangle and its back values from region `r[1]`'s
+/// back triangle.
+fn midpoint(out: &mut Projected, r: [u32; 2], a: u32, b: u32) -> u32 {
     let (va, vb) = (out.vertices[a as usize], out.vertices[b as usize]);
     let q = (DVec2::new(va.px, va.py) + DVec2::new(vb.px, vb.py)) * 0.5;
-    let [front, back] = out.region_faces[r as usize];
+    let front = out.region_faces[r[0] as usize][0];
+    let back = out.region_faces[r[1] as usize][1];
     let mut v = RegionVertex::evaluate(&out.view, &front, &back, q, false);
     if va.profile && vb.profile {
         v.z_back = v.z_front;
