@@ -389,6 +389,37 @@ pub fn check_images_with(
     ))
 }
 
+/// [`check_images_with`] on the float values (linear premultiplied RGBA,
+/// all four channels) instead of the PNG display values: for tests whose
+/// bounds are tighter than 8-bit output can show. On failure it writes the
+/// actual, expected and difference images (as PNGs) like
+/// [`check_images_with`].
+pub fn check_float_images(
+    name: &str,
+    actual: &Image,
+    expected: &Image,
+    max_abs: f64,
+    rms: f64,
+) -> Result<ImageDiff, String> {
+    let (d, diff) = compare_float(actual, expected).map_err(|e| e.to_string())?;
+    if d.max_abs <= max_abs && d.rms <= rms && actual.count_non_finite() == 0 {
+        return Ok(d);
+    }
+    let dir = test_output_dir();
+    let _ = std::fs::create_dir_all(&dir);
+    let _ = actual.write_png(&dir.join(format!("{name}.actual.png")), [0.0; 3], false);
+    let _ = expected.write_png(&dir.join(format!("{name}.expected.png")), [0.0; 3], false);
+    let _ = diff.write_png(&dir.join(format!("{name}.diff.png")), [0.0; 3], false);
+    Err(format!(
+        "{name}: float max {:.3e} (bound {max_abs:.1e}) at {:?}, rms {:.3e} (bound {rms:.1e}), non-finite {}; images in {}",
+        d.max_abs,
+        d.worst,
+        d.rms,
+        actual.count_non_finite(),
+        dir.display()
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

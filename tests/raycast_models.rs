@@ -7,7 +7,7 @@ mod raycast_util;
 use glam::DVec3;
 use raycast_util::*;
 use zoovr::camera::{Camera, CameraParams};
-use zoovr::image::compare_float;
+use zoovr::image::check_float_images;
 use zoovr::mesh::Mesh;
 use zoovr::raycast::{render, FieldModel, RaycastOptions, Raycaster, Scalars, Scene};
 
@@ -88,8 +88,8 @@ fn models_agree_on_a_parallelepiped_grid_with_a_linear_field() {
         }
         assert!(seen > 0.3, "the scene must be visible");
         for k in 1..3 {
-            let (d, _) = compare_float(&imgs[0], &imgs[k]).unwrap();
-            assert!(d.max_abs < 2e-6, "model {k}: {d:?}");
+            check_float_images(&format!("models_grid_{k}"), &imgs[k], &imgs[0], 2e-6, 2e-6)
+                .unwrap_or_else(|e| panic!("model {k}: {e}"));
         }
     }
 }
@@ -114,8 +114,8 @@ fn models_agree_on_a_tet_mesh() {
     let cams = cameras(&mesh);
     for imgs in images(&mesh, &s, &cams) {
         for k in 1..3 {
-            let (d, _) = compare_float(&imgs[0], &imgs[k]).unwrap();
-            assert!(d.max_abs < 1e-6, "model {k}: {d:?}");
+            check_float_images(&format!("models_tets_{k}"), &imgs[k], &imgs[0], 1e-6, 1e-6)
+                .unwrap_or_else(|e| panic!("model {k}: {e}"));
         }
     }
 }
@@ -198,6 +198,6 @@ fn faces_and_tets_bound_the_same_volume_on_a_warped_grid() {
     let mat = material();
     let fa = render(&scene, &mat, &cams[0], &opts(FieldModel::Faces)).unwrap();
     let te = render(&scene, &mat, &cams[0], &opts(FieldModel::Tets)).unwrap();
-    let (d, _) = compare_float(&fa, &te).unwrap();
-    assert!(d.max_abs < 2e-6, "{d:?}");
+    check_float_images("models_faces_vs_tets_warped", &te, &fa, 2e-6, 2e-6)
+        .unwrap_or_else(|e| panic!("{e}"));
 }

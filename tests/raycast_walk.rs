@@ -9,7 +9,7 @@ mod raycast_util;
 use glam::DVec3;
 use raycast_util::*;
 use zoovr::camera::{Camera, CameraParams, Ray};
-use zoovr::image::compare_float;
+use zoovr::image::check_float_images;
 use zoovr::mesh::{CellKind, Mesh};
 use zoovr::raycast::{render, FieldModel, RaycastOptions, Raycaster, Scalars, Scene};
 
@@ -209,8 +209,14 @@ fn five_and_six_tet_cubes_render_the_same_exact_image() {
             imgs.push(render(&scene, &m, &cam, &opts(FieldModel::Faces)).unwrap());
         }
         for k in 1..3 {
-            let (d, _) = compare_float(&imgs[0], &imgs[k]).unwrap();
-            assert!(d.max_abs < 1e-6, "az {az} el {el}: {:?}", d);
+            check_float_images(
+                &format!("walk_{az}_{el}_{k}"),
+                &imgs[k],
+                &imgs[0],
+                1e-6,
+                1e-6,
+            )
+            .unwrap_or_else(|e| panic!("az {az} el {el}: {e}"));
         }
         // Every pixel against the exact chord.
         for j in 0..40 {

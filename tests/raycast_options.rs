@@ -1,0 +1,136 @@
+//! The ray caster's cell data (the homogeneous integral) and its early ray
+//! termination, against closed forms.
+
+use glam::DVec3;
+use zoovr::camera::Ray;
+use zoovr::generate::{warped_hex_grid_dims, Warp};
+use zoovr::integrate::RayMaterial;
+use zoovr::mesh::topology::Topology;
+use zoovr::raycast::{trace_ray, FieldModel, RaycastOptions, Scalars, Scene};
+use zoovr::tf::{EmissionModel, TransferFunction};
+
+/// Extinction `tau(s) = 2 s`, colour from blue at 0 to red at 1.
+fn tf() -> TransferFunction {
+    TransferFunction::from_channels(
+        &[(0.0, [0.0]), (1.0, [2.0])],
+        &[(0.0, [0.0, 0.0, 1.0]), (1.0, [1.0, 0.0, 0.0])],
+        None,
+        EmissionModel::Glow,
+    )
+    .unwrap()
+}
+
+/// Two unit-height hexes side by side along x (x in [0, 0.5] and [0.5, 1]).
+fn two_cells() -> zoovr::mesh::Mesh {
+    let m = warped_hex_grid_dims(
+        [2, 1, 1],
+        &Warp {
+            amplitude: 0.0,
+            seed: 1,
+        },
+    );
+    assert_eq!(m.cells.len(), 2);
+    m
+}
+
+/// Cell scalars are constant in each cell: each cell's segment is the
+/// homogeneous integral, `alpha = 1 - exp(-tau l)`, colour `c alpha`, and the
+/// two compose front to back.
+#[test]
+fn cell_data_uses_the_homogeneous_integral() {
+    let mesh = two_cells();
+    let topology = Topology::build(&mesh.cells);
+    let values = [0.3, 0.8];
+    let scene = Scene {
+        mesh: &mesh,
+        topology: &topology,
+        scalars: Scalars::Cell(&values),
+    };
+    let tf = tf();
+    for model in [FieldModel::Faces, FieldModel::Tets, FieldModel::Native] {
+        for (dir, front) in [(DVec3::X, 0), (-DVec3::X, 1)] {
+            let origin = if dir.x > 0.0 {
+                DVec3::new(-1.0, 0.37, 0.61)
+            } else {
+                DVec3::new(2.0, 0.37, 0.61)
+            };
+            let ray = Ray { origin, dir };
+            let opts = RaycastOptions {
+                model,
+                early_termination: 0.0,
+                ..Default::default()
+            };
+            let acc = trace_ray(&scene, &tf, &ray, &opts).unwrap().rgba();
+            // Front cell f, back cell b, each 0.5 long.
+            let seg = |s: f64| {
+                let tau = tf.tau_at(s);
+                let a = -(-tau * 0.5).exp_m1();
+                let c = [s, 0.0, 1.0 - s];
+                (a, c.map(|x| x * a))
+            };
+            let (af, cf) = seg(values[front]);
+            let (ab, cb) = seg(values[1 - front]);
+            let alpha = af + (1.0 - af) * ab;
+            let colour: [f64; 3] = std::array::from_fn(|k| cf[k] + (1.0 - af) * cb[k]);
+            let got = [acc[0] as f64, acc[1] as f64, acc[2] as f64, acc[3] as f64];
+            let want = [colour[0], colour[1], colour[2], alpha];
+            for k in 0..4 {
+                assert!(
+                    (got[k] - want[k]).abs() < 1e-6,
+                    "{model:?} dir {dir}: channel {k}: {} vs {}",
+                    got[k],
+                    want[k]
+                );
+            }
+        }
+    }
+}
+
+/// Stopping a ray once its transmittance falls below `eps` loses at most
+/// `eps` of opacity (and of colour, the colours being at most 1), and the
+/// opacity reached is at least `1 - eps` when the full ray gets there.
+#[test]
+fn early_termination_loses_at_most_its_threshold() {
+    let mut mesh = warped_hex_grid_dims([12, 2, 2], &Warp::default());
+    // Stretch along x so that the ray is optically thick.
+    for p in &mut mesh.points {
+        p.x *= 15.0;
+    }
+    let topology = Topology::build(&mesh.cells);
+    let s: Vec<f64> = (0..mesh.points.len())
+        .map(|i| 0.5 + 0.4 * (i as f64 * 0.7).sin())
+        .collect();
+    let scene = Scene {
+        mesh: &mesh,
+        topology: &topology,
+        scalars: Scalars::Point(&s),
+    };
+    let tf = tf();
+    let ray = Ray {
+        origin: DVec3::new(-1.0, 0.41, 0.53),
+        dir: DVec3::X,
+    };
+    let full = |eps: f64| {
+        let opts = RaycastOptions {
+            early_termination: eps,
+            ..Default::default()
+        };
+        trace_ray(&scene, &tf, &ray, &opts).unwrap().rgba()
+    };
+    let exact = full(0.0);
+    assert!(exact[3] > 0.999, "the ray must be thick: {}", exact[3]);
+    for eps in [1e-6, 1e-3, 0.1, 0.5] {
+        let got = full(eps);
+        for k in 0..4 {
+            assert!(
+                (got[k] as f64 - exact[k] as f64).abs() <= eps + 1e-6,
+                "eps {eps} channel {k}: {} vs {}",
+                got[k],
+                exact[k]
+            );
+        }
+        assert!(got[3] as f64 >= 1.0 - eps - 1e-6, "eps {eps}: {}", got[3]);
+    }
+    // A large threshold really stops early: some opacity is left out.
+    assert!(full(0.5)[3] < exact[3]);
+}
