@@ -4,7 +4,6 @@
 use glam::DVec3;
 use zoovr::camera::Ray;
 use zoovr::generate::{warped_hex_grid_dims, Warp};
-use zoovr::integrate::RayMaterial;
 use zoovr::mesh::topology::Topology;
 use zoovr::raycast::{trace_ray, FieldModel, RaycastOptions, Scalars, Scene};
 use zoovr::tf::{EmissionModel, TransferFunction};

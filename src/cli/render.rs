@@ -196,6 +196,19 @@ pub fn print_stats(stats: &RenderStats, load_s: f64) {
             r.model.name(),
             r.termination_transmittance
         );
+        if r.model == FieldModel::Native {
+            let n = &r.native;
+            eprintln!(
+                "native       {} intervals, {} extra cells (bilinear faces), {} Newton failures, \
+                 {} linear fallbacks, {} parity-classified, {} depth-limited brackets",
+                n.intervals,
+                n.extra_cells,
+                n.newton_failures,
+                n.fallback_intervals,
+                n.parity_classified,
+                n.bracket_depth_limited
+            );
+        }
     }
     eprintln!("render total {:.3} s", stats.total_s);
 }

@@ -12,13 +12,32 @@
 //! - [`FieldModel::Tets`]: the same walk over the consistent
 //!   tetrahedralisation (`tetra::tetrahedralize_cell`), whose faces model is
 //!   the linear field of each tet;
-//! - [`FieldModel::Native`]: the faces walk gives the cell sequence and the
-//!   entry/exit depths; inside hexahedra, wedges and pyramids the scalar is
-//!   the iso-parametric field ([`native`]). Tets are linear; pentagonal and
-//!   hexagonal prisms and general polyhedra fall back to `faces`.
-//!   Known simplification: the cell boundary is the triangulated faces
-//!   (shared by neighbours), not the bilinear patches; the field is
-//!   evaluated (extrapolated) by inverting the map at those points.
+//! - [`FieldModel::Native`] (point data): each hexahedron, wedge and pyramid
+//!   is integrated between the ray's intersections with its true boundary,
+//!   the bilinear patches of its quad faces and its planar triangles, with
+//!   the iso-parametric scalar inside ([`native`]). The walk over the
+//!   triangulated faces still gives the cells (it is watertight); the
+//!   integration intervals come from the cells' own boundaries: every walk
+//!   cell of a native kind, plus (transitively) every native neighbour
+//!   across a face whose bilinear patch the ray crosses (a ray through the
+//!   sliver between a bulging patch and its two triangles may enter a cell
+//!   the walk does not visit; counted in [`native::NativeStats::extra_cells`]).
+//!   Shared faces are parameterised canonically, so neighbouring cells get
+//!   bit-identical crossing depths: no gap, no double count. A point of the
+//!   ray belongs to a cell iff its inverted parametric coordinates are in the
+//!   reference element. The intervals of all cells are sorted by depth and
+//!   composited. Tets, pentagonal and hexagonal prisms and polyhedra keep
+//!   their walk segments and `faces` field. Known limits: a quad face shared
+//!   by a native cell and a prism or polyhedron is a bilinear patch on one
+//!   side and two triangles on the other (the sliver between them is counted
+//!   twice or not at all); a boundary patch that bulges out where the ray
+//!   misses the walk's triangles and every walk cell's patches is not seen.
+//!   For cell data and constant scalars `native` equals `faces` (segments
+//!   bounded by the triangulated faces). [`Raycaster::segments`] reports the
+//!   walk's segments; [`Raycaster::native_segments`] the native intervals.
+//!   Fallbacks (Newton failures, linear fallback intervals, parity
+//!   classification, subdivision depth limits) are counted per render:
+//!   [`Raycaster::native_stats`].
 //!
 //! Cell data uses the homogeneous integral `segment(l, s, s)`; no field means
 //! a constant scalar. The near plane is at the eye: only `t >= camera.near`
@@ -35,7 +54,8 @@ pub mod walk;
 
 use std::borrow::Cow;
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::collections::HashSet;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 use thiserror::Error;
@@ -45,7 +65,7 @@ use crate::image::Image;
 use crate::integrate::{RayAccumulator, RayMaterial};
 use crate::mesh::tetra::tetrahedralize_cell;
 use crate::mesh::topology::Topology;
-use crate::mesh::{CellKind, Cells, Mesh};
+use crate::mesh::{CellKind, Cells, Mesh, NONE};
 use crate::numeric::tolerance::RAY_TERMINATION_TRANSMITTANCE;
 use geometry::RayFrame;
 use walk::{RawSegment, Scratch, WalkMesh};
@@ -171,6 +191,9 @@ pub struct Raycaster<'a> {
     /// Tets model: the mesh cell of each tet.
     parent: Option<Vec<u32>>,
     walker: WalkMesh<'a>,
+    /// Native-model counters summed over all traced rays (see
+    /// [`native::NativeStats`], same field order).
+    native_counts: [AtomicU64; 6],
 }
 
 fn validate(scene: &Scene) -> Result<(), RaycastError> {
@@ -265,6 +288,7 @@ impl<'a> Raycaster<'a> {
                 model,
                 parent: Some(parent),
                 walker,
+                native_counts: Default::default(),
             });
         }
         let walker = WalkMesh::new(
@@ -277,7 +301,178 @@ impl<'a> Raycaster<'a> {
             model,
             parent: None,
             walker,
+            native_counts: Default::default(),
         })
+    }
+
+    /// The native model's counters summed over every ray traced so far.
+    pub fn native_stats(&self) -> native::NativeStats {
+        let c = |k: usize| self.native_counts[k].load(Ordering::Relaxed);
+        native::NativeStats {
+            intervals: c(0),
+            extra_cells: c(1),
+            newton_failures: c(2),
+            fallback_intervals: c(3),
+            parity_classified: c(4),
+            bracket_depth_limited: c(5),
+        }
+    }
+
+    fn record_native(&self, s: &native::NativeStats) {
+        let v = [
+            s.intervals,
+            s.extra_cells,
+            s.newton_failures,
+            s.fallback_intervals,
+            s.parity_classified,
+            s.bracket_depth_limited,
+        ];
+        for (a, x) in self.native_counts.iter().zip(v) {
+            if x > 0 {
+                a.fetch_add(x, Ordering::Relaxed);
+            }
+        }
+    }
+
+    /// The native model's intervals of `ray` with `t_out > t_near`, sorted
+    /// by entry depth (not clipped): for hexahedra, wedges and pyramids
+    /// bounded by their bilinear / planar faces, for other kinds the walk's
+    /// segments (`faces` entry and exit scalars). `None` unless the scene
+    /// has point scalars.
+    pub fn native_intervals(
+        &self,
+        ray: &Ray,
+        t_near: f64,
+        scratch: &mut Scratch,
+        stats: &mut native::NativeStats,
+    ) -> Option<Vec<native::Interval>> {
+        let vals = native::point_values(&self.scene)?;
+        let cells = &self.scene.mesh.cells;
+        let topo = self.scene.topology;
+        let mut out = Vec::new();
+        let mut queue: Vec<u32> = Vec::new();
+        let mut seen: HashSet<u32> = HashSet::new();
+        let frame = RayFrame::new(ray, self.walker.center, self.walker.radius);
+        let t0 = self.start_t(ray);
+        self.walker.walk(&frame, t0, scratch, |raw| {
+            let c = raw.cell as usize;
+            if c < cells.len() && native::is_native_kind(cells.kinds[c]) {
+                if seen.insert(raw.cell) {
+                    queue.push(raw.cell);
+                }
+            } else if raw.t_out > t_near {
+                let s = self.to_segment(raw);
+                out.push(native::Interval {
+                    cell: s.cell,
+                    t_a: s.t_in,
+                    t_b: s.t_out,
+                    s_a: s.s_in,
+                    s_b: s.s_out,
+                });
+            }
+            true
+        });
+        let walked = queue.len();
+        let axes = native::axes_of(ray);
+        let mut crossed = Vec::new();
+        let limit = 4 * cells.len() + 16;
+        let mut k = 0;
+        while k < queue.len() && k < limit {
+            let c = queue[k];
+            let before = out.len();
+            crossed.clear();
+            native::cell_intervals(
+                &self.scene,
+                vals,
+                c as usize,
+                ray,
+                axes,
+                &mut out,
+                &mut crossed,
+                stats,
+            );
+            if k >= walked && out.len() > before {
+                stats.extra_cells += 1;
+            }
+            for &f in &crossed {
+                if f as usize >= topo.face_count() {
+                    continue;
+                }
+                let n = topo.neighbour(f as usize, c);
+                if n != NONE
+                    && (n as usize) < cells.len()
+                    && native::is_native_kind(cells.kinds[n as usize])
+                    && seen.insert(n)
+                {
+                    queue.push(n);
+                }
+            }
+            k += 1;
+        }
+        out.retain(|iv| iv.t_b > t_near);
+        out.sort_by(|a, b| a.t_a.total_cmp(&b.t_a).then(a.cell.cmp(&b.cell)));
+        Some(out)
+    }
+
+    /// [`Raycaster::native_intervals`] as segments clipped at `t_near`
+    /// (entry and exit scalars exact on the true boundary); the walk's
+    /// [`Raycaster::segments`] when the scene has no point scalars.
+    pub fn native_segments(&self, ray: &Ray, t_near: f64) -> Vec<Segment> {
+        let mut stats = native::NativeStats::default();
+        match self.native_intervals(ray, t_near, &mut Scratch::default(), &mut stats) {
+            Some(ivs) => ivs
+                .iter()
+                .map(|iv| {
+                    let mut s = Segment {
+                        cell: iv.cell,
+                        t_in: iv.t_a,
+                        t_out: iv.t_b,
+                        s_in: iv.s_a,
+                        s_out: iv.s_b,
+                    };
+                    if s.t_in < t_near {
+                        let x = (t_near - s.t_in) / (s.t_out - s.t_in);
+                        s.s_in += x * (s.s_out - s.s_in);
+                        s.t_in = t_near;
+                    }
+                    s
+                })
+                .collect(),
+            None => self.segments(ray, t_near),
+        }
+    }
+
+    fn trace_native<M: RayMaterial>(
+        &self,
+        material: &M,
+        ray: &Ray,
+        t_near: f64,
+        stop_depth: f64,
+        scratch: &mut Scratch,
+    ) -> Option<RayAccumulator> {
+        let vals = native::point_values(&self.scene)?;
+        let mut stats = native::NativeStats::default();
+        let ivs = self.native_intervals(ray, t_near, scratch, &mut stats)?;
+        let cells = &self.scene.mesh.cells;
+        let mut acc = RayAccumulator::default();
+        for iv in &ivs {
+            let v = if native::is_native_kind(cells.kinds[iv.cell as usize]) {
+                native::interval_value(&self.scene, vals, material, ray, iv, t_near, &mut stats)
+            } else {
+                let (mut ta, mut sa) = (iv.t_a, iv.s_a);
+                if ta < t_near {
+                    sa += (t_near - ta) / (iv.t_b - ta) * (iv.s_b - sa);
+                    ta = t_near;
+                }
+                material.segment(iv.t_b - ta, sa, iv.s_b)
+            };
+            acc.add(&v);
+            if acc.depth >= stop_depth {
+                break;
+            }
+        }
+        self.record_native(&stats);
+        Some(acc)
     }
 
     /// Bytes of memory the prepared structures hold (beyond the mesh).
@@ -394,15 +589,13 @@ impl<'a> Raycaster<'a> {
         } else {
             f64::INFINITY
         };
-        let native = self.model == FieldModel::Native;
+        if self.model == FieldModel::Native {
+            if let Some(acc) = self.trace_native(material, ray, t_near, stop_depth, scratch) {
+                return acc;
+            }
+        }
         self.for_each_segment(ray, t_near, scratch, |s, _| {
-            let l = s.t_out - s.t_in;
-            let v = if native {
-                native::segment_value(self.scene, material, ray, s)
-            } else {
-                material.segment(l, s.s_in, s.s_out)
-            };
-            acc.add(&v);
+            acc.add(&material.segment(s.t_out - s.t_in, s.s_in, s.s_out));
             acc.depth < stop_depth
         });
         acc

@@ -1,17 +1,40 @@
 //! The `native` field model: the iso-parametric field of hexahedra (trilinear),
-//! wedges and pyramids, integrated along a ray to a stated accuracy.
+//! wedges and pyramids, integrated along a ray between the ray's
+//! intersections with the cells' true boundaries, to a stated accuracy.
 //!
-//! Along a ray through such a cell the scalar `s(t)` is not a polynomial in
-//! `t`. For each cell segment `[t_in, t_out]` given by the walk:
+//! **Cell boundary.** The iso-parametric cell is the image of its reference
+//! element; its faces are bilinear patches (quads) and planar triangles.
+//! [`cell_intervals`] intersects the ray line with every face of a cell:
+//! [`ray_bilinear`] solves the patch's quadratic in `u` with the stable root
+//! pair and polishes each root by Newton on the 3D system; [`ray_triangle`]
+//! is Möller-Trumbore. Each face is parameterised canonically by its global
+//! point ids ([`canonical_quad`]; triangles by sorted ids), so the two cells
+//! sharing a face compute bit-identical roots: the exit of one is the entry
+//! of the other, with no gap and no double count. Between two consecutive
+//! roots the ray is inside the cell iff the midpoint's inverted parametric
+//! coordinates lie in the reference element (`PARAM_TOL` = 1e-9 widened);
+//! duplicated roots at edges give empty or zero-length intervals, and a
+//! root missed at an edge by one face is found by the other (both accept
+//! `PARAM_TOL` outside `[0, 1]`). Where the midpoint cannot be inverted the
+//! root parity decides (counted in [`NativeStats::parity_classified`]).
+//! Which cells are visited is described in `super` (the walk's cells plus
+//! the neighbours across crossed bilinear faces).
+//!
+//! **Along an interval** `s(t)` is not a polynomial in `t`:
 //! 1. **Evaluate** `s(t)`: invert the iso-parametric map `x(xi) = o + t d` by
-//!    Newton's method (warm-started from the previous solution; the 3x3
-//!    Jacobian solved directly), then `s = sum N_i(xi) s_i`. `ds/dt` is
-//!    `grad_xi s . J^-1 d`.
+//!    Newton's method (warm-started from the previous solution, then from
+//!    the cell's centre; the 3x3 Jacobian solved directly), then
+//!    `s = sum N_i(xi) s_i`. `ds/dt` is `grad_xi s . J^-1 d`. Evaluations
+//!    that fail from both starts are counted ([`NativeStats::newton_failures`]).
 //! 2. **Split** so that each piece is monotone in `s` and inside one piece of
-//!    the transfer function: sample `s` and `ds/dt` at 9 equally spaced
-//!    depths, bisect sign changes of `ds/dt` (extrema), then bisect
-//!    `s(t) - S_k` for each breakpoint `S_k` crossed on each monotone part.
-//!    Assumption (stated): at most one extremum of `s` between samples.
+//!    the transfer function ([`breakpoint_crossings`]): from 8 equal
+//!    subintervals, each is refined adaptively until the cubic Hermite
+//!    interpolant of its end values and slopes reproduces `s` and `s'` at
+//!    the midpoint (to 1e-3 relative) and shows at most one extremum, which
+//!    is then bisected on `s'`; then `s(t) - S_k` is bisected for every
+//!    breakpoint `S_k` crossed on each monotone part. The precise guarantee
+//!    and assumption are stated at [`monotone_nodes`]: exact for cubic
+//!    `s(t)` (all affine cells), an accuracy assumption otherwise.
 //! 3. **Integrate** each smooth piece by adaptive Gauss-Legendre collocation:
 //!    on an interval, the 8-point Gauss nodes give `tau` and the source `g`;
 //!    the optical depth at each node is the exact integral of the degree-7
@@ -21,21 +44,22 @@
 //!    depth). Material is only evaluated at interior nodes, never exactly on
 //!    a breakpoint.
 //!
-//! If the map cannot be inverted (degenerate cell, Newton failure) the
-//! segment falls back to the `faces` integral, which the caller provides.
+//! If the map cannot be inverted inside an interval (degenerate cell,
+//! Newton failure) the interval falls back to the linear integral between
+//! the exact boundary scalars at its ends ([`interval_value`]), counted in
+//! [`NativeStats::fallback_intervals`].
 
 use std::sync::OnceLock;
 
 use glam::{DMat3, DVec3};
 
-use super::{Scalars, Scene, Segment};
+use super::{Scalars, Scene};
 use crate::camera::Ray;
 use crate::integrate::{RayMaterial, SegmentValue};
 use crate::mesh::CellKind;
 use crate::numeric::tolerance::{NATIVE_INTEGRAL_TOL, NATIVE_NEWTON_TOL};
 
 const GL_N: usize = 8;
-const SAMPLES: usize = 8;
 const MAX_LEVEL: u32 = 24;
 
 struct Quadrature {
@@ -151,6 +175,98 @@ fn shape(kind: CellKind, p: DVec3, n: &mut [f64; 8], dn: &mut [DVec3; 8]) -> usi
     }
 }
 
+/// Parametric tolerance of "inside the reference element" and of "inside a
+/// face" for ray / face roots.
+const PARAM_TOL: f64 = 1e-9;
+/// Subdivision depth limit of the monotone-piece search.
+const BRACKET_DEPTH: u32 = 30;
+/// Initial samples of `s(t)` per interval before the adaptive refinement.
+const BRACKET_START: usize = 8;
+
+/// Counters of one ray's (or a whole render's) native work: what had to
+/// fall back from the exact method, so that a reference image says how
+/// reference it is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NativeStats {
+    /// Cell intervals integrated through the iso-parametric field.
+    pub intervals: u64,
+    /// Cells whose bilinear boundary the ray crosses although the walk over
+    /// the triangulated faces did not visit them (found through shared
+    /// bilinear faces).
+    pub extra_cells: u64,
+    /// Point evaluations where Newton did not converge from the warm start
+    /// and then also not from the cell's centre.
+    pub newton_failures: u64,
+    /// Intervals integrated with the linear (`faces`-style) fallback
+    /// `segment(l, s_a, s_b)` between the exact boundary scalars because
+    /// the map could not be inverted somewhere inside.
+    pub fallback_intervals: u64,
+    /// Intervals between two boundary roots whose midpoint could not be
+    /// located (Newton failure): classified by root parity instead.
+    pub parity_classified: u64,
+    /// Pieces taken as monotone only because the subdivision reached its
+    /// depth limit (the cubic-Hermite test had not yet accepted them).
+    pub bracket_depth_limited: u64,
+}
+
+impl NativeStats {
+    /// Adds `o` to `self`.
+    pub fn add(&mut self, o: &NativeStats) {
+        self.intervals += o.intervals;
+        self.extra_cells += o.extra_cells;
+        self.newton_failures += o.newton_failures;
+        self.fallback_intervals += o.fallback_intervals;
+        self.parity_classified += o.parity_classified;
+        self.bracket_depth_limited += o.bracket_depth_limited;
+    }
+
+    /// The counts added since `earlier` (a snapshot of the same counters).
+    pub fn since(&self, earlier: &NativeStats) -> NativeStats {
+        NativeStats {
+            intervals: self.intervals - earlier.intervals,
+            extra_cells: self.extra_cells - earlier.extra_cells,
+            newton_failures: self.newton_failures - earlier.newton_failures,
+            fallback_intervals: self.fallback_intervals - earlier.fallback_intervals,
+            parity_classified: self.parity_classified - earlier.parity_classified,
+            bracket_depth_limited: self.bracket_depth_limited - earlier.bracket_depth_limited,
+        }
+    }
+
+    /// Whether anything fell back from the exact method.
+    pub fn any_fallback(&self) -> bool {
+        self.newton_failures + self.fallback_intervals + self.parity_classified > 0
+            || self.bracket_depth_limited > 0
+    }
+}
+
+/// Whether `kind` has an iso-parametric field here.
+pub fn is_native_kind(kind: CellKind) -> bool {
+    matches!(
+        kind,
+        CellKind::Hexahedron | CellKind::Wedge | CellKind::Pyramid
+    )
+}
+
+fn centre_of(kind: CellKind) -> DVec3 {
+    match kind {
+        CellKind::Hexahedron => DVec3::splat(0.5),
+        CellKind::Wedge => DVec3::new(1.0 / 3.0, 1.0 / 3.0, 0.5),
+        _ => DVec3::new(0.5, 0.5, 0.25),
+    }
+}
+
+/// Whether parametric point `xi` is in the (closed, `PARAM_TOL`-widened)
+/// reference element of `kind`.
+pub fn in_reference(kind: CellKind, xi: DVec3) -> bool {
+    let lo = -PARAM_TOL;
+    let hi = 1.0 + PARAM_TOL;
+    let box01 = |v: f64| v >= lo && v <= hi;
+    match kind {
+        CellKind::Wedge => xi.x >= lo && xi.y >= lo && xi.x + xi.y <= hi && box01(xi.z),
+        _ => box01(xi.x) && box01(xi.y) && box01(xi.z),
+    }
+}
+
 /// One cell's iso-parametric map and field along one ray.
 pub struct IsoRay {
     kind: CellKind,
@@ -159,6 +275,8 @@ pub struct IsoRay {
     o: DVec3,
     d: DVec3,
     xi: DVec3,
+    /// Evaluations that failed from both starts.
+    pub failures: u64,
 }
 
 impl IsoRay {
@@ -178,27 +296,23 @@ impl IsoRay {
         let mut ss = [0.0; 8];
         xs[..n].copy_from_slice(x);
         ss[..n].copy_from_slice(s);
-        let xi = match kind {
-            CellKind::Hexahedron => DVec3::splat(0.5),
-            CellKind::Wedge => DVec3::new(1.0 / 3.0, 1.0 / 3.0, 0.5),
-            _ => DVec3::new(0.5, 0.5, 0.25),
-        };
         Some(IsoRay {
             kind,
             x: xs,
             s: ss,
             o: ray.origin,
             d: ray.dir,
-            xi,
+            xi: centre_of(kind),
+            failures: 0,
         })
     }
 
-    /// Scalar and its derivative along the ray at depth `t`.
-    pub fn eval(&mut self, t: f64) -> Option<(f64, f64)> {
-        let target = self.o + self.d * t;
+    /// Newton on `x(xi) = target` from `start`: the parametric point and the
+    /// inverse Jacobian there.
+    fn newton(&self, target: DVec3, start: DVec3) -> Option<(DVec3, DMat3)> {
         let mut n = [0.0; 8];
         let mut dn = [DVec3::ZERO; 8];
-        let mut xi = self.xi;
+        let mut xi = start;
         for it in 0..40 {
             let cnt = shape(self.kind, xi, &mut n, &mut dn);
             let mut pos = DVec3::ZERO;
@@ -223,19 +337,48 @@ impl IsoRay {
                 if step.length() > 1e-8 {
                     return None;
                 }
-                let cnt = shape(self.kind, xi, &mut n, &mut dn);
-                let mut sv = 0.0;
-                let mut grad = DVec3::ZERO;
-                for i in 0..cnt {
-                    sv += self.s[i] * n[i];
-                    grad += dn[i] * self.s[i];
-                }
-                self.xi = xi;
-                let dxi = inv * self.d;
-                return Some((sv, grad.dot(dxi)));
+                return Some((xi, inv));
             }
         }
         None
+    }
+
+    /// Newton from the warm start, then from the cell's centre.
+    fn invert(&mut self, t: f64) -> Option<(DVec3, DMat3)> {
+        let target = self.o + self.d * t;
+        let r = self
+            .newton(target, self.xi)
+            .or_else(|| self.newton(target, centre_of(self.kind)));
+        match r {
+            Some((xi, inv)) => {
+                self.xi = xi;
+                Some((xi, inv))
+            }
+            None => {
+                self.failures += 1;
+                None
+            }
+        }
+    }
+
+    /// The parametric coordinates of the ray's point at depth `t`.
+    pub fn locate(&mut self, t: f64) -> Option<DVec3> {
+        self.invert(t).map(|(xi, _)| xi)
+    }
+
+    /// Scalar and its derivative along the ray at depth `t`.
+    pub fn eval(&mut self, t: f64) -> Option<(f64, f64)> {
+        let (xi, inv) = self.invert(t)?;
+        let mut n = [0.0; 8];
+        let mut dn = [DVec3::ZERO; 8];
+        let cnt = shape(self.kind, xi, &mut n, &mut dn);
+        let mut sv = 0.0;
+        let mut grad = DVec3::ZERO;
+        for i in 0..cnt {
+            sv += self.s[i] * n[i];
+            grad += dn[i] * self.s[i];
+        }
+        Some((sv, grad.dot(inv * self.d)))
     }
 }
 
@@ -257,44 +400,148 @@ fn bisect(lo: f64, hi: f64, f_lo: f64, mut f: impl FnMut(f64) -> Option<f64>) ->
     Some(0.5 * (a + b))
 }
 
-/// Integrates `[t_in, t_out]` through the iso-parametric field; `None` when
-/// the map cannot be inverted.
-pub fn integrate<M: RayMaterial>(
+/// A sample of `s(t)`: depth, value, slope.
+type Sample = (f64, f64, f64);
+
+/// Whether the cubic Hermite interpolant of `a`, `b` has a critical point
+/// strictly inside `(a.0, b.0)`.
+fn hermite_has_critical(a: Sample, b: Sample) -> bool {
+    let h = b.0 - a.0;
+    // On x in [0, 1]: H'(x) / h = d0 p0' + ... ; in slope units:
+    // H'(x) = c0 + c1 x + c2 x^2 with
+    let m = (b.1 - a.1) / h;
+    let c0 = a.2;
+    let c1 = 6.0 * m - 4.0 * a.2 - 2.0 * b.2;
+    let c2 = 3.0 * (a.2 + b.2) - 6.0 * m;
+    let has_root = |x: f64| x > 0.0 && x < 1.0;
+    if c2.abs() <= 1e-14 * (c0.abs() + c1.abs()) {
+        return c1 != 0.0 && has_root(-c0 / c1);
+    }
+    let disc = c1 * c1 - 4.0 * c2 * c0;
+    if disc < 0.0 {
+        return false;
+    }
+    let q = -0.5 * (c1 + c1.signum() * disc.sqrt());
+    let r1 = q / c2;
+    let r2 = if q != 0.0 { c0 / q } else { r1 };
+    has_root(r1) || has_root(r2)
+}
+
+/// Slope of the cubic Hermite interpolant of `a`, `b` at the midpoint.
+fn hermite_mid_slope(a: Sample, b: Sample) -> f64 {
+    1.5 * (b.1 - a.1) / (b.0 - a.0) - 0.25 * (a.2 + b.2)
+}
+
+/// Value of the cubic Hermite interpolant of `a`, `b` at the midpoint.
+fn hermite_mid(a: Sample, b: Sample) -> f64 {
+    0.5 * (a.1 + b.1) + 0.125 * (b.0 - a.0) * (a.2 - b.2)
+}
+
+/// Splits `[t_in, t_out]` into pieces on which `s` is monotone, returning
+/// the piece ends with their values (`nodes`), front to back.
+///
+/// An interval `[a, b]` (with midpoint `m` evaluated) is accepted as
+/// monotone when the slopes at `a`, `m`, `b` are non-zero with one sign,
+/// the cubic Hermite interpolant of the end values and slopes has no
+/// critical point inside, and it predicts `s(m)` to within 1e-3 of
+/// `|s(b) - s(a)|` (plus 1e-12 absolute). An interval with opposite end
+/// slopes whose Hermite interpolant has exactly one critical point and
+/// predicts `s(m)` so is taken to hold exactly one extremum, found by
+/// bisection on the slope. Anything else is halved (depth limit
+/// `BRACKET_DEPTH`, counted). Where `s(t)` is a cubic polynomial (every
+/// affine cell: parallelepipeds, affine wedges and pyramids) the Hermite
+/// interpolant is exact, so every extremum, and hence every breakpoint
+/// crossing, is bracketed; for curved cells the stated assumption is that
+/// an accepted interval, on which a cubic reproduces `s` and `s'` at three
+/// points to that accuracy, hides no pair of extrema.
+fn monotone_nodes(
     field: &mut IsoRay,
-    material: &M,
     t_in: f64,
     t_out: f64,
-) -> Option<SegmentValue> {
-    let h = (t_out - t_in) / SAMPLES as f64;
-    let mut ts = Vec::with_capacity(SAMPLES + 8);
-    let mut vals = Vec::with_capacity(SAMPLES + 8);
-    for k in 0..=SAMPLES {
-        let t = if k == SAMPLES {
+    stats: &mut NativeStats,
+) -> Option<Vec<(f64, f64)>> {
+    let mut nodes = Vec::new();
+    let sample = |field: &mut IsoRay, t: f64| field.eval(t).map(|(s, d)| (t, s, d));
+    let h = (t_out - t_in) / BRACKET_START as f64;
+    let mut prev = sample(field, t_in)?;
+    nodes.push((prev.0, prev.1));
+    for k in 1..=BRACKET_START {
+        let t = if k == BRACKET_START {
             t_out
         } else {
             t_in + h * k as f64
         };
-        ts.push(t);
-        vals.push(field.eval(t)?);
+        let next = sample(field, t)?;
+        split_monotone(field, prev, next, 0, &mut nodes, stats)?;
+        prev = next;
     }
-    // Extrema of s between samples.
-    let mut nodes: Vec<(f64, f64)> = vec![(ts[0], vals[0].0)];
-    for k in 0..SAMPLES {
-        let (d0, d1) = (vals[k].1, vals[k + 1].1);
-        if d0 != 0.0 && d1 != 0.0 && (d0 > 0.0) != (d1 > 0.0) {
-            let te = bisect(ts[k], ts[k + 1], d0, |t| field.eval(t).map(|v| v.1))?;
-            nodes.push((te, field.eval(te)?.0));
+    Some(nodes)
+}
+
+fn split_monotone(
+    field: &mut IsoRay,
+    a: Sample,
+    b: Sample,
+    depth: u32,
+    nodes: &mut Vec<(f64, f64)>,
+    stats: &mut NativeStats,
+) -> Option<()> {
+    let tm = 0.5 * (a.0 + b.0);
+    if !(tm > a.0 && tm < b.0) {
+        nodes.push((b.0, b.1));
+        return Some(());
+    }
+    let m = field.eval(tm).map(|(s, d)| (tm, s, d))?;
+    let scale = 1.0 + a.1.abs().max(b.1.abs());
+    let tol = 1e-3 * (b.1 - a.1).abs() + 1e-12 * scale;
+    let h = b.0 - a.0;
+    let secant = (b.1 - a.1) / h;
+    let dtol = 1e-3 * (a.2.abs() + b.2.abs() + secant.abs()) + 1e-12 * scale / h;
+    let cubic_ok =
+        (hermite_mid(a, b) - m.1).abs() <= tol && (hermite_mid_slope(a, b) - m.2).abs() <= dtol;
+    let pos = a.2 > 0.0 || m.2 > 0.0 || b.2 > 0.0;
+    let neg = a.2 < 0.0 || m.2 < 0.0 || b.2 < 0.0;
+    if cubic_ok && !(pos && neg) && !hermite_has_critical(a, b) {
+        nodes.push((b.0, b.1));
+        return Some(());
+    }
+    // Opposite end slopes: the interpolant's slope (a quadratic) has an odd
+    // number of roots inside, i.e. exactly one.
+    let opposite = (a.2 > 0.0 && b.2 < 0.0) || (a.2 < 0.0 && b.2 > 0.0);
+    let one_extremum = cubic_ok && opposite;
+    if one_extremum || depth >= BRACKET_DEPTH {
+        if !one_extremum {
+            stats.bracket_depth_limited += 1;
         }
-        nodes.push((ts[k + 1], vals[k + 1].0));
+        if opposite {
+            let te = bisect(a.0, b.0, a.2, |t| field.eval(t).map(|v| v.1))?;
+            let se = field.eval(te)?.0;
+            nodes.push((te, se));
+        }
+        nodes.push((b.0, b.1));
+        return Some(());
     }
-    // Breakpoint crossings on each monotone part.
-    let mut cuts = vec![t_in];
-    let bps = material.breakpoints();
+    split_monotone(field, a, m, depth + 1, nodes, stats)?;
+    split_monotone(field, m, b, depth + 1, nodes, stats)
+}
+
+/// The depths in `(t_in, t_out)` where `s(t)` crosses one of the sorted
+/// `breakpoints`, in order (see [`monotone_nodes`] for the bracketing
+/// guarantee); `None` when the map cannot be inverted somewhere.
+pub fn breakpoint_crossings(
+    field: &mut IsoRay,
+    breakpoints: &[f64],
+    t_in: f64,
+    t_out: f64,
+    stats: &mut NativeStats,
+) -> Option<Vec<f64>> {
+    let nodes = monotone_nodes(field, t_in, t_out, stats)?;
+    let mut cuts = Vec::new();
     for k in 0..nodes.len() - 1 {
         let ((ta, sa), (tb, sb)) = (nodes[k], nodes[k + 1]);
         let (lo, hi) = (sa.min(sb), sa.max(sb));
         let mut here = Vec::new();
-        for &b in bps {
+        for &b in breakpoints {
             if b > lo && b < hi {
                 let t = bisect(ta, tb, sa - b, |t| field.eval(t).map(|v| v.0 - b))?;
                 here.push(t);
@@ -303,6 +550,27 @@ pub fn integrate<M: RayMaterial>(
         here.sort_by(f64::total_cmp);
         cuts.extend(here);
     }
+    cuts.sort_by(f64::total_cmp);
+    Some(cuts)
+}
+
+/// Integrates `[t_in, t_out]` through the iso-parametric field; `None` when
+/// the map cannot be inverted.
+pub fn integrate<M: RayMaterial>(
+    field: &mut IsoRay,
+    material: &M,
+    t_in: f64,
+    t_out: f64,
+    stats: &mut NativeStats,
+) -> Option<SegmentValue> {
+    let mut cuts = vec![t_in];
+    cuts.extend(breakpoint_crossings(
+        field,
+        material.breakpoints(),
+        t_in,
+        t_out,
+        stats,
+    )?);
     cuts.push(t_out);
     cuts.sort_by(f64::total_cmp);
     let mut acc = SegmentValue::default();
@@ -381,39 +649,327 @@ fn refine<M: RayMaterial>(
     Some(combine(l, r))
 }
 
-/// The native integral of one walk segment (falls back to the faces
-/// integral where the native field does not apply).
-pub fn segment_value<M: RayMaterial>(
-    scene: Scene,
+/// Two unit vectors perpendicular to `d` and to each other.
+fn ray_plane_axes(d: DVec3) -> (DVec3, DVec3) {
+    let helper = if d.x.abs() < 0.6 { DVec3::X } else { DVec3::Y };
+    let u = helper.cross(d).normalize();
+    (u, d.cross(u))
+}
+
+/// Roots `(t, u, v)` of the ray line `o + t d` (unit `d`, `e1`, `e2` its
+/// perpendicular axes) with the bilinear patch
+/// `P(u, v) = (1-u)(1-v) q0 + u(1-v) q1 + u v q2 + (1-u) v q3`, with `u`,
+/// `v` in `[0, 1]` (widened by `PARAM_TOL`).
+///
+/// Projected onto the two planes through the ray, `P(u, v) = o` is two
+/// bilinear equations `A_k + B_k u + C_k v + D_k u v = 0`; eliminating `v`
+/// gives a quadratic in `u`, solved with the cancellation-free pair
+/// `q = -(b + sgn(b) sqrt(b^2 - 4ac)) / 2`, `u = q / a`, `u = c / q`; `v` then
+/// from the equation with the larger denominator `|C_k + D_k u|`. Each
+/// root is polished by two Newton steps on the 3D system
+/// `P(u, v) - o - t d = 0` (Ramsey, Potter and Hansen 2004 solve the same
+/// system; this is the standard stable form).
+pub fn ray_bilinear(
+    o: DVec3,
+    d: DVec3,
+    axes: (DVec3, DVec3),
+    q: [DVec3; 4],
+    out: &mut Vec<(f64, f64, f64)>,
+) {
+    let (e1, e2) = axes;
+    let r = q.map(|p| p - o);
+    let proj = |e: DVec3| {
+        let p = r.map(|x| x.dot(e));
+        (p[0], p[1] - p[0], p[3] - p[0], p[0] - p[1] + p[2] - p[3])
+    };
+    let (a1, b1, c1, d1) = proj(e1);
+    let (a2, b2, c2, d2) = proj(e2);
+    let qa = b1 * d2 - b2 * d1;
+    let qb = a1 * d2 - a2 * d1 + b1 * c2 - b2 * c1;
+    let qc = a1 * c2 - a2 * c1;
+    let scale = qa.abs().max(qb.abs()).max(qc.abs());
+    if scale == 0.0 || !scale.is_finite() {
+        return;
+    }
+    let mut us = [f64::NAN; 2];
+    if qa.abs() <= 1e-13 * scale {
+        if qb != 0.0 {
+            us[0] = -qc / qb;
+        }
+    } else {
+        let disc = qb * qb - 4.0 * qa * qc;
+        let disc = if disc < 0.0 {
+            if disc > -1e-12 * qb * qb {
+                0.0
+            } else {
+                return;
+            }
+        } else {
+            disc
+        };
+        let sq = disc.sqrt();
+        let qq = -0.5 * (qb + if qb >= 0.0 { sq } else { -sq });
+        us[0] = qq / qa;
+        if qq != 0.0 {
+            us[1] = qc / qq;
+        }
+    }
+    let eval = |u: f64, v: f64| {
+        let p = q[0] * ((1.0 - u) * (1.0 - v))
+            + q[1] * (u * (1.0 - v))
+            + q[2] * (u * v)
+            + q[3] * ((1.0 - u) * v);
+        let pu = (q[1] - q[0]) * (1.0 - v) + (q[2] - q[3]) * v;
+        let pv = (q[3] - q[0]) * (1.0 - u) + (q[2] - q[1]) * u;
+        (p, pu, pv)
+    };
+    let in01 = |x: f64| (-PARAM_TOL..=1.0 + PARAM_TOL).contains(&x);
+    for (k, &u) in us.iter().enumerate() {
+        if !u.is_finite() || (k == 1 && (us[0] - u).abs() == 0.0) {
+            continue;
+        }
+        if !(-1e-3..=1.0 + 1e-3).contains(&u) {
+            continue;
+        }
+        let den1 = c1 + d1 * u;
+        let den2 = c2 + d2 * u;
+        let v = if den1.abs() >= den2.abs() {
+            if den1 == 0.0 {
+                continue;
+            }
+            -(a1 + b1 * u) / den1
+        } else {
+            -(a2 + b2 * u) / den2
+        };
+        if !v.is_finite() || !(-1e-3..=1.0 + 1e-3).contains(&v) {
+            continue;
+        }
+        let (mut u, mut v) = (u, v);
+        let mut t = (eval(u, v).0 - o).dot(d);
+        for _ in 0..2 {
+            let (p, pu, pv) = eval(u, v);
+            let f = p - o - d * t;
+            let j = DMat3::from_cols(pu, pv, -d);
+            let det = j.determinant();
+            if det == 0.0 || !det.is_finite() {
+                break;
+            }
+            let step = j.inverse() * f;
+            if !step.is_finite() {
+                break;
+            }
+            u -= step.x;
+            v -= step.y;
+            t -= step.z;
+        }
+        if in01(u) && in01(v) && t.is_finite() {
+            out.push((t, u, v));
+        }
+    }
+}
+
+/// The root `(t, b1, b2)` of the ray line with triangle `p` (barycentric
+/// weights of `p[1]`, `p[2]`, widened by `PARAM_TOL`), Möller-Trumbore.
+pub fn ray_triangle(o: DVec3, d: DVec3, p: [DVec3; 3]) -> Option<(f64, f64, f64)> {
+    let e1 = p[1] - p[0];
+    let e2 = p[2] - p[0];
+    let pv = d.cross(e2);
+    let det = e1.dot(pv);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let tv = o - p[0];
+    let b1 = tv.dot(pv) * inv;
+    let qv = tv.cross(e1);
+    let b2 = d.dot(qv) * inv;
+    let t = e2.dot(qv) * inv;
+    let ok = b1 >= -PARAM_TOL && b2 >= -PARAM_TOL && b1 + b2 <= 1.0 + PARAM_TOL;
+    (ok && t.is_finite()).then_some((t, b1, b2))
+}
+
+/// One cell's part of a ray in the native model: between two roots of the
+/// ray with the cell's true (bilinear / planar) boundary, with the exact
+/// boundary scalars at both ends.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interval {
+    pub cell: u32,
+    pub t_a: f64,
+    pub t_b: f64,
+    pub s_a: f64,
+    pub s_b: f64,
+}
+
+/// A root of the ray with a face of the cell: depth, exact scalar there,
+/// the global face.
+#[derive(Clone, Copy, Debug)]
+struct Root {
+    t: f64,
+    s: f64,
+    face: u32,
+}
+
+/// The canonical cyclic order of a quad face's global ids: from the
+/// smallest, towards the smaller of its two neighbours. Both cells sharing
+/// the face see the same patch parameterisation, hence bit-identical roots.
+fn canonical_quad(g: [u32; 4]) -> [usize; 4] {
+    let k0 = (0..4).min_by_key(|&i| g[i]).unwrap_or(0);
+    let fwd = g[(k0 + 1) % 4] < g[(k0 + 3) % 4];
+    std::array::from_fn(|i| if fwd { (k0 + i) % 4 } else { (k0 + 4 - i) % 4 })
+}
+
+/// The intervals of `ray` inside native cell `c` (bounded by its bilinear
+/// quad faces and planar triangles), appended to `out`; the global faces
+/// through which the ray crosses the cell's boundary are appended to
+/// `crossed` (so a caller can add neighbours the walk missed).
+///
+/// All roots of the ray line with the cell's faces are sorted; the ray is
+/// inside the cell between two consecutive roots iff the midpoint's
+/// inverted parametric coordinates lie in the reference element (the
+/// definition of the iso-parametric cell, robust to roots duplicated or
+/// missed at edges). Where the midpoint cannot be inverted the parity of
+/// the root index decides (counted). Returns `None` for cells without a
+/// native field.
+#[allow(clippy::too_many_arguments)]
+pub fn cell_intervals(
+    scene: &Scene,
+    vals: &[f64],
+    c: usize,
+    ray: &Ray,
+    axes: (DVec3, DVec3),
+    out: &mut Vec<Interval>,
+    crossed: &mut Vec<u32>,
+    stats: &mut NativeStats,
+) -> Option<()> {
+    let cells = &scene.mesh.cells;
+    let kind = cells.kinds[c];
+    if !is_native_kind(kind) {
+        return None;
+    }
+    let nodes = cells.nodes(c);
+    let pts = &scene.mesh.points;
+    let x: Vec<DVec3> = nodes.iter().map(|&n| pts[n as usize]).collect();
+    let s: Vec<f64> = nodes.iter().map(|&n| vals[n as usize]).collect();
+    let mut field = IsoRay::new(kind, &x, &s, ray)?;
+    let faces = scene.topology.faces_of(c);
+    let (o, d) = (ray.origin, ray.dir);
+    let mut roots: Vec<Root> = Vec::with_capacity(12);
+    let mut hits = Vec::with_capacity(2);
+    for (fi, lf) in kind.faces().iter().enumerate() {
+        let face = faces.get(fi).copied().unwrap_or(u32::MAX);
+        match lf.len() {
+            4 => {
+                let g: [u32; 4] = std::array::from_fn(|i| nodes[lf[i] as usize]);
+                let ord = canonical_quad(g);
+                let q = ord.map(|i| pts[g[i] as usize]);
+                let sv = ord.map(|i| vals[g[i] as usize]);
+                hits.clear();
+                ray_bilinear(o, d, axes, q, &mut hits);
+                for &(t, u, v) in &hits {
+                    let s = sv[0] * ((1.0 - u) * (1.0 - v))
+                        + sv[1] * (u * (1.0 - v))
+                        + sv[2] * (u * v)
+                        + sv[3] * ((1.0 - u) * v);
+                    roots.push(Root { t, s, face });
+                }
+            }
+            3 => {
+                let mut g: [u32; 3] = std::array::from_fn(|i| nodes[lf[i] as usize]);
+                g.sort_unstable();
+                let p = g.map(|i| pts[i as usize]);
+                if let Some((t, b1, b2)) = ray_triangle(o, d, p) {
+                    let sv = g.map(|i| vals[i as usize]);
+                    let s = sv[0] * (1.0 - b1 - b2) + sv[1] * b1 + sv[2] * b2;
+                    roots.push(Root { t, s, face });
+                }
+            }
+            _ => {}
+        }
+    }
+    roots.sort_by(|a, b| a.t.total_cmp(&b.t));
+    for r in &roots {
+        crossed.push(r.face);
+    }
+    for (k, w) in roots.windows(2).enumerate() {
+        let (a, b) = (w[0], w[1]);
+        if b.t <= a.t {
+            continue;
+        }
+        let tm = 0.5 * (a.t + b.t);
+        let inside = match field.locate(tm) {
+            Some(xi) => in_reference(kind, xi),
+            None => {
+                stats.parity_classified += 1;
+                k % 2 == 0
+            }
+        };
+        if inside {
+            out.push(Interval {
+                cell: c as u32,
+                t_a: a.t,
+                t_b: b.t,
+                s_a: a.s,
+                s_b: b.s,
+            });
+        }
+    }
+    stats.newton_failures += field.failures;
+    Some(())
+}
+
+/// Integrates one native interval (clipped to `t >= t_near`): the
+/// iso-parametric integral, or, when the map cannot be inverted inside, the
+/// linear integral between the exact boundary scalars (counted).
+pub fn interval_value<M: RayMaterial>(
+    scene: &Scene,
+    vals: &[f64],
     material: &M,
     ray: &Ray,
-    seg: &Segment,
+    iv: &Interval,
+    t_near: f64,
+    stats: &mut NativeStats,
 ) -> SegmentValue {
-    let l = seg.t_out - seg.t_in;
-    let fallback = || material.segment(l, seg.s_in, seg.s_out);
-    let Scalars::Point(vals) = scene.scalars else {
-        return fallback();
-    };
+    let c = iv.cell as usize;
+    let (mut ta, tb) = (iv.t_a, iv.t_b);
+    let mut sa = iv.s_a;
+    if ta < t_near {
+        let x = (t_near - ta) / (tb - ta);
+        sa += x * (iv.s_b - sa);
+        ta = t_near;
+    }
+    let l = tb - ta;
+    if l.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return SegmentValue::default();
+    }
+    stats.intervals += 1;
     let cells = &scene.mesh.cells;
-    let c = seg.cell as usize;
-    if l.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || c >= cells.len() {
-        return fallback();
-    }
-    let kind = cells.kinds[c];
     let nodes = cells.nodes(c);
-    if nodes.len() > 8 {
-        return fallback();
-    }
-    let mut x = [DVec3::ZERO; 8];
-    let mut s = [0.0; 8];
-    for (k, &n) in nodes.iter().enumerate() {
-        x[k] = scene.mesh.points[n as usize];
-        s[k] = vals[n as usize];
-    }
-    let k = nodes.len();
-    match IsoRay::new(kind, &x[..k], &s[..k], ray) {
-        Some(mut f) => integrate(&mut f, material, seg.t_in, seg.t_out).unwrap_or_else(fallback),
-        None => fallback(),
+    let x: Vec<DVec3> = nodes
+        .iter()
+        .map(|&n| scene.mesh.points[n as usize])
+        .collect();
+    let s: Vec<f64> = nodes.iter().map(|&n| vals[n as usize]).collect();
+    let value = IsoRay::new(cells.kinds[c], &x, &s, ray).and_then(|mut f| {
+        let r = integrate(&mut f, material, ta, tb, stats);
+        stats.newton_failures += f.failures;
+        r
+    });
+    value.unwrap_or_else(|| {
+        stats.fallback_intervals += 1;
+        material.segment(l, sa, iv.s_b)
+    })
+}
+
+/// The ray line's perpendicular axes, for [`cell_intervals`].
+pub fn axes_of(ray: &Ray) -> (DVec3, DVec3) {
+    ray_plane_axes(ray.dir)
+}
+
+/// Point scalars of a scene (the native model's field), if any.
+pub fn point_values<'a>(scene: &Scene<'a>) -> Option<&'a [f64]> {
+    match scene.scalars {
+        Scalars::Point(v) => Some(v),
+        _ => None,
     }
 }
 

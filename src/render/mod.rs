@@ -124,6 +124,9 @@ pub struct RaycastStats {
     /// Rays stop once their transmittance falls below this (0: never), so
     /// a pixel's opacity may fall short of the full integral by at most it.
     pub termination_transmittance: f64,
+    /// Native model: intervals integrated and what fell back from the
+    /// exact method during this render (zero for other models).
+    pub native: crate::raycast::native::NativeStats,
 }
 
 /// Reusable state for rendering many views of one scene.
@@ -223,11 +226,13 @@ impl<'s> Renderer<'s> {
                     model: opts.model,
                     ..Default::default()
                 };
+                let before = rc.native_stats();
+                let img = rc.render_with_progress(&scene.tf, &camera, &ro, progress);
                 stats.raycast = Some(RaycastStats {
                     model: opts.model,
                     termination_transmittance: ro.early_termination,
+                    native: rc.native_stats().since(&before),
                 });
-                let img = rc.render_with_progress(&scene.tf, &camera, &ro, progress);
                 self.raycaster = Some((opts.model, rc));
                 img
             }
