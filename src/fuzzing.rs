@@ -247,6 +247,19 @@ pub fn projection(data: &[u8]) {
                 pr.arrangement().sanity_check().expect("sanity_check");
                 let area = out.region_area();
                 assert!(area.is_finite() && area >= 0.0);
+                // Orthographic, whole cell (nothing clipped): the regions
+                // tile the silhouette, the hull of the projected corners.
+                if cam.ortho && kind != CellKind::Tetra {
+                    let px: Vec<(f64, f64)> = pts
+                        .iter()
+                        .filter_map(|&p| cam.project(p).map(|(x, y, _)| (x, y)))
+                        .collect();
+                    let hull = hull_area(&px);
+                    assert!(
+                        (area - hull).abs() <= 1e-9 * hull.max(1.0),
+                        "{kind:?}: regions {area} vs silhouette {hull}"
+                    );
+                }
             }
             // A convex piece always gets a consistent subdivision in which
             // every region has one front and one back triangle.
@@ -310,4 +323,43 @@ pub fn visibility(data: &[u8]) {
         let v = validate(&mesh, &order, &cam, &sample_pixels(&cam, usize::MAX, 0));
         assert!(v.ok(), "{} violations: {:?}", v.count, v.examples.first());
     }
+}
+
+/// Area of the convex hull of `pts` (Andrew's monotone chain).
+fn hull_area(pts: &[(f64, f64)]) -> f64 {
+    let mut p: Vec<(f64, f64)> = pts.to_vec();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    p.dedup();
+    if p.len() < 3 {
+        return 0.0;
+    }
+    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut hull: Vec<(f64, f64)> = Vec::with_capacity(2 * p.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &(f64, f64)>> = if pass == 0 {
+            Box::new(p.iter())
+        } else {
+            Box::new(p.iter().rev())
+        };
+        for &q in iter {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+    }
+    let n = hull.len();
+    0.5 * (0..n)
+        .map(|i| {
+            let (a, b) = (hull[i], hull[(i + 1) % n]);
+            a.0 * b.1 - a.1 * b.0
+        })
+        .sum::<f64>()
+        .abs()
 }
