@@ -1,0 +1,141 @@
+//! The exact mode end to end (issue 7): bluntfin (default field and TF), the
+//! hex_shell scene of `../shared/data/synthetic/README.md` (bench_tf.json,
+//! azimuth 20, elevation 35, zoom 1.25, perspective) and the generated
+//! 1M-hex grid, at 512^2 and 1024^2, on every backend present (Vulkan
+//! lavapipe with f32 accumulation, GL llvmpipe with f16). For every case one
+//! frame is reported by stage (sort, project + integrals, GPU upload/draw,
+//! wait, readback) with triangle counts; criterion then times whole frames
+//! of bluntfin (the heavy scenes take seconds per frame; their per-frame
+//! figure is the reported one). Skips scenes whose data is absent.
+//!
+//! Run: `cargo bench --bench render` (`-- bluntfin` to filter).
+//!
+//! Measured 2026-12-01 (Mesa 22.3.6, 2 idle cores), frame after the first:
+//! bluntfin 0.57 s at 512^2 (Vulkan and GL alike), 0.69-0.72 s at 1024^2;
+//! hex_shell 5.9 s (Vulkan) / 6.2 s (GL) at 512^2, 12.0M triangles, of
+//! which projection and integrals take 4.4-5.4 s; grid_1m 6.7 / 7.2 s,
+//! 20.5M triangles. Projection dominates: the GPU work is streamed and
+//! overlaps it.
+
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use zoovr::camera::CameraParams;
+use zoovr::generate::{warped_hex_grid, Warp};
+use zoovr::gpu::{Backend, Context, GpuOptions};
+use zoovr::io::{self, ReadOptions};
+use zoovr::render::{Mode, RenderOptions, Renderer, Scene, SceneSpec};
+use zoovr::testdata::shared_file;
+
+fn scenes() -> Vec<(&'static str, Scene, CameraParams)> {
+    let mut out = Vec::new();
+    if let Some(p) = shared_file("bluntfin/bluntfin_converted.vts") {
+        let mesh = io::read(&p, &ReadOptions::default()).unwrap();
+        out.push((
+            "bluntfin",
+            Scene::build(mesh, &SceneSpec::default()).unwrap(),
+            CameraParams::default(),
+        ));
+    }
+    if let (Some(p), Some(tf)) = (
+        shared_file("synthetic/hex_shell_zlib.vtu"),
+        shared_file("synthetic/bench_tf.json"),
+    ) {
+        let mesh = io::read(&p, &ReadOptions::default()).unwrap();
+        let spec = SceneSpec {
+            tf_file: Some(tf),
+            ..Default::default()
+        };
+        out.push((
+            "hex_shell",
+            Scene::build(mesh, &spec).unwrap(),
+            CameraParams {
+                azimuth: 20.0,
+                elevation: 35.0,
+                zoom: 1.25,
+                ..Default::default()
+            },
+        ));
+    }
+    let mesh = warped_hex_grid(100, &Warp::default());
+    out.push((
+        "grid_1m",
+        Scene::build(mesh, &SceneSpec::default()).unwrap(),
+        CameraParams {
+            azimuth: 20.0,
+            elevation: 35.0,
+            ..Default::default()
+        },
+    ));
+    out
+}
+
+fn backends() -> Vec<(&'static str, GpuOptions)> {
+    [("vulkan", Backend::Vulkan), ("gl", Backend::Gl)]
+        .into_iter()
+        .map(|(n, b)| {
+            (
+                n,
+                GpuOptions {
+                    backend: Some(b),
+                    cpu_adapter: false,
+                },
+            )
+        })
+        .filter(|(_, o)| Context::new(o).is_ok())
+        .collect()
+}
+
+fn bench(c: &mut Criterion) {
+    let backends = backends();
+    if backends.is_empty() {
+        eprintln!("no GPU adapter: nothing to bench");
+        return;
+    }
+    for (name, scene, cam) in scenes() {
+        for &(bname, gpu) in &backends {
+            let mut renderer = Renderer::new(&scene);
+            for size in [512u32, 1024] {
+                let opts = RenderOptions {
+                    camera: CameraParams {
+                        width: size,
+                        height: size,
+                        ..cam
+                    },
+                    mode: Mode::Exact,
+                    gpu,
+                    ..Default::default()
+                };
+                // The first frame builds the sorter and opens the device.
+                let (_, first) = renderer.render(&opts, |_, _| {}).unwrap();
+                let (_, s) = renderer.render(&opts, |_, _| {}).unwrap();
+                let e = s.exact.as_ref().unwrap();
+                eprintln!(
+                    "{name} {bname} {size}: frame {:.2} s (first {:.2} s) = sort {:.3} + project/integrals {:.2} + gpu {:.2} (upload+draw {:.2}, wait {:.2}, readback {:.3}); {} pieces, {} triangles, {} batches",
+                    s.total_s,
+                    first.total_s,
+                    e.sort_s,
+                    e.project_s,
+                    e.gpu_total_s,
+                    e.gpu.upload_s,
+                    e.gpu.gpu_wait_s,
+                    e.gpu.readback_s,
+                    e.pieces,
+                    e.triangles,
+                    e.gpu.batches
+                );
+                if name == "bluntfin" {
+                    let mut g = c.benchmark_group(format!("exact/{name}/{bname}"));
+                    g.sample_size(10).measurement_time(Duration::from_secs(8));
+                    g.bench_function(format!("{size}"), |b| {
+                        b.iter(|| renderer.render(&opts, |_, _| {}).unwrap())
+                    });
+                    g.finish();
+                }
+            }
+        }
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
