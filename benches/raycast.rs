@@ -6,11 +6,6 @@
 //! azimuth 20, elevation 35, zoom 1.25, 512 x 512, and the transfer function
 //! of `bench_tf.json` (extinction = opacity / 0.5, glow colour).
 //!
-//! The transfer function's `segment` here slices at breakpoints and uses the
-//! exact depth with the colour at each sub-segment's midpoint (the cost class
-//! of the closed form, not its colour accuracy; the real `tf` closed form
-//! plugs in at merge time).
-//!
 //! `cargo bench --bench raycast` prints setup time and memory, then criterion
 //! timings per frame for faces/tets x perspective/ortho and native.
 
@@ -19,10 +14,10 @@ use std::time::Instant;
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::DVec3;
 use zoovr::camera::{Camera, CameraParams};
-use zoovr::integrate::{Material, RayMaterial, SegmentValue};
 use zoovr::mesh::topology::Topology;
 use zoovr::mesh::{CellKind, Cells, Mesh};
 use zoovr::raycast::{FieldModel, RaycastOptions, Raycaster, Scalars, Scene};
+use zoovr::tf::TransferFunction;
 
 const N: usize = 64;
 
@@ -110,132 +105,24 @@ pub fn hex_shell() -> (Mesh, Vec<f64>) {
     (mesh, f)
 }
 
-/// `bench_tf.json`: piecewise-linear extinction and glow colour.
-pub struct BenchTf {
-    s: Vec<f64>,
-    tau: Vec<f64>,
-    rgb: Vec<[f64; 3]>,
-}
-
-impl BenchTf {
-    pub fn new() -> BenchTf {
-        let op = [
-            (0.0, 0.0),
-            (0.28, 0.0),
-            (0.3, 0.5),
-            (0.4, 0.5),
-            (0.45, 0.02),
-            (0.6, 0.02),
-            (0.62, 0.9),
-            (0.75, 0.9),
-            (0.8, 0.2),
-            (1.0, 0.2),
-        ];
-        let col = [
-            (0.0, [0.0, 0.0, 1.0]),
-            (0.3, [0.0, 0.6, 1.0]),
-            (0.45, [0.1, 0.9, 0.3]),
-            (0.62, [1.0, 0.9, 0.0]),
-            (0.8, [1.0, 0.3, 0.0]),
-            (1.0, [0.8, 0.0, 0.3]),
-        ];
-        let mut s: Vec<f64> = op
-            .iter()
-            .map(|p| p.0)
-            .chain(col.iter().map(|c| c.0))
-            .collect();
-        s.sort_by(f64::total_cmp);
-        s.dedup();
-        let lerp = |x: f64, pts: &[(f64, f64)]| {
-            let k = pts
-                .iter()
-                .rposition(|p| p.0 <= x)
-                .unwrap_or(0)
-                .min(pts.len() - 2);
-            let t = ((x - pts[k].0) / (pts[k + 1].0 - pts[k].0)).clamp(0.0, 1.0);
-            pts[k].1 * (1.0 - t) + pts[k + 1].1 * t
-        };
-        let tau = s.iter().map(|&x| lerp(x, &op) / 0.5).collect();
-        let rgb = s
-            .iter()
-            .map(|&x| {
-                std::array::from_fn(|c| {
-                    let pts: Vec<(f64, f64)> = col.iter().map(|p| (p.0, p.1[c])).collect();
-                    lerp(x, &pts)
-                })
-            })
-            .collect();
-        BenchTf { s, tau, rgb }
-    }
-
-    #[inline]
-    fn at(&self, x: f64) -> (f64, [f64; 3]) {
-        let n = self.s.len();
-        let x = x.clamp(self.s[0], self.s[n - 1]);
-        let k = self.s.partition_point(|&b| b <= x).clamp(1, n - 1) - 1;
-        let t = (x - self.s[k]) / (self.s[k + 1] - self.s[k]);
-        let c = std::array::from_fn(|i| self.rgb[k][i] * (1.0 - t) + self.rgb[k + 1][i] * t);
-        (self.tau[k] * (1.0 - t) + self.tau[k + 1] * t, c)
-    }
-}
-
-impl Default for BenchTf {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl RayMaterial for BenchTf {
-    fn segment(&self, l: f64, s_f: f64, s_b: f64) -> SegmentValue {
-        let mut out = SegmentValue::default();
-        let (lo, hi) = (s_f.min(s_b), s_f.max(s_b));
-        let mut x0 = 0.0;
-        let emit = |x0: f64, x1: f64, out: &mut SegmentValue| {
-            let (sa, sb) = (s_f + (s_b - s_f) * x0, s_f + (s_b - s_f) * x1);
-            let (ta, tb) = (self.at(sa).0, self.at(sb).0);
-            let d = l * (x1 - x0) * 0.5 * (ta + tb);
-            if d > 0.0 {
-                let c = self.at(0.5 * (sa + sb)).1;
-                let a = -(-d).exp_m1();
-                let tr = (-out.depth).exp();
-                for (o, ck) in out.color.iter_mut().zip(c) {
-                    *o += tr * ck * a;
-                }
-                out.depth += d;
-            }
-        };
-        if hi > lo {
-            let i0 = self.s.partition_point(|&b| b <= lo);
-            let i1 = self.s.partition_point(|&b| b < hi);
-            let mut cuts: Vec<f64> = self.s[i0..i1]
-                .iter()
-                .map(|&b| (b - s_f) / (s_b - s_f))
-                .collect();
-            if s_b < s_f {
-                cuts.reverse();
-            }
-            for x in cuts {
-                emit(x0, x, &mut out);
-                x0 = x;
-            }
-        }
-        emit(x0, 1.0, &mut out);
-        out.alpha = -(-out.depth).exp_m1();
-        out
-    }
-
-    fn breakpoints(&self) -> &[f64] {
-        &self.s
-    }
-
-    fn material(&self, s: f64) -> Material {
-        let (tau, c) = self.at(s);
-        Material {
-            tau,
-            source: c.map(|x| x * tau),
-        }
-    }
-}
+/// `bench_tf.json` (the copy in `../shared/data/synthetic/`), embedded so
+/// the bench runs without the shared data: the real transfer function and
+/// its closed-form segment integral.
+const BENCH_TF: &str = r#"{
+ "scalar": "f",
+ "unit_distance": 0.5,
+ "opacity_points": [
+  {"s": 0.0, "opacity": 0.0}, {"s": 0.28, "opacity": 0.0}, {"s": 0.3, "opacity": 0.5},
+  {"s": 0.4, "opacity": 0.5}, {"s": 0.45, "opacity": 0.02}, {"s": 0.6, "opacity": 0.02},
+  {"s": 0.62, "opacity": 0.9}, {"s": 0.75, "opacity": 0.9}, {"s": 0.8, "opacity": 0.2},
+  {"s": 1.0, "opacity": 0.2}
+ ],
+ "color_points": [
+  {"s": 0.0, "rgb": [0.0, 0.0, 1.0]}, {"s": 0.3, "rgb": [0.0, 0.6, 1.0]},
+  {"s": 0.45, "rgb": [0.1, 0.9, 0.3]}, {"s": 0.62, "rgb": [1.0, 0.9, 0.0]},
+  {"s": 0.8, "rgb": [1.0, 0.3, 0.0]}, {"s": 1.0, "rgb": [0.8, 0.0, 0.3]}
+ ]
+}"#;
 
 fn peak_rss_mib() -> f64 {
     std::fs::read_to_string("/proc/self/status")
@@ -292,7 +179,7 @@ fn bench(c: &mut Criterion) {
         topology: &topology,
         scalars: Scalars::Point(&f),
     };
-    let tf = BenchTf::new();
+    let tf = TransferFunction::from_json_str(BENCH_TF, 0.5).expect("bench_tf");
     let size: u32 = std::env::var("RAYCAST_BENCH_SIZE")
         .ok()
         .and_then(|s| s.parse().ok())
