@@ -75,6 +75,8 @@ pub struct Projector {
     facing: Vec<Facing>,
     segs: Vec<Piece>,
     mark: Vec<bool>,
+    /// Half-edges of the unbounded face's cycle.
+    outer: Vec<bool>,
     face_of: Vec<u32>,
     face_start: Vec<u32>,
     cycles: Vec<(u32, f64)>,
@@ -103,6 +105,7 @@ impl Default for Projector {
             facing: Vec::new(),
             segs: Vec::new(),
             mark: Vec::new(),
+            outer: Vec::new(),
             face_of: Vec::new(),
             face_start: Vec::new(),
             cycles: Vec::new(),
@@ -288,7 +291,9 @@ impl Projector {
         Ok(())
     }
 
-    /// Traces face cycles; bounded faces get ids (see
+    /// Traces face cycles; bounded faces get ids: every cycle except the
+    /// unbounded face's, found exactly ([`Arrangement::outer_half_edge`]),
+    /// and except any other clearly negative one (a second component, a bug;
     /// [`super::arrangement::is_outer`]).
     fn trace_regions(&mut self) {
         let sub = &self.arr.sub;
@@ -301,8 +306,10 @@ impl Projector {
         let cycles = &mut self.cycles;
         sub.trace_faces(&mut self.mark, |h0| cycles.push((h0, arr.cycle_area(h0))));
         let amin = self.cycles.iter().fold(0.0, |m: f64, c| m.min(c.1));
+        let mut outer = std::mem::take(&mut self.outer);
+        self.arr.outer_cycle(&mut outer);
         for &(h0, a) in &self.cycles {
-            if is_outer(a, amin) {
+            if outer[h0 as usize] || is_outer(a, amin) {
                 continue;
             }
             let id = self.face_start.len() as u32;
@@ -316,6 +323,7 @@ impl Projector {
                 }
             }
         }
+        self.outer = outer;
     }
 
     /// Front and back triangle of every bounded face.
