@@ -4,10 +4,8 @@
 //! - [`orient_dir`]: the exact sign of `((b - a) x (c - a)) . d`, the side of
 //!   a triangle's plane an orthographic eye at infinity (direction `-d`) is on.
 //!   `orient3d(a, b, c, a + d)` is not exact because `a + d` rounds, so this is
-//!   computed with Shewchuk's expansion arithmetic (two-sum / two-product),
-//!   which represents every intermediate value exactly as a sum of
-//!   non-overlapping doubles; the sign of the expansion is the sign of its
-//!   largest component.
+//!   computed with [`crate::numeric::expansion`] arithmetic, which represents
+//!   every intermediate value exactly.
 //! - [`ray_triangle`]: whether the line through two points `o, q` crosses a
 //!   triangle, from the signs of the three tetrahedra `(o, q, edge)` (Plücker
 //!   test) evaluated with exact `orient3d`. A crossing through an edge or a
@@ -22,77 +20,8 @@
 
 use glam::DVec3;
 
+use crate::numeric::expansion::Expansion;
 use crate::numeric::predicates::{orient3d, Side};
-
-/// `a + b` as a two-component expansion `(sum, err)`, exactly.
-#[inline]
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let x = a + b;
-    let bv = x - a;
-    let av = x - bv;
-    (x, (a - av) + (b - bv))
-}
-
-/// `a * b` as `(product, err)`, exactly (fused multiply-add).
-#[inline]
-fn two_product(a: f64, b: f64) -> (f64, f64) {
-    let x = a * b;
-    (x, a.mul_add(b, -x))
-}
-
-/// `e + b` for a non-overlapping expansion `e` (increasing magnitude).
-fn grow(e: &[f64], b: f64, out: &mut Vec<f64>) {
-    out.clear();
-    let mut q = b;
-    for &c in e {
-        let (s, h) = two_sum(q, c);
-        if h != 0.0 {
-            out.push(h);
-        }
-        q = s;
-    }
-    if q != 0.0 {
-        out.push(q);
-    }
-}
-
-/// Sum of two expansions (by repeated growth; the expansions here are short).
-fn add(e: &[f64], f: &[f64]) -> Vec<f64> {
-    let mut acc: Vec<f64> = e.to_vec();
-    let mut tmp = Vec::with_capacity(e.len() + f.len() + 1);
-    for &x in f {
-        grow(&acc, x, &mut tmp);
-        std::mem::swap(&mut acc, &mut tmp);
-    }
-    acc
-}
-
-/// `e * b`, exactly.
-fn scale(e: &[f64], b: f64) -> Vec<f64> {
-    let mut acc: Vec<f64> = Vec::new();
-    for &x in e {
-        let (p, err) = two_product(x, b);
-        acc = add(&acc, &[err, p]);
-    }
-    acc
-}
-
-/// Product of two expansions, exactly.
-fn mul(e: &[f64], f: &[f64]) -> Vec<f64> {
-    let mut acc: Vec<f64> = Vec::new();
-    for &x in f {
-        acc = add(&acc, &scale(e, x));
-    }
-    acc
-}
-
-fn sign_of(e: &[f64]) -> Side {
-    match e.iter().rev().find(|&&x| x != 0.0) {
-        Some(&x) if x > 0.0 => Side::Positive,
-        Some(_) => Side::Negative,
-        None => Side::On,
-    }
-}
 
 /// Exact sign of `((b - a) x (c - a)) . d`.
 pub fn orient_dir(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Side {
@@ -118,22 +47,16 @@ pub fn orient_dir(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Side {
 
 /// The expansion-arithmetic evaluation behind [`orient_dir`].
 pub fn orient_dir_exact(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Side {
-    let diff = |p: f64, q: f64| {
-        let (s, e) = two_sum(p, -q);
-        vec![e, s]
-    };
-    let u = [diff(b.x, a.x), diff(b.y, a.y), diff(b.z, a.z)];
-    let v = [diff(c.x, a.x), diff(c.y, a.y), diff(c.z, a.z)];
-    let w = [d.x, d.y, d.z];
-    let mut total: Vec<f64> = Vec::new();
+    let u = [0, 1, 2].map(|k| Expansion::diff(b[k], a[k]));
+    let v = [0, 1, 2].map(|k| Expansion::diff(c[k], a[k]));
+    let w = [0, 1, 2].map(|k| Expansion::from_f64(d[k]));
+    let mut total = Expansion::default();
     // det = sum over cyclic (i, j, k) of u_i (v_j w_k - v_k w_j).
     for (i, j, k) in [(0, 1, 2), (1, 2, 0), (2, 0, 1)] {
-        let pos = scale(&v[j], w[k]);
-        let neg: Vec<f64> = scale(&v[k], w[j]).iter().map(|x| -x).collect();
-        let minor = add(&pos, &neg);
-        total = add(&total, &mul(&u[i], &minor));
+        let minor = v[j].mul(&w[k]).sub(&v[k].mul(&w[j]));
+        total = total.add(&u[i].mul(&minor));
     }
-    sign_of(&total)
+    total.sign()
 }
 
 /// Outcome of an exact line-triangle crossing test.
