@@ -35,3 +35,42 @@ pub fn shared_file(rel: &str) -> Option<PathBuf> {
 pub fn mesh_file(rel: &str) -> PathBuf {
     project_root().join("meshes").join(rel)
 }
+
+/// Every dataset file of the shared data folder that a test renders (one
+/// dataset each; `.pvtu` pieces and series steps through their collection).
+pub const SHARED_DATASETS: &[&str] = &[
+    "angular_sector/AngularSector.vtk",
+    "blood_vessels_pvtu/blood_vessels/T0000000500.pvtu",
+    "bluntfin/bluntfin_converted.vts",
+    "bluntfin/bluntfin_converted_legacy42_binary.vtk",
+    "bluntfin/bluntfinxyz.bin",
+    "can_crush/can.vtu",
+    "can_crush/series/can_series.pvd",
+    "disk_out_ref/disk_out_ref_converted.vtu",
+    "disk_out_ref/disk_out_ref_converted_legacy51_binary.vtk",
+    "fea_bracket_qtet/kiefer_bracket.vtu",
+    "fire_room/fire_ug.vtu",
+    "notch/notch_disp.vtu",
+    "notch/notch_stress.vtk",
+    "office_kitchen/kitchen.vtk",
+    "office_kitchen/office.binary.vtk",
+    "prisms_zoo/PentaHexa.vtk",
+    "prisms_zoo/hexa.vtk",
+    "prisms_zoo/uGridEx.vtk",
+    "su2_sphere_hybrid/sphere_hybrid_converted.vtu",
+    "su2_sphere_hybrid/sphere_hybrid_converted_legacy42_ascii.vtk",
+    "synthetic/hex_shell_zlib.vtu",
+    "synthetic/mixed.vtk",
+    "tets_small/CylinderLinear.vtk",
+    "tets_small/tetraMesh.vtk",
+];
+
+/// The read options for a [`SHARED_DATASETS`] entry: the PLOT3D grid of
+/// bluntfin gets its solution file.
+pub fn read_options(rel: &str) -> crate::io::ReadOptions {
+    let mut o = crate::io::ReadOptions::default();
+    if rel.ends_with("xyz.bin") {
+        o.q_file = shared_file("bluntfin/bluntfinq.bin");
+    }
+    o
+}

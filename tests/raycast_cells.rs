@@ -5,17 +5,9 @@ mod raycast_util;
 use glam::DVec3;
 use raycast_util::*;
 use zoovr::mesh::{CellKind, Cells, Mesh};
-use zoovr::raycast::{trace_ray, FieldModel, RaycastOptions, Raycaster, Scalars, Scene};
+use zoovr::raycast::{trace_ray, FieldModel, Raycaster, Scalars, Scene};
 
 const MODELS: [FieldModel; 3] = [FieldModel::Faces, FieldModel::Tets, FieldModel::Native];
-
-fn opts(model: FieldModel) -> RaycastOptions {
-    RaycastOptions {
-        model,
-        early_termination: 0.0,
-        ..Default::default()
-    }
-}
 
 fn one_cell(kind: CellKind, pts: &[[f64; 3]]) -> Mesh {
     let mut cells = Cells::default();

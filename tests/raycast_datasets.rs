@@ -9,49 +9,19 @@ mod raycast_util;
 use raycast_util::TestMaterial;
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::field::{select_field, Association};
-use zoovr::io::{self, ReadOptions};
+use zoovr::io;
 use zoovr::mesh::topology::Topology;
 use zoovr::raycast::{render, RaycastOptions, Scalars, Scene};
-
-const FILES: &[&str] = &[
-    "angular_sector/AngularSector.vtk",
-    "blood_vessels_pvtu/blood_vessels/T0000000500.pvtu",
-    "bluntfin/bluntfin_converted.vts",
-    "bluntfin/bluntfin_converted_legacy42_binary.vtk",
-    "bluntfin/bluntfinxyz.bin",
-    "can_crush/can.vtu",
-    "can_crush/series/can_series.pvd",
-    "disk_out_ref/disk_out_ref_converted.vtu",
-    "disk_out_ref/disk_out_ref_converted_legacy51_binary.vtk",
-    "fea_bracket_qtet/kiefer_bracket.vtu",
-    "fire_room/fire_ug.vtu",
-    "notch/notch_disp.vtu",
-    "notch/notch_stress.vtk",
-    "office_kitchen/kitchen.vtk",
-    "office_kitchen/office.binary.vtk",
-    "prisms_zoo/PentaHexa.vtk",
-    "prisms_zoo/hexa.vtk",
-    "prisms_zoo/uGridEx.vtk",
-    "su2_sphere_hybrid/sphere_hybrid_converted.vtu",
-    "su2_sphere_hybrid/sphere_hybrid_converted_legacy42_ascii.vtk",
-    "synthetic/hex_shell_zlib.vtu",
-    "synthetic/mixed.vtk",
-    "tets_small/CylinderLinear.vtk",
-    "tets_small/tetraMesh.vtk",
-];
 
 #[test]
 fn render_every_shared_dataset_at_128() {
     let mut rendered = 0;
     let mut found = 0;
-    for rel in FILES {
+    for rel in zoovr::testdata::SHARED_DATASETS {
         let Some(path) = zoovr::testdata::shared_file(rel) else {
             continue;
         };
-        let mut opts = ReadOptions::default();
-        if rel.ends_with("xyz.bin") {
-            opts.q_file = zoovr::testdata::shared_file("bluntfin/bluntfinq.bin");
-        }
+        let opts = zoovr::testdata::read_options(rel);
         found += 1;
         let mesh = io::read(&path, &opts).unwrap_or_else(|e| panic!("{rel}: {e}"));
         mesh.sanity_check().unwrap_or_else(|e| panic!("{rel}: {e}"));
@@ -101,6 +71,9 @@ fn render_every_shared_dataset_at_128() {
         );
         rendered += 1;
     }
-    eprintln!("rendered {rendered} of {} datasets", FILES.len());
+    eprintln!(
+        "rendered {rendered} of {} datasets",
+        zoovr::testdata::SHARED_DATASETS.len()
+    );
     assert_eq!(rendered, found, "every dataset present must render");
 }

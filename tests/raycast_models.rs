@@ -9,15 +9,7 @@ use raycast_util::*;
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::image::check_float_images;
 use zoovr::mesh::Mesh;
-use zoovr::raycast::{render, FieldModel, RaycastOptions, Raycaster, Scalars, Scene};
-
-fn opts(model: FieldModel) -> RaycastOptions {
-    RaycastOptions {
-        model,
-        early_termination: 0.0,
-        ..Default::default()
-    }
-}
+use zoovr::raycast::{render, FieldModel, Raycaster, Scalars, Scene};
 
 fn material() -> TestMaterial {
     TestMaterial {

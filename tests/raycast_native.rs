@@ -12,15 +12,7 @@ use zoovr::camera::Ray;
 use zoovr::integrate::RayMaterial;
 use zoovr::mesh::{CellKind, Cells, Mesh};
 use zoovr::raycast::native::{breakpoint_crossings, IsoRay, NativeStats};
-use zoovr::raycast::{FieldModel, RaycastOptions, Raycaster, Scalars, Scene};
-
-fn opts(model: FieldModel) -> RaycastOptions {
-    RaycastOptions {
-        model,
-        early_termination: 0.0,
-        ..Default::default()
-    }
-}
+use zoovr::raycast::{FieldModel, Raycaster, Scalars, Scene};
 
 fn material() -> TestMaterial {
     TestMaterial {

@@ -11,17 +11,9 @@ use raycast_util::*;
 use zoovr::camera::{Camera, CameraParams, Ray};
 use zoovr::image::check_float_images;
 use zoovr::mesh::{CellKind, Mesh};
-use zoovr::raycast::{render, FieldModel, RaycastOptions, Raycaster, Scalars, Scene};
+use zoovr::raycast::{render, FieldModel, Raycaster, Scalars, Scene};
 
 const TAU: f64 = 0.7;
-
-fn opts(model: FieldModel) -> RaycastOptions {
-    RaycastOptions {
-        model,
-        early_termination: 0.0,
-        ..Default::default()
-    }
-}
 
 /// Boxes of a grid mesh whose points lie on integer coordinates.
 fn boxes(mesh: &Mesh) -> Vec<(DVec3, DVec3)> {

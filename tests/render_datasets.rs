@@ -12,33 +12,6 @@ use zoovr::io::{self, ReadOptions};
 use zoovr::render::{Mode, RenderOptions, Renderer, Scene, SceneSpec};
 use zoovr::testdata::{mesh_file, shared_file};
 
-const FILES: &[&str] = &[
-    "angular_sector/AngularSector.vtk",
-    "blood_vessels_pvtu/blood_vessels/T0000000500.pvtu",
-    "bluntfin/bluntfin_converted.vts",
-    "bluntfin/bluntfin_converted_legacy42_binary.vtk",
-    "bluntfin/bluntfinxyz.bin",
-    "can_crush/can.vtu",
-    "can_crush/series/can_series.pvd",
-    "disk_out_ref/disk_out_ref_converted.vtu",
-    "disk_out_ref/disk_out_ref_converted_legacy51_binary.vtk",
-    "fea_bracket_qtet/kiefer_bracket.vtu",
-    "fire_room/fire_ug.vtu",
-    "notch/notch_disp.vtu",
-    "notch/notch_stress.vtk",
-    "office_kitchen/kitchen.vtk",
-    "office_kitchen/office.binary.vtk",
-    "prisms_zoo/PentaHexa.vtk",
-    "prisms_zoo/hexa.vtk",
-    "prisms_zoo/uGridEx.vtk",
-    "su2_sphere_hybrid/sphere_hybrid_converted.vtu",
-    "su2_sphere_hybrid/sphere_hybrid_converted_legacy42_ascii.vtk",
-    "synthetic/hex_shell_zlib.vtu",
-    "synthetic/mixed.vtk",
-    "tets_small/CylinderLinear.vtk",
-    "tets_small/tetraMesh.vtk",
-];
-
 fn gpu(opts: &GpuOptions) -> Option<Context> {
     match Context::new(opts) {
         Ok(c) => Some(c),
@@ -56,15 +29,12 @@ fn every_shared_dataset_renders_exact_at_256_without_nan() {
     }
     let mut rendered = 0;
     let mut found = 0;
-    for rel in FILES {
+    for rel in zoovr::testdata::SHARED_DATASETS {
         let Some(path) = shared_file(rel) else {
             continue;
         };
         found += 1;
-        let mut ro = ReadOptions::default();
-        if rel.ends_with("xyz.bin") {
-            ro.q_file = shared_file("bluntfin/bluntfinq.bin");
-        }
+        let ro = zoovr::testdata::read_options(rel);
         let mesh = io::read(&path, &ro).unwrap_or_else(|e| panic!("{rel}: {e}"));
         let scene =
             Scene::build(mesh, &SceneSpec::default()).unwrap_or_else(|e| panic!("{rel}: {e}"));

@@ -9,6 +9,16 @@ use zoovr::integrate::{Material, RayMaterial, SegmentValue};
 use zoovr::mesh::tetra::tetrahedralize_cell;
 use zoovr::mesh::topology::Topology;
 use zoovr::mesh::{CellKind, Cells, Mesh};
+use zoovr::raycast::{FieldModel, RaycastOptions};
+
+/// Options for `model` with early ray termination off (exact comparisons).
+pub fn opts(model: FieldModel) -> RaycastOptions {
+    RaycastOptions {
+        model,
+        early_termination: 0.0,
+        ..Default::default()
+    }
+}
 
 /// Glow model with extinction and colour piecewise linear in `s` (nodes
 /// `s_k`, constant outside). `segment` is computed here independently of the
