@@ -43,10 +43,11 @@
 //!    consistent tets and everything is re-sorted (at most
 //!    [`MAX_SPLIT_ROUNDS`] rounds). A cycle that remains (tets only, or after
 //!    the last round) is emitted as one **group**: a range of
-//!    [`Order::pieces`] listed in [`Order::groups`] that the renderer must
-//!    composite with per-pixel depth sorting; the order between the group and
-//!    every other piece is still exact. Cutting tets with planes through a
-//!    cycle member (MWS) is not implemented; groups replace it. The sort
+//!    [`Order::pieces`] listed in [`Order::groups`], sorted inside by
+//!    centroid depth; the order between the group and every other piece is
+//!    still exact. Only tets that really overlap (self-intersecting meshes
+//!    such as a crushed can, where no back-to-front order exists) were seen
+//!    to leave groups; inside a group the order is approximate. The sort
 //!    always terminates.
 //!
 //! Subdivisions persist between views inside the [`Sorter`] (a pool of split
