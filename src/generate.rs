@@ -380,6 +380,36 @@ pub fn single_cell(kind: CellKind) -> Mesh {
     finish(mesh, 0.0)
 }
 
+/// Three long, thin tetrahedra in cyclic overlap, the classic visibility
+/// cycle: seen along `z` each one lies in front of the next where they cross
+/// (a "pinwheel" around the `z` axis), though no two of them touch. No
+/// back-to-front order of the three exists; the sorter can only group them
+/// (`visibility::Order::groups`). Stick `k` lies on the line `p . v_k = 1`
+/// (`v_k` the in-plane normal at angle `120 k` degrees), runs from `s = -3`
+/// to `s = 3` along it with depth `z = s / 2`; it is a segment of width 0.8
+/// (along `v_k`) at one end and of thickness 0.8 (along `z`) at the other.
+/// Neighbouring sticks cross at `s = -+sqrt 3`, `z` 1.73 apart.
+pub fn interlocked_tets() -> Mesh {
+    let mut mesh = Mesh::default();
+    let (len, dz, w, t) = (3.0, 0.5, 0.8, 0.8);
+    for k in 0..3 {
+        let a = k as f64 * std::f64::consts::TAU / 3.0;
+        let u = DVec3::new(a.cos(), a.sin(), 0.0);
+        let v = DVec3::new(-a.sin(), a.cos(), 0.0);
+        let at = |s: f64| v + u * s + DVec3::Z * (s * dz);
+        let base = mesh.points.len() as u32;
+        mesh.points.extend([
+            at(-len) - v * (0.5 * w),
+            at(-len) + v * (0.5 * w),
+            at(len) - DVec3::Z * (0.5 * t),
+            at(len) + DVec3::Z * (0.5 * t),
+        ]);
+        mesh.cells
+            .push(CellKind::Tetra, &[base, base + 1, base + 2, base + 3]);
+    }
+    finish(mesh, 0.0)
+}
+
 /// `steps` time steps `(time, mesh)` of an `n^3` warped grid: same geometry,
 /// `f` evaluated at `t = 0, 0.5, 1, ...`.
 pub fn time_series(n: usize, steps: usize) -> Vec<(f64, Mesh)> {

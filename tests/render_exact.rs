@@ -208,7 +208,8 @@ fn shared_datasets() {
             continue;
         };
         // can_crush: crushed, self-intersecting cells (overlapping pieces,
-        // where no back-to-front order exists) and 24,569 nonplanar faces:
+        // which the exact mode integrates both where the ray caster's walk
+        // follows one layer) and 24,569 nonplanar faces:
         // measured p99.9 7.4e-2, RMS 3.3e-3 in perspective, both for whole
         // cells vs faces and for --split all vs tets. Known gap (issue 7).
         let whole = if rel.starts_with("can_crush") {

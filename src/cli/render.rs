@@ -178,8 +178,15 @@ pub fn print_stats(stats: &RenderStats, load_s: f64) {
     }
     if let Some(e) = &stats.exact {
         eprintln!(
-            "sort         {:.3} s  ({} pieces, {} split cells, {} problem cells, {} cycles, {} cycle groups)",
-            e.sort_s, e.pieces, e.order.split_cells, e.order.problem_cells, e.order.cycles_found, e.order.cycle_groups
+            "sort         {:.3} s  ({} pieces, {} split cells, {} problem cells, {} cycles, {} cycle groups of {} pieces over {} pixels)",
+            e.sort_s,
+            e.pieces,
+            e.order.split_cells,
+            e.order.problem_cells,
+            e.order.cycles_found,
+            e.order.cycle_groups,
+            e.order.pieces_in_groups,
+            e.group_pixels
         );
         eprintln!(
             "project      {:.3} s  ({} triangles, {} culled pieces, {} extra slabs, {} refined triangles)",

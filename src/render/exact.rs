@@ -27,7 +27,8 @@
 //! model the projection's perspective refinement bounds (projection docs).
 //!
 //! Unresolved visibility cycles ([`crate::visibility::Order::groups`]) are
-//! drawn in the sorter's order and counted in the stats.
+//! composited per pixel on the CPU into one layer each, drawn at the group's
+//! place in the order ([`super::group`]).
 
 use std::time::Instant;
 
@@ -35,7 +36,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::camera::Camera;
-use crate::gpu::{AccumFormat, Context, ExactVertex, FrameOptions, FrameStats};
+use crate::gpu::{AccumFormat, Context, ExactVertex, Frame, FrameOptions, FrameStats};
 use crate::image::Image;
 use crate::integrate::{vertex_values, VertexValues};
 use crate::mesh::Mesh;
@@ -45,6 +46,7 @@ use crate::projection::{refine, slice_tet, Polyhedron, Projected, Projector};
 use crate::tf::TransferFunction;
 use crate::visibility::{Piece, Sorter, SplitPolicy};
 
+use super::group::composite_group;
 use super::scene::{ScalarsRef, Scene};
 use super::RenderError;
 
@@ -59,6 +61,8 @@ pub struct ExactStats {
     pub slabs: usize,
     pub triangles: usize,
     pub refined_triangles: usize,
+    /// Pixels of the per-pixel layers of cycle groups ([`composite_group`]).
+    pub group_pixels: usize,
     pub sort_s: f64,
     pub project_s: f64,
     pub gpu: FrameStats,
@@ -68,25 +72,25 @@ pub struct ExactStats {
 
 /// Output of one chunk: vertices and triangles ready for the GPU.
 #[derive(Default)]
-struct ChunkOut {
-    vertices: Vec<ExactVertex>,
-    indices: Vec<u32>,
-    culled: usize,
+pub(super) struct ChunkOut {
+    pub(super) vertices: Vec<ExactVertex>,
+    pub(super) indices: Vec<u32>,
+    pub(super) culled: usize,
     slabs: usize,
     refined: usize,
     /// Triangles dropped as degenerate in f32 ([`gpu_area_positive`]).
     degenerate: usize,
-    error: Option<String>,
+    pub(super) error: Option<String>,
 }
 
-struct Ctx<'a> {
+pub(super) struct Ctx<'a> {
     mesh: &'a Mesh,
     scalars: ScalarsRef<'a>,
-    tf: &'a TransferFunction,
-    camera: &'a Camera,
+    pub(super) tf: &'a TransferFunction,
+    pub(super) camera: &'a Camera,
     breakpoints: &'a [f64],
     /// The frame's length unit ([`FrameOptions::length_unit`]).
-    length_unit: f64,
+    pub(super) length_unit: f64,
 }
 
 impl Ctx<'_> {
@@ -99,8 +103,35 @@ impl Ctx<'_> {
         }
     }
 
+    /// The view-space polyhedron of a piece (whole, not sliced).
+    pub(super) fn piece_polyhedron(
+        &self,
+        piece: &Piece,
+        poly: &mut Polyhedron,
+    ) -> Result<(), String> {
+        let cell = piece.cell();
+        match *piece {
+            Piece::Cell(c) => poly
+                .set_cell(
+                    &self.mesh.cells,
+                    c as usize,
+                    &self.mesh.points,
+                    |n| self.scalar(c, n),
+                    self.camera,
+                )
+                .map_err(|e| format!("cell {c}: {e}")),
+            Piece::Tet { tet, .. } => {
+                let pts = &self.mesh.points;
+                let p: [DVec3; 4] = tet.map(|n| self.camera.to_view(pts[n as usize]));
+                let s: [f64; 4] = tet.map(|n| self.scalar(cell, n));
+                poly.set_tet(p, s);
+                Ok(())
+            }
+        }
+    }
+
     /// Whether extinction is zero over the whole scalar interval.
-    fn invisible(&self, lo: f64, hi: f64) -> bool {
+    pub(super) fn invisible(&self, lo: f64, hi: f64) -> bool {
         if !(lo.is_finite() && hi.is_finite()) {
             return false;
         }
@@ -364,6 +395,19 @@ pub fn split_points(tf: &TransferFunction) -> Vec<f64> {
     out
 }
 
+/// Sends one chunk's triangles to the frame and adds up its counts.
+fn push_out(frame: &mut Frame, out: ChunkOut, stats: &mut ExactStats) -> Result<(), RenderError> {
+    if let Some(e) = out.error {
+        return Err(RenderError::Projection(e));
+    }
+    stats.culled_pieces += out.culled;
+    stats.slabs += out.slabs;
+    stats.refined_triangles += out.refined;
+    stats.triangles += out.indices.len() / 3;
+    frame.push_triangles(&out.vertices, &out.indices)?;
+    Ok(())
+}
+
 /// Renders the scene in the exact mode through `ctx`.
 pub fn render_exact(
     scene: &Scene,
@@ -406,24 +450,38 @@ pub fn render_exact(
     let window = CHUNK * rayon::current_num_threads().max(1) * 2;
     let mut project_s = 0.0;
     let total = order.pieces.len();
-    for (wi, win) in order.pieces.chunks(window).enumerate() {
-        let tp = Instant::now();
-        let outs: Vec<ChunkOut> = win
-            .par_chunks(CHUNK)
-            .map(|c| process_chunk(&ctx, c))
-            .collect();
-        project_s += tp.elapsed().as_secs_f64();
-        for out in outs {
-            if let Some(e) = out.error {
-                return Err(RenderError::Projection(e));
+    let mut done = 0;
+    // Stretches of ordinary pieces, each followed by at most one group.
+    let mut stretches: Vec<(std::ops::Range<usize>, Option<std::ops::Range<usize>>)> = Vec::new();
+    let mut start = 0;
+    for g in &order.groups {
+        stretches.push((start..g.start, Some(g.clone())));
+        start = g.end;
+    }
+    stretches.push((start..total, None));
+    for (plain, group) in stretches {
+        for win in order.pieces[plain].chunks(window) {
+            let tp = Instant::now();
+            let outs: Vec<ChunkOut> = win
+                .par_chunks(CHUNK)
+                .map(|c| process_chunk(&ctx, c))
+                .collect();
+            project_s += tp.elapsed().as_secs_f64();
+            for out in outs {
+                push_out(&mut frame, out, &mut stats)?;
             }
-            stats.culled_pieces += out.culled;
-            stats.slabs += out.slabs;
-            stats.refined_triangles += out.refined;
-            stats.triangles += out.indices.len() / 3;
-            frame.push_triangles(&out.vertices, &out.indices)?;
+            done += win.len();
+            progress(done, total);
         }
-        progress(((wi + 1) * window).min(total), total);
+        if let Some(g) = group {
+            let tp = Instant::now();
+            let mut out = ChunkOut::default();
+            stats.group_pixels += composite_group(&ctx, &order.pieces[g.clone()], &mut out);
+            project_s += tp.elapsed().as_secs_f64();
+            push_out(&mut frame, out, &mut stats)?;
+            done += g.len();
+            progress(done, total);
+        }
     }
     let (image, fstats) = frame.finish_with_stats()?;
     stats.gpu = fstats;

@@ -10,6 +10,7 @@
 //! - [`Mode::Raycast`]: the CPU reference ray caster ([`crate::raycast`]).
 
 pub mod exact;
+mod group;
 pub mod scene;
 
 use std::time::Instant;

@@ -43,12 +43,17 @@
 //!    consistent tets and everything is re-sorted (at most
 //!    [`MAX_SPLIT_ROUNDS`] rounds). A cycle that remains (tets only, or after
 //!    the last round) is emitted as one **group**: a range of
-//!    [`Order::pieces`] listed in [`Order::groups`], sorted inside by
-//!    centroid depth; the order between the group and every other piece is
-//!    still exact. Only tets that really overlap (self-intersecting meshes
-//!    such as a crushed can, where no back-to-front order exists) were seen
-//!    to leave groups; inside a group the order is approximate. The sort
-//!    always terminates.
+//!    [`Order::pieces`] listed in [`Order::groups`] (inside, by centroid
+//!    depth); the order between the group and every other piece is still
+//!    exact, so the renderer composites each group **per pixel** into one
+//!    layer drawn at the group's place (`render::group`: every pixel-centre
+//!    ray clipped against the group's pieces, segments sorted along the
+//!    ray, exact segment integrals), which is exact at pixel centres for
+//!    pieces that do not overlap (tested on interlocked tets,
+//!    `generate::interlocked_tets`). Tets that really overlap
+//!    (self-intersecting meshes such as a crushed can, where no
+//!    back-to-front order exists even along one ray) are ordered by segment
+//!    midpoint. The sort always terminates.
 //!
 //! Subdivisions persist between views inside the [`Sorter`] (a pool of split
 //! cells); cells that stop needing a split are restored. [`Sorter::sanity_check`]
@@ -84,7 +89,7 @@ pub use sorter::{NonConvex, Sorter};
 pub use validate::{sample_pixels, validate, Violation, Violations};
 
 /// Rounds of "split the whole cells of every cycle, then sort again" before
-/// the remaining cycles are emitted as per-pixel groups.
+/// the remaining cycles are emitted as groups (composited per pixel).
 pub const MAX_SPLIT_ROUNDS: usize = 4;
 
 /// One drawable piece.
