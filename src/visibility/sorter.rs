@@ -7,6 +7,14 @@
 //! edges through `face_target` (the cell drawn later, or `NONE`); every other
 //! edge (per triangle next to a split cell, inside a split cell, non-convex
 //! constraints) is an "extra" edge in a CSR list rebuilt per round.
+//!
+//! Speed: the sort is bound by memory, not arithmetic. Kahn reads the
+//! out-edges of a cell from `slot_target` (the face targets laid out by
+//! cell, contiguous per cell) and keeps its ready cells on a stack whose top
+//! is the ready neighbour nearest in id to the cell just emitted, so the walk
+//! proceeds next door in memory (along rows of a grid) instead of jumping by
+//! a layer's stride: on the 1M-hex grid this took the sort from 123 ms to
+//! 25 ms per view (benches/visibility.rs).
 
 use std::time::Instant;
 
@@ -85,6 +93,12 @@ pub struct Sorter {
     // Per-view scratch.
     tri_sign: Vec<i8>,
     face_target: Vec<u32>,
+    /// `face_target` by cell-face slot (`topo.cell_faces` layout), kept only
+    /// on the source cell's side: the out-edges of cell `c` are the
+    /// non-`NONE` entries of its slots, read contiguously by Kahn (reading
+    /// `face_target` through `cell_faces` costs a cache miss per face on
+    /// large meshes).
+    slot_target: Vec<u32>,
     want: Vec<u8>,
     indeg: Vec<u32>,
 }
@@ -128,6 +142,7 @@ impl Sorter {
             nonconvex: NonConvex::PixelConstraints,
             tri_sign: vec![0; nt],
             face_target: vec![NONE; nf],
+            slot_target: Vec::new(),
             want: Vec::new(),
             indeg: Vec::new(),
             topo,
@@ -548,10 +563,22 @@ impl Sorter {
         let pieces = extra.pieces;
         self.indeg.clear();
         self.indeg.resize(pieces, 0);
-        for &t in &self.face_target {
-            if t != NONE {
-                self.indeg[t as usize] += 1;
+        let topo = &self.topo;
+        self.slot_target.clear();
+        self.slot_target.resize(topo.cell_faces.len(), NONE);
+        for (f, &t) in self.face_target.iter().enumerate() {
+            if t == NONE {
+                continue;
             }
+            let [c0, c1] = topo.face_cells[f];
+            let [l0, l1] = topo.face_local[f];
+            let (src, local) = if t == c1 { (c0, l0) } else { (c1, l1) };
+            if src == NONE || src == t {
+                continue;
+            }
+            let slot = topo.cell_face_offsets[src as usize] as usize + local as usize;
+            self.slot_target[slot] = t;
+            self.indeg[t as usize] += 1;
         }
         for &t in &extra.to {
             self.indeg[t as usize] += 1;
@@ -570,15 +597,23 @@ impl Sorter {
         while let Some(v) = stack.pop() {
             out.push(v);
             if (v as usize) < n {
-                for &f in self.topo.faces_of(v as usize) {
-                    let t = self.face_target[f as usize];
-                    if t != NONE && t != v {
+                let offs = &self.topo.cell_face_offsets;
+                let slots = offs[v as usize] as usize..offs[v as usize + 1] as usize;
+                let mark = stack.len();
+                for &t in &self.slot_target[slots] {
+                    if t != NONE {
                         let d = &mut self.indeg[t as usize];
                         *d -= 1;
                         if *d == 0 {
                             stack.push(t);
                         }
                     }
+                }
+                // The nearest id on top: the walk continues next door in
+                // memory (for a grid, along rows first).
+                let ready = &mut stack[mark..];
+                if ready.len() > 1 {
+                    ready.sort_unstable_by_key(|&t| std::cmp::Reverse(t.abs_diff(v)));
                 }
             }
             if !extra.off.is_empty() {
