@@ -108,6 +108,8 @@ pub struct Sorter {
 struct Extra {
     /// `base[k]`: first tet id of `pool.active[k]`.
     base: Vec<u32>,
+    /// The same by storage slot (`pool.slot_of`).
+    base_by_slot: Vec<u32>,
     /// Per tet id (offset by `cells`): index into `pool.active`.
     tet_slot: Vec<u32>,
     /// CSR over piece ids.
@@ -404,17 +406,14 @@ impl Sorter {
     #[inline]
     fn piece_on(&self, extra: &Extra, c: u32, f: u32, k: usize) -> u32 {
         let n = self.mesh.cells.len() as u32;
-        let Some(sc) = self.pool.get(c) else {
+        let s = self.pool.slot_of[c as usize];
+        if s == NONE {
             return c;
-        };
-        let li = self
-            .topo
-            .faces_of(c as usize)
-            .iter()
-            .position(|&g| g == f)
-            .unwrap_or(0);
-        let slot = self.pool.active.binary_search(&c).unwrap_or(0);
-        n + extra.base[slot] + sc.owner(li, k)
+        }
+        let sc = &self.pool.slots[s as usize];
+        let side = (self.topo.face_cells[f as usize][0] != c) as usize;
+        let li = self.topo.face_local[f as usize][side] as usize;
+        n + extra.base_by_slot[s as usize] + sc.owner(li, k)
     }
 
     /// Tet ids, per-triangle edges next to split cells, edges inside split
@@ -423,8 +422,10 @@ impl Sorter {
         let n = self.mesh.cells.len();
         let mut extra = Extra::default();
         let mut next = 0u32;
+        extra.base_by_slot.resize(self.pool.slots.len(), 0);
         for (k, &c) in self.pool.active.iter().enumerate() {
             extra.base.push(next);
+            extra.base_by_slot[self.pool.slot_of[c as usize] as usize] = next;
             let sc = self.pool.get(c).map_or(0, |s| s.tets.len());
             for _ in 0..sc {
                 extra.tet_slot.push(k as u32);
@@ -471,8 +472,7 @@ impl Sorter {
                 }
             }
             if let Some(sc) = self.pool.get(c) {
-                let slot = self.pool.active.binary_search(&c).unwrap_or(0);
-                let b = n as u32 + extra.base[slot];
+                let b = n as u32 + extra.base_by_slot[self.pool.slot_of[c as usize] as usize];
                 for it in &sc.internal {
                     let [a, bb, cc] = it.tri.map(|v| p[v as usize]);
                     let se = view.side(a, bb, cc);
