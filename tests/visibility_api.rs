@@ -6,7 +6,7 @@ use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::topology::Topology;
 use zoovr::mesh::{CellKind, Mesh};
 use zoovr::visibility::synth::{grid, GridSpec};
-use zoovr::visibility::{Piece, Sorter, SplitPolicy, VisibilityError};
+use zoovr::visibility::{Piece, Sorter, SplitPolicy, VisibilityError, NO_LEVEL};
 
 fn warped() -> Mesh {
     grid(
@@ -91,12 +91,160 @@ fn breakpoint_cells_match_brute_force() {
         .pieces
         .iter()
         .filter_map(|p| match p {
-            Piece::Tet { cell, .. } => Some(*cell),
+            Piece::Tet { cell, .. } | Piece::Slab { cell, .. } => Some(*cell),
             _ => None,
         })
         .collect();
     assert!(tet_cells.len() >= want);
     assert_eq!(tet_cells.len(), o.stats.split_cells);
+}
+
+/// Entry and exit parameters of the line `o + t d` through tet `q`.
+fn clip_tet(q: [DVec3; 4], o: DVec3, d: DVec3) -> Option<(f64, f64)> {
+    let centre = (q[0] + q[1] + q[2] + q[3]) / 4.0;
+    let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
+    for f in [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]] {
+        let [a, b, c] = f.map(|i| q[i]);
+        let mut n = (b - a).cross(c - a);
+        if n.dot(centre - a) > 0.0 {
+            n = -n;
+        }
+        let (num, den) = (n.dot(a - o), n.dot(d));
+        if den == 0.0 {
+            if num < 0.0 {
+                return None;
+            }
+        } else if den < 0.0 {
+            t0 = t0.max(num / den);
+        } else {
+            t1 = t1.min(num / den);
+        }
+    }
+    (t0 < t1).then_some((t0, t1))
+}
+
+/// Tets holding a breakpoint are listed as their slabs: consecutive, the
+/// bands chained from open end to open end, and back to front along the
+/// ray through the tet's centroid (brute force: the scalar at the ray's
+/// entry and exit says which bands it meets, front to back).
+#[test]
+fn slabs_are_listed_back_to_front() {
+    let mesh = warped();
+    let topo = Topology::build(&mesh.cells);
+    let mut s = Sorter::new(&mesh, &topo);
+    let scalars: Vec<f64> = mesh.points.iter().map(|p| p.x + p.y * p.z).collect();
+    let bps = [0.75, 0.3, 0.5];
+    let pol = SplitPolicy {
+        all: false,
+        breakpoints: &bps,
+        point_scalars: Some(&scalars),
+    };
+    let mut checked = 0;
+    for (az, el, ortho) in [
+        (10.0, 10.0, false),
+        (200.0, -30.0, true),
+        (95.0, 60.0, false),
+    ] {
+        let camera = cam(&mesh, az, el, ortho);
+        let o = s.order(&camera, &pol).unwrap();
+        assert_eq!(o.levels, vec![0.3, 0.5, 0.75]);
+        assert!(
+            o.stats.slabs > 0 && o.stats.sliced_tets > 0,
+            "{:?}",
+            o.stats
+        );
+        let level = |k: u32, open: f64| {
+            if k == NO_LEVEL {
+                open
+            } else {
+                o.levels[k as usize]
+            }
+        };
+        let mut k = 0;
+        while k < o.pieces.len() {
+            let range = |t: [u32; 4]| {
+                let v = t.map(|i| scalars[i as usize]);
+                let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                (lo, hi)
+            };
+            match o.pieces[k] {
+                Piece::Tet { tet, .. } => {
+                    let (lo, hi) = range(tet);
+                    assert!(!bps.iter().any(|&b| lo < b && b < hi), "unsliced {tet:?}");
+                    k += 1;
+                }
+                Piece::Slab { tet, .. } => {
+                    let run: Vec<(f64, f64)> = o.pieces[k..]
+                        .iter()
+                        .take_while(|p| matches!(p, Piece::Slab { tet: t, .. } if *t == tet))
+                        .map(|p| match *p {
+                            Piece::Slab { lo, hi, .. } => {
+                                (level(lo, f64::NEG_INFINITY), level(hi, f64::INFINITY))
+                            }
+                            _ => unreachable!(),
+                        })
+                        .collect();
+                    // The bands chain from -inf to +inf through the levels
+                    // inside the tet's range.
+                    let (lo, hi) = range(tet);
+                    let mut sorted = run.clone();
+                    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+                    let inner: Vec<f64> = o
+                        .levels
+                        .iter()
+                        .copied()
+                        .filter(|&b| lo < b && b < hi)
+                        .collect();
+                    assert_eq!(sorted.len(), inner.len() + 1, "{tet:?}");
+                    assert_eq!(sorted[0].0, f64::NEG_INFINITY);
+                    assert_eq!(sorted[sorted.len() - 1].1, f64::INFINITY);
+                    for w in sorted.windows(2) {
+                        assert_eq!(w[0].1, w[1].0);
+                    }
+                    // Back to front along the centroid ray.
+                    let q = tet.map(|i| mesh.points[i as usize]);
+                    let sv = tet.map(|i| scalars[i as usize]);
+                    let c = (q[0] + q[1] + q[2] + q[3]) / 4.0;
+                    let (orig, dir) = if camera.ortho {
+                        (c - camera.forward * 100.0, camera.forward)
+                    } else {
+                        (camera.position, (c - camera.position).normalize())
+                    };
+                    let (t0, t1) = clip_tet(q, orig, dir).expect("the ray meets the tet");
+                    // Scalar at a point of the tet (barycentric).
+                    let m = glam::DMat3::from_cols(q[1] - q[0], q[2] - q[0], q[3] - q[0]);
+                    let at = |x: DVec3| {
+                        let w = m.inverse() * (x - q[0]);
+                        sv[0]
+                            + w.x * (sv[1] - sv[0])
+                            + w.y * (sv[2] - sv[0])
+                            + w.z * (sv[3] - sv[0])
+                    };
+                    let (s_front, s_back) = (at(orig + dir * t0), at(orig + dir * t1));
+                    let met: Vec<usize> = run
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, &(a, b))| a < s_front.max(s_back) && b > s_front.min(s_back))
+                        .map(|(i, _)| i)
+                        .collect();
+                    // Drawn first = nearest to s_back.
+                    for w in met.windows(2) {
+                        let (a, b) = (run[w[0]], run[w[1]]);
+                        if s_back > s_front {
+                            assert!(a.0 > b.0, "{tet:?}: {run:?} s {s_front}..{s_back}");
+                        } else {
+                            assert!(a.0 < b.0, "{tet:?}: {run:?} s {s_front}..{s_back}");
+                        }
+                        checked += 1;
+                    }
+                    k += run.len();
+                }
+                Piece::Cell(_) => k += 1,
+            }
+        }
+    }
+    assert!(checked > 50, "{checked} slab pairs checked");
 }
 
 #[test]

@@ -189,7 +189,7 @@ pub fn print_stats(stats: &RenderStats, load_s: f64) {
             e.group_pixels
         );
         eprintln!(
-            "project      {:.3} s  ({} triangles, {} culled pieces, {} extra slabs, {} refined triangles)",
+            "project      {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles)",
             e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles
         );
         eprintln!(

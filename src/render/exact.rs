@@ -4,12 +4,14 @@
 //! Per view:
 //! 1. [`Sorter::order`] gives the drawable pieces back to front (whole cells;
 //!    consistent tets of problem cells and of cells whose nodal scalar range
-//!    holds a TF breakpoint; every cell's tets with `--split all`).
-//! 2. Pieces whose scalar range maps to zero extinction everywhere are skipped
-//!    (they neither emit nor absorb in the glow model).
-//! 3. Each piece becomes a view-space [`Polyhedron`]; a tet holding a
-//!    breakpoint is sliced into slabs (back to front, [`slice_tet`]); each is
-//!    projected into regions ([`Projector`]).
+//!    holds a TF breakpoint, a tet holding one as its slabs; every cell's
+//!    tets with `--split all`).
+//! 2. Pieces whose scalar range (a slab's: its band) maps to zero extinction
+//!    everywhere are skipped (they neither emit nor absorb in the glow
+//!    model).
+//! 3. Each piece becomes a view-space [`Polyhedron`] (a slab: its tet
+//!    clipped to the band, [`Clipper`]); each is projected into regions
+//!    ([`Projector`]).
 //! 4. Region triangles whose vertices differ much in optical depth and glow
 //!    colour are refined (math README 8.1: `C/alpha` is interpolated inside a
 //!    region), see [`COLOR_REFINE_TOL`].
@@ -42,9 +44,9 @@ use crate::integrate::{vertex_values, VertexValues};
 use crate::mesh::Mesh;
 use crate::numeric::predicates::{orient2d, Side};
 use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL, TF_SLOPE_REL};
-use crate::projection::{refine, slice_tet, Polyhedron, Projected, Projector};
+use crate::projection::{refine, slice_tet, ClipValue, Clipper, Polyhedron, Projected, Projector};
 use crate::tf::TransferFunction;
-use crate::visibility::{Piece, Sorter, SplitPolicy};
+use crate::visibility::{Piece, Sorter, SplitPolicy, NO_LEVEL};
 
 use super::group::composite_group;
 use super::scene::{ScalarsRef, Scene};
@@ -89,6 +91,8 @@ pub(super) struct Ctx<'a> {
     pub(super) tf: &'a TransferFunction,
     pub(super) camera: &'a Camera,
     breakpoints: &'a [f64],
+    /// The order's slab bounds ([`crate::visibility::Order::levels`]).
+    levels: &'a [f64],
     /// The frame's length unit ([`FrameOptions::length_unit`]).
     pub(super) length_unit: f64,
 }
@@ -121,13 +125,45 @@ impl Ctx<'_> {
                 )
                 .map_err(|e| format!("cell {c}: {e}")),
             Piece::Tet { tet, .. } => {
-                let pts = &self.mesh.points;
-                let p: [DVec3; 4] = tet.map(|n| self.camera.to_view(pts[n as usize]));
-                let s: [f64; 4] = tet.map(|n| self.scalar(cell, n));
+                let (p, s) = self.tet_view(cell, tet);
                 poly.set_tet(p, s);
                 Ok(())
             }
+            Piece::Slab { tet, lo, hi, .. } => {
+                let (p, s) = self.tet_view(cell, tet);
+                let whole = Polyhedron::from_tet(p, s);
+                let (lo, hi) = self.band(lo, hi);
+                match Clipper::default().clip(&whole, ClipValue::Scalar, lo, hi, poly) {
+                    Ok(true) => Ok(()),
+                    Ok(false) => {
+                        poly.clear();
+                        Ok(())
+                    }
+                    Err(e) => Err(format!("cell {cell}: {e}")),
+                }
+            }
         }
+    }
+
+    /// View-space corners and scalars of a tet of cell `cell`.
+    fn tet_view(&self, cell: u32, tet: [u32; 4]) -> ([DVec3; 4], [f64; 4]) {
+        let pts = &self.mesh.points;
+        (
+            tet.map(|n| self.camera.to_view(pts[n as usize])),
+            tet.map(|n| self.scalar(cell, n)),
+        )
+    }
+
+    /// The scalar bounds of a slab ([`Piece::Slab`]).
+    fn band(&self, lo: u32, hi: u32) -> (f64, f64) {
+        let level = |k: u32, open: f64| {
+            if k == NO_LEVEL {
+                open
+            } else {
+                self.levels.get(k as usize).copied().unwrap_or(open)
+            }
+        };
+        (level(lo, f64::NEG_INFINITY), level(hi, f64::INFINITY))
     }
 
     /// Whether extinction is zero over the whole scalar interval.
@@ -271,6 +307,8 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
     // up to the perspective refinement's bound.
     projector.clip_to_image = true;
     let mut poly = Polyhedron::default();
+    let mut whole = Polyhedron::default();
+    let mut clipper = Clipper::default();
     let mut proj = Projected::default();
     let mut vals = Vec::new();
     let pts = &ctx.mesh.points;
@@ -307,8 +345,7 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                 push_projected(ctx, &mut proj, &mut vals, &mut out);
             }
             Piece::Tet { tet, .. } => {
-                let p: [DVec3; 4] = tet.map(|n| ctx.camera.to_view(pts[n as usize]));
-                let s: [f64; 4] = tet.map(|n| ctx.scalar(cell, n));
+                let (p, s) = ctx.tet_view(cell, tet);
                 let lo = s.iter().copied().fold(f64::INFINITY, f64::min);
                 let hi = s.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 if ctx.invisible(lo, hi) {
@@ -324,8 +361,10 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                     push_projected(ctx, &mut proj, &mut vals, &mut out);
                     continue;
                 }
+                // A tet the order did not slice (an order made without the
+                // nodal scalars): sliced here, back to front.
                 let slabs = slice_tet(p, s, ctx.breakpoints, ctx.camera);
-                out.slabs += slabs.len().saturating_sub(1);
+                out.slabs += slabs.len();
                 for slab in &slabs {
                     if let Err(e) = projector.project(slab, ctx.camera, &mut proj) {
                         out.error = Some(format!("cell {cell}: {e}"));
@@ -333,6 +372,31 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                     }
                     push_projected(ctx, &mut proj, &mut vals, &mut out);
                 }
+            }
+            Piece::Slab { tet, lo, hi, .. } => {
+                let (p, s) = ctx.tet_view(cell, tet);
+                let (blo, bhi) = ctx.band(lo, hi);
+                let smin = s.iter().copied().fold(f64::INFINITY, f64::min).max(blo);
+                let smax = s.iter().copied().fold(f64::NEG_INFINITY, f64::max).min(bhi);
+                if ctx.invisible(smin, smax) {
+                    out.culled += 1;
+                    continue;
+                }
+                whole.set_tet(p, s);
+                match clipper.clip(&whole, ClipValue::Scalar, blo, bhi, &mut poly) {
+                    Ok(true) => {}
+                    Ok(false) => continue,
+                    Err(e) => {
+                        out.error = Some(format!("cell {cell}: {e}"));
+                        return out;
+                    }
+                }
+                out.slabs += 1;
+                if let Err(e) = projector.project(&poly, ctx.camera, &mut proj) {
+                    out.error = Some(format!("cell {cell}: {e}"));
+                    return out;
+                }
+                push_projected(ctx, &mut proj, &mut vals, &mut out);
             }
         }
     }
@@ -441,6 +505,7 @@ pub fn render_exact(
         tf: &scene.tf,
         camera,
         breakpoints: &breakpoints,
+        levels: &order.levels,
         length_unit: scene.unit_distance as f32 as f64,
     };
     let mut opts = FrameOptions::new(camera.width, camera.height, format);
@@ -548,6 +613,7 @@ mod tests {
             tf: &scene.tf,
             camera: &camera,
             breakpoints: &breakpoints,
+            levels: &order.levels,
             length_unit: scene.unit_distance,
         };
         // Piece by piece, up to the first one that makes such a sliver (the

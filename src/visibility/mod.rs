@@ -2,9 +2,12 @@
 //!
 //! # What it produces
 //! [`Sorter::order`] lists the [`Piece`]s of a mesh back to front for one
-//! [`Camera`]: whole cells, or the consistent tetrahedra
-//! ([`crate::mesh::tetra`]) of cells that must be split. A piece is drawn
-//! after every piece it occludes at the image's pixel centres.
+//! [`Camera`]: whole cells, the consistent tetrahedra
+//! ([`crate::mesh::tetra`]) of cells that must be split, and the slabs of
+//! the tets whose nodal scalar range strictly holds a transfer-function
+//! breakpoint (consecutive, back to front along the gradient: [`slabs`]).
+//! A piece is drawn after every piece it occludes at the image's pixel
+//! centres.
 //!
 //! # How it works
 //! 1. **Per geometry** ([`Sorter::new`]): every unique face is split into its
@@ -76,6 +79,7 @@ mod input;
 mod raster;
 mod sanity;
 pub mod scc;
+pub mod slabs;
 mod sorter;
 mod split;
 #[doc(hidden)]
@@ -100,14 +104,36 @@ pub enum Piece {
     /// One consistent tetrahedron of a split cell (global point ids, in the
     /// orientation `tetra::tetrahedralize_cell` gives).
     Tet { cell: u32, tet: [u32; 4] },
+    /// The part of a consistent tet (as in [`Piece::Tet`]) where
+    /// `levels[lo] <= s <= levels[hi]`, `levels` being [`Order::levels`] and
+    /// [`NO_LEVEL`] an open end: one slab of a tet whose nodal scalar range
+    /// strictly holds transfer-function breakpoints. A tet's slabs are
+    /// consecutive in the order, back to front ([`slabs`]).
+    Slab {
+        cell: u32,
+        tet: [u32; 4],
+        lo: u32,
+        hi: u32,
+    },
 }
+
+/// An open end of a [`Piece::Slab`].
+pub const NO_LEVEL: u32 = u32::MAX;
 
 impl Piece {
     /// The cell the piece belongs to.
     pub fn cell(&self) -> u32 {
         match *self {
             Piece::Cell(c) => c,
-            Piece::Tet { cell, .. } => cell,
+            Piece::Tet { cell, .. } | Piece::Slab { cell, .. } => cell,
+        }
+    }
+
+    /// The tetrahedron of a tet or slab piece.
+    pub fn tet(&self) -> Option<[u32; 4]> {
+        match *self {
+            Piece::Cell(_) => None,
+            Piece::Tet { tet, .. } | Piece::Slab { tet, .. } => Some(tet),
         }
     }
 }
@@ -120,7 +146,8 @@ pub struct SplitPolicy<'a> {
     /// Transfer-function breakpoints.
     pub breakpoints: &'a [f64],
     /// Nodal scalars; cells whose nodal range strictly contains a breakpoint
-    /// are split into tets.
+    /// are split into tets, and those tets whose range strictly contains
+    /// one are listed as slabs ([`Piece::Slab`]).
     pub point_scalars: Option<&'a [f64]>,
 }
 
@@ -133,8 +160,12 @@ pub struct OrderStats {
     pub pieces: usize,
     /// Cells drawn as tets in this view (all reasons).
     pub split_cells: usize,
-    /// Tets emitted.
+    /// Tets emitted (whole or as slabs).
     pub tets: usize,
+    /// Tets drawn as slabs because their nodal range strictly holds
+    /// breakpoints, and the slab pieces they became.
+    pub sliced_tets: usize,
+    pub slabs: usize,
     /// Problem faces (interior and boundary) in this view.
     pub problem_faces: usize,
     /// Cells split because of a problem face.
@@ -187,6 +218,9 @@ pub struct OrderStats {
 pub struct Order {
     /// Pieces back to front (draw in this order with "over").
     pub pieces: Vec<Piece>,
+    /// The breakpoints the slabs are cut at (sorted, distinct, finite): the
+    /// bounds of every [`Piece::Slab`].
+    pub levels: Vec<f64>,
     /// Ranges of `pieces` that form unresolved visibility cycles: the pieces
     /// of one range must be composited together with per-pixel depth sorting.
     /// Every piece outside a range is correctly ordered against the range.

@@ -24,8 +24,9 @@ use super::exact::orient_dir;
 use super::geometry::{Geometry, BOUNDARY, CONCAVE, FLIP, PLANAR};
 use super::raster::{exit_entry_pairs, rasterize};
 use super::scc::tarjan;
+use super::slabs;
 use super::split::SplitPool;
-use super::{Order, OrderStats, Piece, SplitPolicy, VisibilityError, MAX_SPLIT_ROUNDS};
+use super::{Order, OrderStats, Piece, SplitPolicy, VisibilityError, MAX_SPLIT_ROUNDS, NO_LEVEL};
 use crate::camera::Camera;
 use crate::mesh::topology::Topology;
 use crate::mesh::{Cells, Mesh, NONE};
@@ -247,7 +248,7 @@ impl Sorter {
             let emitted = self.kahn(&extra);
             let total_alive = n - self.pool.active.len() + (extra.pieces - n);
             if emitted.len() == total_alive {
-                let order = self.finish(emitted, Vec::new(), &extra, camera, &mut stats);
+                let order = self.finish(emitted, Vec::new(), &extra, camera, policy, &mut stats);
                 stats.time_sort += tk.elapsed();
                 stats.time_total = t_start.elapsed();
                 return Ok(Order { stats, ..order });
@@ -274,7 +275,7 @@ impl Sorter {
             }
             stats.cycle_split_cells += new_split;
             if new_split == 0 {
-                let order = self.finish(emitted, comps, &extra, camera, &mut stats);
+                let order = self.finish(emitted, comps, &extra, camera, policy, &mut stats);
                 stats.time_sort += tk.elapsed();
                 stats.time_total = t_start.elapsed();
                 return Ok(Order { stats, ..order });
@@ -658,27 +659,47 @@ impl Sorter {
         )
     }
 
-    /// Converts ids to pieces; appends the leftover components (topological
-    /// order, cycles as groups).
+    /// Converts ids to pieces (tets holding breakpoints become their slabs,
+    /// back to front); appends the leftover components (topological order,
+    /// cycles as groups).
     fn finish(
         &self,
         emitted: Vec<u32>,
         comps: Vec<Vec<u32>>,
         extra: &Extra,
         camera: &Camera,
+        policy: &SplitPolicy,
         stats: &mut OrderStats,
     ) -> Order {
-        let mut pieces: Vec<Piece> = Vec::with_capacity(extra.pieces);
+        let mut levels: Vec<f64> = match policy.point_scalars {
+            Some(_) => policy
+                .breakpoints
+                .iter()
+                .copied()
+                .filter(|b| b.is_finite())
+                .collect(),
+            None => Vec::new(),
+        };
+        levels.sort_by(f64::total_cmp);
+        levels.dedup();
+        let mut out = Emit {
+            pieces: Vec::with_capacity(extra.pieces),
+            levels: &levels,
+            scalars: policy.point_scalars,
+            points: &self.mesh.points,
+            camera,
+            sliced: 0,
+        };
         for &v in &emitted {
-            pieces.push(self.piece(extra, v));
+            out.push(self.piece(extra, v));
         }
         let mut groups = Vec::new();
         for comp in comps.into_iter().rev() {
             if comp.len() == 1 {
-                pieces.push(self.piece(extra, comp[0]));
+                out.push(self.piece(extra, comp[0]));
                 continue;
             }
-            let start = pieces.len();
+            let start = out.pieces.len();
             let mut members: Vec<(f64, Piece)> = comp
                 .iter()
                 .map(|&v| {
@@ -687,16 +708,25 @@ impl Sorter {
                 })
                 .collect();
             members.sort_by(|a, b| b.0.total_cmp(&a.0));
-            pieces.extend(members.into_iter().map(|m| m.1));
-            groups.push(start..pieces.len());
+            for m in members {
+                out.push(m.1);
+            }
+            groups.push(start..out.pieces.len());
         }
+        let pieces = out.pieces;
         stats.cycle_groups = groups.len();
         stats.pieces_in_groups = groups.iter().map(|g| g.len()).sum();
         stats.pieces = pieces.len();
         stats.split_cells = self.pool.active.len();
         stats.tets = extra.pieces - self.mesh.cells.len();
+        stats.sliced_tets = out.sliced;
+        stats.slabs = pieces
+            .iter()
+            .filter(|p| matches!(p, Piece::Slab { .. }))
+            .count();
         Order {
             pieces,
+            levels,
             groups,
             stats: OrderStats::default(),
         }
@@ -728,13 +758,57 @@ impl Sorter {
                     nodes.len(),
                 )
             }
-            Piece::Tet { tet, .. } => (tet.iter().map(|&v| p[v as usize]).sum::<DVec3>(), 4),
+            Piece::Tet { tet, .. } | Piece::Slab { tet, .. } => {
+                (tet.iter().map(|&v| p[v as usize]).sum::<DVec3>(), 4)
+            }
         };
         let centre = sum / cnt.max(1) as f64;
         if camera.ortho {
             (centre - camera.position).dot(camera.forward)
         } else {
             (centre - camera.position).length()
+        }
+    }
+}
+
+/// Appends pieces to an order, a tet holding breakpoints as its slabs.
+struct Emit<'a> {
+    pieces: Vec<Piece>,
+    levels: &'a [f64],
+    scalars: Option<&'a [f64]>,
+    points: &'a [DVec3],
+    camera: &'a Camera,
+    sliced: usize,
+}
+
+impl Emit<'_> {
+    fn push(&mut self, piece: Piece) {
+        let (Piece::Tet { cell, tet }, Some(sc)) = (piece, self.scalars) else {
+            self.pieces.push(piece);
+            return;
+        };
+        let s = tet.map(|v| sc.get(v as usize).copied().unwrap_or(0.0));
+        let inner = slabs::inner_levels(&s, self.levels);
+        if inner.is_empty() {
+            self.pieces.push(piece);
+            return;
+        }
+        self.sliced += 1;
+        let bands = slabs::bands(&self.levels[inner.clone()]);
+        let view = tet.map(|v| self.camera.to_view(self.points[v as usize]));
+        for i in slabs::slab_order(&view, &s, &bands, self.camera.ortho) {
+            // Band i lies between inner levels i - 1 and i.
+            let lo = if i == 0 {
+                NO_LEVEL
+            } else {
+                (inner.start + i - 1) as u32
+            };
+            let hi = if i + 1 == bands.len() {
+                NO_LEVEL
+            } else {
+                (inner.start + i) as u32
+            };
+            self.pieces.push(Piece::Slab { cell, tet, lo, hi });
         }
     }
 }

@@ -102,7 +102,7 @@ fn piece_triangles(mesh: &Mesh, piece: &Piece, out: &mut Vec<[u32; 3]>) {
                 });
             }
         }
-        Piece::Tet { tet, .. } => {
+        Piece::Tet { tet, .. } | Piece::Slab { tet, .. } => {
             let [a, b, c, d] = tet;
             out.extend_from_slice(&[[a, b, c], [a, b, d], [a, c, d], [b, c, d]]);
         }
@@ -138,6 +138,16 @@ pub fn validate(mesh: &Mesh, order: &Order, camera: &Camera, pixels: &[(u32, u32
     let mut tris = Vec::new();
     let mut ts: Vec<f64> = Vec::new();
     for (pos, piece) in order.pieces.iter().enumerate() {
+        // The slabs of one tet are consecutive: the tet is checked once, at
+        // its first slab (the order of the slabs inside is along the
+        // gradient, `super::slabs`).
+        if let (Piece::Slab { tet, .. }, Some(prev)) = (piece, pos.checked_sub(1)) {
+            if order.pieces[prev].tet() == Some(*tet)
+                && matches!(order.pieces[prev], Piece::Slab { .. })
+            {
+                continue;
+            }
+        }
         piece_triangles(mesh, piece, &mut tris);
         if tris.iter().flatten().any(|&v| v as usize >= p.len()) {
             continue;
