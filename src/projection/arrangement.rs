@@ -290,33 +290,11 @@ impl Arrangement {
         s(o3) && s(o4) && o3 != o4
     }
 
-    /// Parameter along `p` of its crossing with `q`, in `f64` from the
-    /// original endpoints.
-    fn param(&self, p: Piece, q: Piece) -> f64 {
-        let (p0, p1, q0, q1) = (self.pt(p.a), self.pt(p.b), self.pt(q.a), self.pt(q.b));
-        let d = p1 - p0;
-        let e = q1 - q0;
-        let den = d.perp_dot(e);
-        let t = (q0 - p0).perp_dot(e) / den;
-        if t.is_finite() {
-            t.clamp(0.0, 1.0)
-        } else {
-            0.5
-        }
-    }
-
     /// Position of the crossing of pieces `p` and `q`, symmetric in `p, q`.
     fn crossing_point(&self, p: u32, q: u32) -> DVec2 {
         let (p, q) = if p < q { (p, q) } else { (q, p) };
         let (pp, qq) = (self.pieces[p as usize], self.pieces[q as usize]);
-        let t = self.param(pp, qq);
-        let (p0, p1) = (self.pt(pp.a), self.pt(pp.b));
-        let x = p0 + (p1 - p0) * t;
-        // Keep the rounded point inside both bounding boxes.
-        let (q0, q1) = (self.pt(qq.a), self.pt(qq.b));
-        let lo = p0.min(p1).max(q0.min(q1));
-        let hi = p0.max(p1).min(q0.max(q1));
-        x.max(lo).min(hi)
+        segment_crossing(self.pt(pp.a), self.pt(pp.b), self.pt(qq.a), self.pt(qq.b))
     }
 
     /// Whether, along piece `p` (direction `a -> b`), its crossing with `q1`
@@ -706,6 +684,24 @@ impl Arrangement {
             c[0]
         }
     }
+}
+
+/// The crossing of segments `p0 p1` and `q0 q1` (which cross properly), in
+/// `f64` from the endpoints: the point at the crossing's parameter along
+/// `p` (clamped to `[0, 1]`), kept inside both bounding boxes.
+pub(super) fn segment_crossing(p0: DVec2, p1: DVec2, q0: DVec2, q1: DVec2) -> DVec2 {
+    let d = p1 - p0;
+    let e = q1 - q0;
+    let t = (q0 - p0).perp_dot(e) / d.perp_dot(e);
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    let x = p0 + d * t;
+    let lo = p0.min(p1).max(q0.min(q1));
+    let hi = p0.max(p1).min(q0.max(q1));
+    x.max(lo).min(hi)
 }
 
 /// Whether a face cycle of (twice the) signed area `a` is clearly an outer

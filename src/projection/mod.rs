@@ -9,7 +9,10 @@
 //!
 //! Layers, one module each:
 //! - `subdivision`: half-edge topology only (ids in arenas, `sanity_check`);
-//! - `arrangement`: inserting segments one by one with exact predicates;
+//! - `arrangement`: inserting segments one by one with exact predicates
+//!   (the general path, any piece and view);
+//! - `overlay`: the fast path for pieces in general position (checked
+//!   exactly): regions as intersections of a front and a back triangle;
 //! - `project`: the [`Projector`] pipeline (near clip, projection, regions,
 //!   per-vertex values, fan triangles);
 //! - `refine`: conforming midpoint refinement of region triangles, for the
@@ -36,6 +39,7 @@
 mod arrangement;
 mod clip;
 mod exact;
+mod overlay;
 mod polyhedron;
 mod project;
 mod refine;
@@ -55,6 +59,16 @@ pub use subdivision::{Subdivision, TopologyError};
 
 use crate::camera::Camera;
 use crate::numeric::predicates::{orient2d, Side};
+
+/// How a boundary triangle faces the viewer, from the exact orientation of
+/// its projection: front (clockwise in pixel coordinates, whose y grows
+/// downwards), back (counter-clockwise) or edge-on (zero area).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Facing {
+    Front,
+    Back,
+    EdgeOn,
+}
 
 /// Errors of projection (bad input or an inconsistent subdivision).
 #[derive(Debug, Error, Clone, PartialEq)]

@@ -9,22 +9,29 @@
 //! 3. classify each boundary triangle by the exact orientation of its
 //!    projection: front (clockwise in pixel coordinates, whose y grows
 //!    downwards), back (counter-clockwise) or edge-on (skipped: zero area);
-//! 4. build the arrangement of the front and back triangles' edges
-//!    (`arrangement`), each piece remembering the front/back triangle on
-//!    each of its sides;
-//! 5. faces of the subdivision with positive area are the regions; each gets
-//!    its front and back triangle from a bounding half-edge that lies on a
-//!    front (back) edge, or, when it has none, from a neighbour across an
-//!    edge that is not a front (back) edge (a region inside a triangle);
-//! 6. one [`RegionVertex`] per subdivision vertex: front and back values by
+//! 4. fast path (`overlay`, [`Projector::fast_path`]): when every point
+//!    is distinct, no triangle is edge-on and the exact checks of `overlay`
+//!    find the piece in general position, the regions are the intersections
+//!    of a front and a back triangle, traced directly (no arrangement);
+//!    anything else declines to the general path, steps 4'-5';
+//! 4'. general path: build the arrangement of the front and back triangles'
+//!    edges (`arrangement`), each piece remembering the front/back triangle
+//!    on each of its sides;
+//! 5'. faces of the subdivision with positive area are the regions; each
+//!    gets its front and back triangle from a bounding half-edge that lies
+//!    on a front (back) edge, or, when it has none, from a neighbour across
+//!    an edge that is not a front (back) edge (a region inside a triangle);
+//! 6. (both paths, from the regions as vertex lists) one [`RegionVertex`]
+//!    per subdivision vertex (or point and crossing of the fast path):
+//!    front and back values by
 //!    evaluating, at the vertex, the widest front and the widest back
 //!    triangle among the regions around it ([`FaceTri::width`]: a face seen
 //!    nearly edge-on projects to a sliver whose plane, evaluated through
 //!    rounded positions, gives meaningless depths; every region around the
 //!    vertex holds it, so any of them gives the same exact value) -- the
 //!    corner's own data when the vertex is that corner, so profile vertices
-//!    get `l = 0` exactly; regions are fan-triangulated, skipping triangles whose exact
-//!    orientation is not positive (zero area); with
+//!    get `l = 0` exactly; regions are fan-triangulated, skipping triangles
+//!    whose exact orientation is not positive (zero area); with
 //!    [`Projector::clip_to_image`] the regions are then clipped to the image
 //!    rectangle plus a margin (near-plane caps project ~1e9 pixels away);
 //! 7. perspective only: conforming midpoint refinement (`refine`) until the
@@ -34,19 +41,13 @@ use glam::DVec2;
 
 use super::arrangement::{is_outer, Arrangement, Piece};
 use super::clip::{ClipValue, Clipper};
+use super::overlay::Overlay;
 use super::polyhedron::Polyhedron;
 use super::subdivision::NIL;
-use super::{FaceTri, Projected, ProjectionError, RegionVertex, ViewMap, WidestFaces};
+use super::{FaceTri, Facing, Projected, ProjectionError, RegionVertex, ViewMap, WidestFaces};
 use crate::camera::Camera;
 use crate::numeric::predicates::{orient2d, Side};
 use crate::numeric::tolerance::{IMAGE_CLIP_MARGIN_PX, NEAR_CLIP_SCALE};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Facing {
-    Front,
-    Back,
-    EdgeOn,
-}
 
 /// Reusable projection state (see module docs).
 #[derive(Clone, Debug)]
@@ -67,9 +68,16 @@ pub struct Projector {
     /// image-sized. New vertices get exact values from their region's
     /// triangles, like refinement midpoints.
     pub clip_to_image: bool,
+    /// Take the fast path (`overlay`) for pieces in general position (on by
+    /// default; the general path, through the arrangement, is always taken
+    /// when [`Self::check_each_insertion`] is set).
+    pub fast_path: bool,
+    /// Whether the last call took the fast path (tests).
+    pub(crate) took_fast_path: bool,
     clipper: Clipper,
     clipped: Polyhedron,
     arr: Arrangement,
+    overlay: Overlay,
     pix: Vec<DVec2>,
     canon: Vec<u32>,
     facing: Vec<Facing>,
@@ -79,6 +87,9 @@ pub struct Projector {
     outer: Vec<bool>,
     face_of: Vec<u32>,
     face_start: Vec<u32>,
+    /// Vertices of each bounded face (general path), flat.
+    region_verts: Vec<u32>,
+    region_start: Vec<u32>,
     cycles: Vec<(u32, f64)>,
     face_fb: Vec<[u32; 2]>,
     vmap: Vec<u32>,
@@ -97,9 +108,12 @@ impl Default for Projector {
             perspective_refine: true,
             max_refine_depth: 6,
             clip_to_image: false,
+            fast_path: true,
+            took_fast_path: false,
             clipper: Clipper::default(),
             clipped: Polyhedron::default(),
             arr: Arrangement::default(),
+            overlay: Overlay::default(),
             pix: Vec::new(),
             canon: Vec::new(),
             facing: Vec::new(),
@@ -108,6 +122,8 @@ impl Default for Projector {
             outer: Vec::new(),
             face_of: Vec::new(),
             face_start: Vec::new(),
+            region_verts: Vec::new(),
+            region_start: Vec::new(),
             cycles: Vec::new(),
             face_fb: Vec::new(),
             vmap: Vec::new(),
@@ -125,7 +141,8 @@ impl Projector {
         Projector::default()
     }
 
-    /// The subdivision built by the last call (for inspection and tests).
+    /// The subdivision built by the last call that took the general path
+    /// (for inspection and tests; see [`Self::fast_path`]).
     pub fn arrangement(&self) -> &Arrangement {
         &self.arr
     }
@@ -138,6 +155,7 @@ impl Projector {
         out: &mut Projected,
     ) -> Result<(), ProjectionError> {
         poly.validate()?;
+        self.took_fast_path = false;
         out.clear();
         out.view = ViewMap::of(camera);
         let zc = camera.near * NEAR_CLIP_SCALE;
@@ -178,8 +196,10 @@ impl Projector {
             self.pix.push(DVec2::new(px, py));
         }
         self.canon.clear();
+        let mut distinct = true;
         for i in 0..n {
             let c = (0..i).find(|&j| self.pix[j] == self.pix[i]).unwrap_or(i);
+            distinct &= c == i;
             self.canon.push(c as u32);
         }
         // 3. Facing of each triangle.
@@ -192,6 +212,79 @@ impl Projector {
                 Side::On => Facing::EdgeOn,
             });
         }
+        self.took_fast_path = distinct
+            && self.fast_path
+            && !self.check_each_insertion
+            && self.overlay.build(&self.pix, &poly.triangles, &self.facing);
+        if self.took_fast_path {
+            // 4-5. Regions of a piece in general position (`overlay`).
+            let o = &self.overlay;
+            let regions = Regions {
+                pos: &o.pos,
+                on_hull: &o.on_hull,
+                verts: &o.region_verts,
+                start: &o.region_start,
+                faces: &o.face_fb,
+            };
+            emit(
+                poly,
+                &self.pix,
+                regions,
+                &mut self.vmap,
+                &mut self.best,
+                out,
+            );
+        } else {
+            self.general_regions(poly, out)?;
+        }
+        if out.regions.is_empty() {
+            return Ok(()); // everything edge-on: zero area
+        }
+        if self.clip_to_image {
+            self.window.clip(out);
+        }
+        // 7. Perspective refinement.
+        if !camera.ortho && self.perspective_refine {
+            let (smin, smax) = poly
+                .scalars
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &s| {
+                    (a.min(s), b.max(s))
+                });
+            let (lo, hi) = poly.points.iter().fold(
+                (
+                    glam::DVec3::splat(f64::INFINITY),
+                    glam::DVec3::splat(f64::NEG_INFINITY),
+                ),
+                |(a, b), &p| (a.min(p), b.max(p)),
+            );
+            // A piece whose scalars are constant up to rounding (cell data)
+            // has no scalar interpolation error: rounding noise in the
+            // interpolated values must not drive the refinement.
+            let srange = smax - smin;
+            let srange = if srange <= 1e-12 * smax.abs().max(smin.abs()) {
+                f64::INFINITY
+            } else {
+                srange
+            };
+            super::refine::refine_perspective(
+                out,
+                srange,
+                (hi - lo).length(),
+                self.max_refine_depth,
+                &mut self.refine,
+            );
+        }
+        Ok(())
+    }
+
+    /// Steps 4-6 through the arrangement (any piece, degenerate views
+    /// included).
+    fn general_regions(
+        &mut self,
+        poly: &Polyhedron,
+        out: &mut Projected,
+    ) -> Result<(), ProjectionError> {
         // 4. Segments with their side triangles, deduplicated.
         self.segs.clear();
         for (ti, t) in poly.triangles.iter().enumerate() {
@@ -251,43 +344,31 @@ impl Projector {
         // 5. Faces.
         self.trace_regions();
         self.assign_front_back()?;
+        // Vertices on the outer boundary.
+        let sub = &self.arr.sub;
+        self.on_hull.clear();
+        self.on_hull.resize(sub.vertex_count(), false);
+        for h in 0..sub.half_edge_count() as u32 {
+            if self.face_of[h as usize] == NIL {
+                self.on_hull[sub.origin(h) as usize] = true;
+            }
+        }
         // 6. Output.
-        self.emit(poly, out);
-        if self.clip_to_image {
-            self.window.clip(out);
-        }
-        // 7. Perspective refinement.
-        if !camera.ortho && self.perspective_refine {
-            let (smin, smax) = poly
-                .scalars
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &s| {
-                    (a.min(s), b.max(s))
-                });
-            let (lo, hi) = poly.points.iter().fold(
-                (
-                    glam::DVec3::splat(f64::INFINITY),
-                    glam::DVec3::splat(f64::NEG_INFINITY),
-                ),
-                |(a, b), &p| (a.min(p), b.max(p)),
-            );
-            // A piece whose scalars are constant up to rounding (cell data)
-            // has no scalar interpolation error: rounding noise in the
-            // interpolated values must not drive the refinement.
-            let srange = smax - smin;
-            let srange = if srange <= 1e-12 * smax.abs().max(smin.abs()) {
-                f64::INFINITY
-            } else {
-                srange
-            };
-            super::refine::refine_perspective(
-                out,
-                srange,
-                (hi - lo).length(),
-                self.max_refine_depth,
-                &mut self.refine,
-            );
-        }
+        let regions = Regions {
+            pos: &self.arr.pos,
+            on_hull: &self.on_hull,
+            verts: &self.region_verts,
+            start: &self.region_start,
+            faces: &self.face_fb,
+        };
+        emit(
+            poly,
+            &self.pix,
+            regions,
+            &mut self.vmap,
+            &mut self.best,
+            out,
+        );
         Ok(())
     }
 
@@ -301,6 +382,9 @@ impl Projector {
         self.face_of.clear();
         self.face_of.resize(nh, NIL);
         self.face_start.clear();
+        self.region_verts.clear();
+        self.region_start.clear();
+        self.region_start.push(0);
         self.cycles.clear();
         let arr = &self.arr;
         let cycles = &mut self.cycles;
@@ -317,11 +401,13 @@ impl Projector {
             let mut h = h0;
             loop {
                 self.face_of[h as usize] = id;
+                self.region_verts.push(sub.origin(h));
                 h = sub.next(h);
                 if h == h0 || self.face_of[h as usize] == id {
                     break;
                 }
             }
+            self.region_start.push(self.region_verts.len() as u32);
         }
         self.outer = outer;
     }
@@ -383,78 +469,74 @@ impl Projector {
             }
         }
     }
+}
 
-    /// Writes vertices, regions and fan triangles.
-    fn emit(&mut self, poly: &Polyhedron, out: &mut Projected) {
-        let sub = &self.arr.sub;
-        let nv = sub.vertex_count();
-        self.vmap.clear();
-        self.vmap.resize(nv, NIL);
-        // Vertices on the outer boundary.
-        self.on_hull.clear();
-        self.on_hull.resize(nv, false);
-        for h in 0..sub.half_edge_count() as u32 {
-            if self.face_of[h as usize] == NIL {
-                self.on_hull[sub.origin(h) as usize] = true;
-            }
-        }
-        // Every region around a vertex holds it under its front and back
-        // triangles, whose planes all give the vertex's values; take them
-        // from the widest ones (best conditioned, `FaceTri::width`), never
-        // from a sliver left by a face seen (nearly) edge-on.
-        self.best.clear();
-        self.best.resize(nv, [(NIL, -1.0); 2]);
-        for (f, &h0) in self.face_start.iter().enumerate() {
-            let [ft, bt] = self.face_fb[f];
-            let front = FaceTri::new(poly, &self.pix, ft);
-            let back = FaceTri::new(poly, &self.pix, bt);
-            let w = [front.width(), back.width()];
-            out.region_faces.push([front, back]);
-            let mut h = h0;
-            let mut k = 0;
-            loop {
-                let best = &mut self.best[sub.origin(h) as usize];
-                for s in 0..2 {
-                    if w[s] > best[s].1 {
-                        best[s] = (f as u32, w[s]);
-                    }
-                }
-                h = sub.next(h);
-                k += 1;
-                if h == h0 || k > sub.half_edge_count() {
-                    break;
-                }
-            }
-        }
-        for &h0 in &self.face_start {
-            let r = out.push_region();
-            let mut h = h0;
-            let mut k = 0;
-            loop {
-                let v = sub.origin(h);
-                if self.vmap[v as usize] == NIL {
-                    self.vmap[v as usize] = out.vertices.len() as u32;
-                    let p = self.arr.pos[v as usize];
-                    let [(bf, _), (bb, _)] = self.best[v as usize];
-                    let rv = RegionVertex::evaluate(
-                        &out.view,
-                        &out.region_faces[bf as usize][0],
-                        &out.region_faces[bb as usize][1],
-                        p,
-                        self.on_hull[v as usize],
-                    );
-                    out.vertices.push(rv);
-                }
-                out.regions[r].push(self.vmap[v as usize]);
-                h = sub.next(h);
-                k += 1;
-                if h == h0 || k > sub.half_edge_count() {
-                    break;
+/// Regions as lists of subdivision vertices, with their front and back
+/// triangles.
+struct Regions<'a> {
+    /// Position of every vertex.
+    pos: &'a [DVec2],
+    /// Vertices on the outer boundary (missing entries: not).
+    on_hull: &'a [bool],
+    /// Vertices of region `r`: `verts[start[r]..start[r + 1]]`, CCW.
+    verts: &'a [u32],
+    start: &'a [u32],
+    /// Front and back triangle of each region.
+    faces: &'a [[u32; 2]],
+}
+
+/// Writes vertices, regions and fan triangles (step 6 of the module docs).
+fn emit(
+    poly: &Polyhedron,
+    pix: &[DVec2],
+    regions: Regions,
+    vmap: &mut Vec<u32>,
+    best: &mut Vec<WidestFaces>,
+    out: &mut Projected,
+) {
+    let nv = regions.pos.len();
+    vmap.clear();
+    vmap.resize(nv, NIL);
+    // Every region around a vertex holds it under its front and back
+    // triangles, whose planes all give the vertex's values; take them
+    // from the widest ones (best conditioned, `FaceTri::width`), never
+    // from a sliver left by a face seen (nearly) edge-on.
+    best.clear();
+    best.resize(nv, [(NIL, -1.0); 2]);
+    let verts = |f: usize| &regions.verts[regions.start[f] as usize..regions.start[f + 1] as usize];
+    for (f, &[ft, bt]) in regions.faces.iter().enumerate() {
+        let front = FaceTri::new(poly, pix, ft);
+        let back = FaceTri::new(poly, pix, bt);
+        let w = [front.width(), back.width()];
+        out.region_faces.push([front, back]);
+        for &v in verts(f) {
+            let best = &mut best[v as usize];
+            for s in 0..2 {
+                if w[s] > best[s].1 {
+                    best[s] = (f as u32, w[s]);
                 }
             }
         }
-        out.triangulate_regions();
     }
+    for f in 0..regions.faces.len() {
+        let r = out.push_region();
+        for &v in verts(f) {
+            if vmap[v as usize] == NIL {
+                vmap[v as usize] = out.vertices.len() as u32;
+                let [(bf, _), (bb, _)] = best[v as usize];
+                let rv = RegionVertex::evaluate(
+                    &out.view,
+                    &out.region_faces[bf as usize][0],
+                    &out.region_faces[bb as usize][1],
+                    regions.pos[v as usize],
+                    regions.on_hull.get(v as usize).copied().unwrap_or(false),
+                );
+                out.vertices.push(rv);
+            }
+            out.regions[r].push(vmap[v as usize]);
+        }
+    }
+    out.triangulate_regions();
 }
 
 /// A point of a region polygon being clipped to the image window.

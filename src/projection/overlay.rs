@@ -1,0 +1,815 @@
+//! The fast path of the projection: the regions of a piece in general
+//! position, as the intersections of its front and back triangles, without
+//! building the arrangement.
+//!
+//! The front triangles of a convex piece tile its silhouette `S`, and so do
+//! the back triangles; a region is then exactly the intersection `F ∩ B` of
+//! a front and a back triangle with positive area (no other edge enters the
+//! interior of `F` or of `B`). [`Overlay::build`] first checks, exactly,
+//! that the rounded pixel positions keep that structure, and otherwise
+//! declines (the caller then takes the general path, `arrangement`):
+//!
+//! 1. all points distinct (checked by the caller), no triangle edge-on, and
+//!    a closed surface (every edge used once in each direction);
+//! 2. the silhouette edges (one front and one back triangle) form a single
+//!    cycle with strictly left turns at every vertex that winds once around
+//!    (a strictly convex polygon). The boundary of the 2-chain of front
+//!    triangles (all counter-clockwise once front ones are reversed) is that
+//!    cycle, so by the degree argument every point off the edges is covered
+//!    by exactly one front triangle (its winding number, 1 inside and 0
+//!    outside); likewise for the back triangles;
+//! 3. no point lies on an edge it does not end, so two edges meet at most
+//!    at a shared endpoint or at a proper crossing, and no three edges
+//!    cross at a point (front edges never cross front edges in a tiling).
+//!    Only points used by front triangles alone against edges between two
+//!    back triangles need testing (`orient2d` when in the edge's bounding
+//!    box), and vice versa: a front point cannot lie inside a front edge
+//!    (the non-degenerate front triangles tile `S`), nor a silhouette point
+//!    (an extreme point of `S`) inside any edge.
+//!
+//! Then every crossing is a proper crossing of an edge between two front
+//! triangles and an edge between two back triangles (four exact `orient2d`,
+//! computed when a walk first asks, cached like every point/edge
+//! orientation). Its position is computed in `f64` from the two edges'
+//! original endpoints (the general path's formula). Regions are traced
+//! counter-clockwise from neighbour to neighbour, starting with the front
+//! and back triangle of one silhouette edge (whose intersection has the
+//! edge's start as a corner). Leaving a vertex along an edge of one
+//! triangle, the next vertex is that edge's exit crossing from the other
+//! triangle (the crossed edge whose left side holds the edge's start; then
+//! follow the crossed edge), or else the edge's end, strictly inside the
+//! other triangle (continue along the same triangle) or a shared corner
+//! (continue along the more counter-clockwise of the two triangles' next
+//! edges, `orient2d`). Each piece of boundary followed along a non-silhouette
+//! edge is also a piece of the boundary of the region across it (the
+//! triangle across the edge, intersected with the same other triangle),
+//! which is queued with its walk's start (the piece's end, along the edge
+//! reversed) unless already found. Every decision is an exact predicate on
+//! original points; anything unexpected (a zero orientation, a walk that
+//! does not close) declines to the general path.
+
+use glam::DVec2;
+
+use super::arrangement::segment_crossing;
+use super::subdivision::NIL;
+use super::Facing;
+use crate::numeric::predicates::{orient2d, Side};
+
+/// Pieces with more points take the general path (the edge table is
+/// `n * n`).
+pub(super) const MAX_POINTS: usize = 64;
+
+/// Not computed yet (crossing table).
+const UNKNOWN: u32 = NIL - 1;
+
+/// Where to start tracing a region: at vertex `v`, along edge `k` of
+/// triangle `t1`, inside triangle `t2`.
+#[derive(Clone, Copy, Debug)]
+struct Start {
+    v: u32,
+    t1: u32,
+    k: u8,
+    t2: u32,
+}
+
+/// A triangle's edge, as the walk needs it.
+#[derive(Clone, Copy, Debug, Default)]
+struct TriEdge {
+    /// Edge id.
+    e: u32,
+    /// Index among the front (back) edges; `NIL` for a silhouette edge.
+    class: u32,
+    /// Whether the triangle runs along it from its smaller end.
+    fwd: bool,
+    /// The triangle across it, and the edge's index there.
+    nbr: u32,
+    nbr_k: u8,
+}
+
+/// Longest region walk: the intersection of two triangles has at most six
+/// corners.
+const MAX_WALK: usize = 8;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum EdgeKind {
+    /// Between two front triangles.
+    Front,
+    /// Between two back triangles.
+    Back,
+    /// One front and one back triangle.
+    Silhouette,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Edge {
+    a: u32,
+    b: u32,
+    front: u8,
+    back: u8,
+    /// Uses in the input winding as `a -> b` and `b -> a`.
+    fwd: u8,
+    bwd: u8,
+    kind: EdgeKind,
+    /// Index among the edges of its kind (front or back).
+    class: u32,
+    /// Start of the edge in its front triangle's counter-clockwise order.
+    front_from: u32,
+    /// The two triangles on its sides.
+    tris: [u32; 2],
+}
+
+/// Regions of a piece in general position (see module docs). Outputs are
+/// valid after [`Overlay::build`] returned `true`.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Overlay {
+    /// Corners of each triangle, counter-clockwise (front ones reversed).
+    ccw: Vec<[u32; 3]>,
+    is_front: Vec<bool>,
+    /// Edge id of each triangle's edge `ccw[k] -> ccw[k + 1]`.
+    tri_edge: Vec<[u32; 3]>,
+    /// The same edges with what the walk needs.
+    te: Vec<[TriEdge; 3]>,
+    edge_id: Vec<u32>,
+    edges: Vec<Edge>,
+    front_edges: Vec<u32>,
+    back_edges: Vec<u32>,
+    fronts: Vec<u32>,
+    backs: Vec<u32>,
+    succ: Vec<u32>,
+    /// `orient2d(a, b, v)` of point `v` and edge `a < b` (index
+    /// `v * edges + e`), 2 while not computed.
+    side: Vec<i8>,
+    /// Crossing vertex of front edge `i` and back edge `j` (`i * nb + j`),
+    /// `NIL` for none, [`UNKNOWN`] before it is computed.
+    cross: Vec<u32>,
+    /// Per point: 1 when used by front triangles only, 2 back only, 3 both.
+    vkind: Vec<u8>,
+    /// Index of each triangle among the front (back) triangles.
+    class: Vec<u32>,
+    /// Regions found (front index * backs + back index).
+    visited: Vec<bool>,
+    queue: Vec<Start>,
+    /// Positions of the vertices: the points, then the crossings.
+    pub pos: Vec<DVec2>,
+    /// Silhouette vertices.
+    pub on_hull: Vec<bool>,
+    /// Vertices of region `r`: `region_verts[region_start[r]..region_start[r + 1]]`.
+    pub region_verts: Vec<u32>,
+    pub region_start: Vec<u32>,
+    /// Front and back triangle of each region.
+    pub face_fb: Vec<[u32; 2]>,
+}
+
+fn sign(s: Side) -> i8 {
+    match s {
+        Side::Positive => 1,
+        Side::Negative => -1,
+        Side::On => 0,
+    }
+}
+
+impl Overlay {
+    /// Builds the regions of the piece with (distinct) pixel positions
+    /// `pix`, boundary triangles `tris` and their `facing`; `false` when the
+    /// piece is not in general position (see module docs; nothing useful is
+    /// left then).
+    pub(super) fn build(&mut self, pix: &[DVec2], tris: &[[u32; 3]], facing: &[Facing]) -> bool {
+        let n = pix.len();
+        if n > MAX_POINTS || tris.is_empty() {
+            return false;
+        }
+        // 1. Triangles counter-clockwise, edges and their kinds.
+        self.ccw.clear();
+        self.is_front.clear();
+        self.fronts.clear();
+        self.backs.clear();
+        self.class.clear();
+        for (ti, (t, f)) in tris.iter().zip(facing).enumerate() {
+            let c = match f {
+                Facing::Front => {
+                    self.class.push(self.fronts.len() as u32);
+                    self.fronts.push(ti as u32);
+                    [t[0], t[2], t[1]]
+                }
+                Facing::Back => {
+                    self.class.push(self.backs.len() as u32);
+                    self.backs.push(ti as u32);
+                    *t
+                }
+                Facing::EdgeOn => return false,
+            };
+            self.ccw.push(c);
+            self.is_front.push(*f == Facing::Front);
+        }
+        self.edge_id.clear();
+        self.edge_id.resize(n * n, NIL);
+        self.edges.clear();
+        self.tri_edge.clear();
+        for (ti, c) in self.ccw.iter().enumerate() {
+            let front = self.is_front[ti];
+            let mut te = [NIL; 3];
+            for k in 0..3 {
+                let (u, v) = (c[k], c[(k + 1) % 3]);
+                let (a, b) = (u.min(v), u.max(v));
+                let key = a as usize * n + b as usize;
+                let mut id = self.edge_id[key];
+                if id == NIL {
+                    id = self.edges.len() as u32;
+                    self.edge_id[key] = id;
+                    self.edges.push(Edge {
+                        a,
+                        b,
+                        front: 0,
+                        back: 0,
+                        fwd: 0,
+                        bwd: 0,
+                        kind: EdgeKind::Silhouette,
+                        class: NIL,
+                        front_from: NIL,
+                        tris: [NIL; 2],
+                    });
+                }
+                let e = &mut self.edges[id as usize];
+                // The input winding (front triangles were reversed).
+                let forward = if front { v < u } else { u < v };
+                if forward {
+                    e.fwd += 1;
+                } else {
+                    e.bwd += 1;
+                }
+                if front {
+                    e.front += 1;
+                    e.front_from = u;
+                } else {
+                    e.back += 1;
+                }
+                if e.tris[0] == NIL {
+                    e.tris[0] = ti as u32;
+                } else {
+                    e.tris[1] = ti as u32;
+                }
+                te[k] = id;
+            }
+            self.tri_edge.push(te);
+        }
+        self.front_edges.clear();
+        self.back_edges.clear();
+        self.succ.clear();
+        self.succ.resize(n, NIL);
+        let mut n_sil = 0;
+        let mut first = NIL;
+        for (id, e) in self.edges.iter_mut().enumerate() {
+            if e.fwd != 1 || e.bwd != 1 {
+                return false; // not a closed surface
+            }
+            match (e.front, e.back) {
+                (2, 0) => {
+                    e.kind = EdgeKind::Front;
+                    e.class = self.front_edges.len() as u32;
+                    self.front_edges.push(id as u32);
+                }
+                (0, 2) => {
+                    e.kind = EdgeKind::Back;
+                    e.class = self.back_edges.len() as u32;
+                    self.back_edges.push(id as u32);
+                }
+                _ => {
+                    let from = e.front_from;
+                    let to = if from == e.a { e.b } else { e.a };
+                    if self.succ[from as usize] != NIL {
+                        return false;
+                    }
+                    self.succ[from as usize] = to;
+                    n_sil += 1;
+                    first = from;
+                }
+            }
+        }
+        // 2. The silhouette: one strictly convex cycle, winding once.
+        if n_sil < 3 {
+            return false;
+        }
+        self.on_hull.clear();
+        self.on_hull.resize(n, false);
+        let half = |d: DVec2| d.y < 0.0 || (d.y == 0.0 && d.x < 0.0);
+        let (mut prev, mut cur) = (first, self.succ[first as usize]);
+        let mut wraps = 0;
+        for step in 0..n_sil {
+            let next = self.succ[cur as usize];
+            if next == NIL || (step + 1 < n_sil && cur == first) {
+                return false;
+            }
+            let (p, c, q) = (pix[prev as usize], pix[cur as usize], pix[next as usize]);
+            if orient2d(p, c, q) != Side::Positive {
+                return false;
+            }
+            if half(c - p) && !half(q - c) {
+                wraps += 1;
+            }
+            self.on_hull[cur as usize] = true;
+            (prev, cur) = (cur, next);
+        }
+        if prev != first || wraps != 1 {
+            return false;
+        }
+        self.te.clear();
+        for t in 0..self.ccw.len() {
+            let mut row = [TriEdge::default(); 3];
+            for (k, r) in row.iter_mut().enumerate() {
+                let id = self.tri_edge[t][k];
+                let e = &self.edges[id as usize];
+                let nbr = if e.tris[0] as usize == t {
+                    e.tris[1]
+                } else {
+                    e.tris[0]
+                };
+                let Some(nbr_k) = (0..3).find(|&j| self.tri_edge[nbr as usize][j] == id) else {
+                    return false;
+                };
+                *r = TriEdge {
+                    e: id,
+                    class: if e.kind == EdgeKind::Silhouette {
+                        NIL
+                    } else {
+                        e.class
+                    },
+                    fwd: self.ccw[t][k] == e.a,
+                    nbr,
+                    nbr_k: nbr_k as u8,
+                };
+            }
+            self.te.push(row);
+        }
+        // 3. No point on an edge it does not end. A front vertex cannot lie
+        // inside a front edge (the front triangles tile `S` and are not
+        // degenerate), nor a silhouette vertex (an extreme point of `S`)
+        // inside any: only vertices of one kind against edges of the other
+        // remain.
+        let ne = self.edges.len();
+        self.side.clear();
+        self.side.resize(n * ne, 2);
+        self.vkind.clear();
+        self.vkind.resize(n, 0);
+        for (t, c) in self.ccw.iter().enumerate() {
+            let bit = if self.is_front[t] { 1 } else { 2 };
+            for &v in c {
+                self.vkind[v as usize] |= bit;
+            }
+        }
+        for v in 0..n {
+            let count = match self.vkind[v] {
+                1 => self.back_edges.len(),
+                2 => self.front_edges.len(),
+                _ => continue,
+            };
+            let q = pix[v];
+            for i in 0..count {
+                let e = if self.vkind[v] == 1 {
+                    self.back_edges[i]
+                } else {
+                    self.front_edges[i]
+                };
+                let Edge { a, b, .. } = self.edges[e as usize];
+                let (pa, pb) = (pix[a as usize], pix[b as usize]);
+                if q.x < pa.x.min(pb.x)
+                    || q.x > pa.x.max(pb.x)
+                    || q.y < pa.y.min(pb.y)
+                    || q.y > pa.y.max(pb.y)
+                {
+                    continue;
+                }
+                if self.side(pix, v as u32, e) == 0 {
+                    return false;
+                }
+            }
+        }
+        // Crossings of front and back edges, computed on demand.
+        self.cross.clear();
+        self.cross
+            .resize(self.front_edges.len() * self.back_edges.len(), UNKNOWN);
+        self.pos.clear();
+        self.pos.extend_from_slice(pix);
+        // 4. Regions, from neighbour to neighbour, starting at a silhouette
+        // edge `u -> v` of front triangle `f` and back triangle `b`: the
+        // region `f ∩ b` has the corner `u`, left along that edge.
+        self.region_verts.clear();
+        self.region_start.clear();
+        self.region_start.push(0);
+        self.face_fb.clear();
+        self.visited.clear();
+        self.visited
+            .resize(self.fronts.len() * self.backs.len(), false);
+        self.queue.clear();
+        let Some(seed) = self
+            .edges
+            .iter()
+            .position(|e| e.kind == EdgeKind::Silhouette)
+        else {
+            return false;
+        };
+        let [t0, t1] = self.edges[seed].tris;
+        let (f, b) = if self.is_front[t0 as usize] {
+            (t0, t1)
+        } else {
+            (t1, t0)
+        };
+        let Some(k) = (0..3).find(|&k| self.tri_edge[f as usize][k] == seed as u32) else {
+            return false;
+        };
+        let u = self.ccw[f as usize][k];
+        self.visit(f, b);
+        self.queue.push(Start {
+            v: u,
+            t1: f,
+            k: k as u8,
+            t2: b,
+        });
+        while let Some(st) = self.queue.pop() {
+            if !self.region(pix, st) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Marks region `t1 ∩ t2` (a front and a back triangle, either order)
+    /// as found; `false` when it was already.
+    fn visit(&mut self, t1: u32, t2: u32) -> bool {
+        let (f, b) = if self.is_front[t1 as usize] {
+            (t1, t2)
+        } else {
+            (t2, t1)
+        };
+        let i =
+            self.class[f as usize] as usize * self.backs.len() + self.class[b as usize] as usize;
+        !std::mem::replace(&mut self.visited[i], true)
+    }
+
+    /// `orient2d` of point `v` and edge `e` (from its smaller end), cached.
+    fn side(&mut self, pix: &[DVec2], v: u32, e: u32) -> i8 {
+        let i = v as usize * self.edges.len() + e as usize;
+        let s = self.side[i];
+        if s != 2 {
+            return s;
+        }
+        let Edge { a, b, .. } = self.edges[e as usize];
+        let s = sign(orient2d(pix[a as usize], pix[b as usize], pix[v as usize]));
+        self.side[i] = s;
+        s
+    }
+
+    /// Side of point `v` of triangle `t`'s edge `k` (counter-clockwise:
+    /// positive is the triangle's side).
+    #[inline]
+    fn tri_side(&mut self, pix: &[DVec2], v: u32, h: TriEdge) -> i8 {
+        let s = self.side(pix, v, h.e);
+        if h.fwd {
+            s
+        } else {
+            -s
+        }
+    }
+
+    fn strictly_inside(&mut self, pix: &[DVec2], v: u32, t: usize) -> bool {
+        let row = self.te[t];
+        row.iter().all(|&h| self.tri_side(pix, v, h) > 0)
+    }
+
+    /// The crossing vertex of triangle edges `g` and `h` (one of a front
+    /// and one of a back triangle, `g` of a front one when `g_front`), or
+    /// `NIL` (computed once).
+    #[inline]
+    fn crossing(&mut self, pix: &[DVec2], g: TriEdge, h: TriEdge, g_front: bool) -> u32 {
+        if g.class == NIL || h.class == NIL {
+            return NIL;
+        }
+        let (fe, be) = if g_front { (g, h) } else { (h, g) };
+        let slot = fe.class as usize * self.back_edges.len() + be.class as usize;
+        let x = self.cross[slot];
+        if x != UNKNOWN {
+            return x;
+        }
+        let x = self.compute_crossing(pix, fe.e, be.e);
+        self.cross[slot] = x;
+        x
+    }
+
+    /// The crossing vertex of front edge `i` and back edge `j`, or `NIL`.
+    fn compute_crossing(&mut self, pix: &[DVec2], i: u32, j: u32) -> u32 {
+        let (fe, be) = (self.edges[i as usize], self.edges[j as usize]);
+        if fe.a == be.a || fe.a == be.b || fe.b == be.a || fe.b == be.b {
+            return NIL;
+        }
+        let (p0, p1) = (pix[fe.a as usize], pix[fe.b as usize]);
+        let (q0, q1) = (pix[be.a as usize], pix[be.b as usize]);
+        let (plo, phi) = (p0.min(p1), p0.max(p1));
+        let (qlo, qhi) = (q0.min(q1), q0.max(q1));
+        if phi.x < qlo.x || qhi.x < plo.x || phi.y < qlo.y || qhi.y < plo.y {
+            return NIL;
+        }
+        if self.side(pix, be.a, i) * self.side(pix, be.b, i) >= 0
+            || self.side(pix, fe.a, j) * self.side(pix, fe.b, j) >= 0
+        {
+            return NIL;
+        }
+        self.pos.push(segment_crossing(p0, p1, q0, q1));
+        (self.pos.len() - 1) as u32
+    }
+
+    /// Traces region `t1 ∩ t2` counter-clockwise from `st` and queues its
+    /// neighbours not found yet; `false` when something unexpected declines
+    /// the fast path.
+    fn region(&mut self, pix: &[DVec2], st: Start) -> bool {
+        let Start { v: v0, t1, k, t2 } = st;
+        let (mut t1, mut k, mut t2) = (t1 as usize, k as usize, t2 as usize);
+        let mut t1_front = self.is_front[t1];
+        let (f, b) = if t1_front { (t1, t2) } else { (t2, t1) };
+        let begin = self.region_verts.len();
+        self.region_verts.push(v0);
+        let mut closed = false;
+        for _ in 0..MAX_WALK {
+            // Along edge g = k of t1 (s -> e), inside t2.
+            let (s, e) = (self.ccw[t1][k], self.ccw[t1][(k + 1) % 3]);
+            let g = self.te[t1][k];
+            let other = t2;
+            // Exit from t2 across one of its edges: then follow that edge.
+            let mut exit = None;
+            if g.class != NIL {
+                for j in 0..3 {
+                    let h = self.te[t2][j];
+                    let x = self.crossing(pix, g, h, t1_front);
+                    if x != NIL && self.tri_side(pix, s, h) > 0 {
+                        exit = Some((x, j));
+                        break;
+                    }
+                }
+            }
+            let v = if let Some((x, j)) = exit {
+                (t1, t2, k) = (t2, t1, j);
+                t1_front = !t1_front;
+                x
+            } else if let Some(j) = (0..3).find(|&j| self.ccw[t2][j] == e) {
+                // A shared corner: the region's wedge there starts at the
+                // more counter-clockwise of the two next edges.
+                let (a, c) = (self.ccw[t1][(k + 2) % 3], self.ccw[t2][(j + 1) % 3]);
+                let turn = if a == c {
+                    Side::Negative
+                } else {
+                    orient2d(pix[e as usize], pix[a as usize], pix[c as usize])
+                };
+                match turn {
+                    Side::Negative => k = (k + 1) % 3,
+                    Side::Positive => {
+                        (t1, t2, k) = (t2, t1, j);
+                        t1_front = !t1_front;
+                    }
+                    Side::On => return false,
+                }
+                e
+            } else if self.strictly_inside(pix, e, t2) {
+                k = (k + 1) % 3;
+                e
+            } else {
+                return false;
+            };
+            // The neighbour across the edge just followed shares this piece
+            // of it, reversed: its walk can start at `v`.
+            if g.class != NIL && self.visit(g.nbr, other as u32) {
+                self.queue.push(Start {
+                    v,
+                    t1: g.nbr,
+                    k: g.nbr_k,
+                    t2: other as u32,
+                });
+            }
+            if v == v0 {
+                closed = true;
+                break;
+            }
+            self.region_verts.push(v);
+        }
+        let len = self.region_verts.len() - begin;
+        if !closed || len < 3 {
+            return false;
+        }
+        self.push_region(f, b);
+        true
+    }
+
+    fn push_region(&mut self, f: usize, b: usize) {
+        self.region_start.push(self.region_verts.len() as u32);
+        self.face_fb.push([f as u32, b as u32]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DMat3, DVec3};
+
+    use crate::camera::{Camera, CameraParams};
+    use crate::mesh::{CellKind, Cells};
+    use crate::projection::{Polyhedron, Projected, Projector};
+
+    struct Rng(u64);
+    impl Rng {
+        fn f64(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            (self.0.wrapping_mul(0x2545F4914F6CDD1D) >> 11) as f64 / (1u64 << 53) as f64
+        }
+        fn range(&mut self, a: f64, b: f64) -> f64 {
+            a + (b - a) * self.f64()
+        }
+    }
+
+    fn reference(kind: CellKind) -> Vec<DVec3> {
+        let v = DVec3::new;
+        let ngon = |n: usize| -> Vec<DVec3> {
+            (0..2 * n)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
+                    v(a.cos(), a.sin(), (i / n) as f64)
+                })
+                .collect()
+        };
+        match kind {
+            CellKind::Tetra => vec![v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.), v(0., 0., 1.)],
+            CellKind::Pyramid => vec![
+                v(0., 0., 0.),
+                v(1., 0., 0.),
+                v(1., 1., 0.),
+                v(0., 1., 0.),
+                v(0.5, 0.5, 1.),
+            ],
+            CellKind::Wedge => vec![
+                v(0., 0., 0.),
+                v(1., 0., 0.),
+                v(0., 1., 0.),
+                v(0., 0., 1.),
+                v(1., 0., 1.),
+                v(0., 1., 1.),
+            ],
+            CellKind::Hexahedron => vec![
+                v(0., 0., 0.),
+                v(1., 0., 0.),
+                v(1., 1., 0.),
+                v(0., 1., 0.),
+                v(0., 0., 1.),
+                v(1., 0., 1.),
+                v(1., 1., 1.),
+                v(0., 1., 1.),
+            ],
+            CellKind::PentagonalPrism => ngon(5),
+            _ => ngon(6),
+        }
+    }
+
+    const KINDS: [CellKind; 6] = [
+        CellKind::Tetra,
+        CellKind::Pyramid,
+        CellKind::Wedge,
+        CellKind::Hexahedron,
+        CellKind::PentagonalPrism,
+        CellKind::HexagonalPrism,
+    ];
+
+    /// A random affine image of `kind`'s reference cell (or the reference
+    /// itself, axis-aligned views then see faces edge-on) and a camera.
+    fn piece(kind: CellKind, rng: &mut Rng, ortho: bool, axis: bool) -> (Polyhedron, Camera) {
+        let r = reference(kind);
+        let m = if axis {
+            DMat3::IDENTITY
+        } else {
+            loop {
+                let m = DMat3::from_cols_array(&std::array::from_fn(|_| rng.range(-1.0, 1.0)));
+                if m.determinant().abs() > 0.15 {
+                    break m;
+                }
+            }
+        };
+        let pts: Vec<DVec3> = r.iter().map(|&p| m * p).collect();
+        let mut cells = Cells::default();
+        cells.push(kind, &(0..r.len() as u32).collect::<Vec<_>>());
+        let near = rng.f64() < 0.2;
+        let e = if near { 0.6 } else { rng.range(1.0, 30.0) };
+        let c = DVec3::splat(0.5);
+        let cam = Camera::fit(
+            [c.x - e, c.x + e, c.y - e, c.y + e, c.z - e, c.z + e],
+            &CameraParams {
+                width: 64,
+                height: 48,
+                azimuth: if axis {
+                    90.0 * (rng.f64() * 4.0).floor()
+                } else {
+                    rng.range(-180.0, 180.0)
+                },
+                elevation: if axis { 0.0 } else { rng.range(-80.0, 80.0) },
+                zoom: if near { 4.0 } else { 1.0 },
+                ortho,
+                ..Default::default()
+            },
+        );
+        let s: Vec<f64> = (0..r.len()).map(|_| rng.f64()).collect();
+        let poly = Polyhedron::from_cell(&cells, 0, &pts, |i| s[i as usize], &cam).unwrap();
+        (poly, cam)
+    }
+
+    fn area(out: &Projected, r: usize) -> f64 {
+        let reg = &out.regions[r];
+        let o = out.vertices[reg[0] as usize].pos();
+        let mut a = 0.0;
+        for k in 1..reg.len() {
+            let p = out.vertices[reg[k] as usize].pos() - o;
+            let q = out.vertices[reg[(k + 1) % reg.len()] as usize].pos() - o;
+            a += p.perp_dot(q);
+        }
+        0.5 * a
+    }
+
+    /// The fast path gives the general path's regions: the same front and
+    /// back triangles, areas and vertex values (crossings may round
+    /// differently), and is taken for pieces in general position.
+    #[test]
+    fn fast_path_matches_general_path() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut fast = Projector::new();
+        let mut general = Projector::new();
+        general.fast_path = false;
+        let (mut a, mut b) = (Projected::default(), Projected::default());
+        let (mut taken, mut total, mut axis_fast, mut axis_total) = (0, 0, 0, 0);
+        for kind in KINDS {
+            for i in 0..400 {
+                let (ortho, axis) = (i % 2 == 0, i % 7 == 0);
+                let (poly, cam) = piece(kind, &mut rng, ortho, axis);
+                fast.project(&poly, &cam, &mut a).unwrap();
+                general.project(&poly, &cam, &mut b).unwrap();
+                total += 1;
+                taken += fast.took_fast_path as usize;
+                assert!(!general.took_fast_path);
+                if axis && ortho {
+                    axis_fast += fast.took_fast_path as usize;
+                    axis_total += 1;
+                }
+                assert_eq!(a.regions.len(), b.regions.len(), "{kind:?} {i}");
+                let hull: f64 = (0..b.regions.len()).map(|r| area(&b, r)).sum();
+                let tol = 1e-9 * hull.max(1e-300);
+                // Crossings of nearly parallel edges (of faces seen nearly
+                // edge-on) are ill-conditioned: either path's rounding may
+                // put them anywhere along the edges' overlap.
+                let well_conditioned = a
+                    .region_faces
+                    .iter()
+                    .all(|f| f[0].width() > 1e-3 && f[1].width() > 1e-3);
+                for ra in 0..a.regions.len() {
+                    // (Rounded crossings may leave slivers of zero area.)
+                    assert!(area(&a, ra) >= -tol, "{kind:?} {i}");
+                    let rb = (0..b.regions.len())
+                        .find(|&rb| b.region_faces[rb] == a.region_faces[ra])
+                        .unwrap_or_else(|| panic!("{kind:?} {i}: region {ra} not found"));
+                    assert!((area(&a, ra) - area(&b, rb)).abs() <= tol, "{kind:?} {i}");
+                    if area(&a, ra) > 1e-6 * hull {
+                        assert_eq!(a.regions[ra].len(), b.regions[rb].len(), "{kind:?} {i}");
+                    }
+                    for &va in &a.regions[ra] {
+                        let va = a.vertices[va as usize];
+                        let vb = b.regions[rb]
+                            .iter()
+                            .map(|&v| b.vertices[v as usize])
+                            .min_by(|x, y| {
+                                let dx = (x.pos() - va.pos()).length();
+                                let dy = (y.pos() - va.pos()).length();
+                                dx.total_cmp(&dy)
+                            })
+                            .unwrap();
+                        let d = (vb.pos() - va.pos()).length();
+                        if well_conditioned {
+                            assert!(d <= 1e-9 * (1.0 + va.pos().length()), "{kind:?} {i}: {d}");
+                        }
+                        // Values where the position names one vertex (a
+                        // rounded crossing may land on another vertex).
+                        let unique = |o: &Projected| {
+                            o.vertices.iter().filter(|v| v.pos() == va.pos()).count() == 1
+                        };
+                        if d == 0.0 && unique(&a) && unique(&b) {
+                            assert_eq!(va.profile, vb.profile);
+                            let e = (va.l - vb.l)
+                                .abs()
+                                .max((va.s_front - vb.s_front).abs())
+                                .max((va.s_back - vb.s_back).abs());
+                            assert!(e <= 1e-9, "{kind:?} {i}: {e} {va:?} {vb:?}");
+                        }
+                    }
+                }
+                // Fans may start at other vertices (and refine differently).
+                let (ta, tb) = (a.triangle_area(), b.triangle_area());
+                assert!((ta - tb).abs() <= tol, "{kind:?} {i}: {ta} {tb}");
+            }
+        }
+        assert!(taken * 10 > total * 7, "fast path taken {taken} of {total}");
+        // Faces seen edge-on in axis-aligned orthographic views (or nearly,
+        // by rounding: those may take either path).
+        assert!(axis_fast * 2 < axis_total, "{axis_fast} of {axis_total}");
+        eprintln!("fast path: {taken} of {total}; axis-aligned {axis_fast} of {axis_total}");
+    }
+}
