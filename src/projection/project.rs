@@ -13,14 +13,14 @@
 //!    is distinct, no triangle is edge-on and the exact checks of `overlay`
 //!    find the piece in general position, the regions are the intersections
 //!    of a front and a back triangle, traced directly (no arrangement);
-//!    anything else declines to the general path, steps 4'-5';
-//! 4'. general path: build the arrangement of the front and back triangles'
+//!    anything else declines to the general path, step 5;
+//! 5. general path: build the arrangement of the front and back triangles'
 //!    edges (`arrangement`), each piece remembering the front/back triangle
-//!    on each of its sides;
-//! 5'. faces of the subdivision with positive area are the regions; each
-//!    gets its front and back triangle from a bounding half-edge that lies
-//!    on a front (back) edge, or, when it has none, from a neighbour across
-//!    an edge that is not a front (back) edge (a region inside a triangle);
+//!    on each of its sides; faces of the subdivision with positive area are
+//!    the regions; each gets its front and back triangle from a bounding
+//!    half-edge that lies on a front (back) edge, or, when it has none, from
+//!    a neighbour across an edge that is not a front (back) edge (a region
+//!    inside a triangle);
 //! 6. (both paths, from the regions as vertex lists) one [`RegionVertex`]
 //!    per subdivision vertex (or point and crossing of the fast path):
 //!    front and back values by
@@ -217,7 +217,7 @@ impl Projector {
             && !self.check_each_insertion
             && self.overlay.build(&self.pix, &poly.triangles, &self.facing);
         if self.took_fast_path {
-            // 4-5. Regions of a piece in general position (`overlay`).
+            // 4. Regions of a piece in general position (`overlay`).
             let o = &self.overlay;
             let regions = Regions {
                 pos: &o.pos,
@@ -278,14 +278,14 @@ impl Projector {
         Ok(())
     }
 
-    /// Steps 4-6 through the arrangement (any piece, degenerate views
+    /// Steps 5-6 through the arrangement (any piece, degenerate views
     /// included).
     fn general_regions(
         &mut self,
         poly: &Polyhedron,
         out: &mut Projected,
     ) -> Result<(), ProjectionError> {
-        // 4. Segments with their side triangles, deduplicated.
+        // 5. Segments with their side triangles, deduplicated.
         self.segs.clear();
         for (ti, t) in poly.triangles.iter().enumerate() {
             let f = self.facing[ti];
@@ -341,7 +341,7 @@ impl Projector {
                 self.arr.sanity_check()?;
             }
         }
-        // 5. Faces.
+        // Faces.
         self.trace_regions();
         self.assign_front_back()?;
         // Vertices on the outer boundary.
