@@ -240,7 +240,7 @@ fn slabs_are_listed_back_to_front() {
                     }
                     k += run.len();
                 }
-                Piece::Cell(_) => k += 1,
+                Piece::Cell(_) | Piece::Frag { .. } => k += 1,
             }
         }
     }

@@ -38,7 +38,9 @@ fn check_cover(mesh: &Mesh, order: &Order) {
     for p in &order.pieces {
         match p {
             Piece::Cell(c) => whole[*c as usize] += 1,
-            Piece::Tet { cell, .. } | Piece::Slab { cell, .. } => tets[*cell as usize] += 1,
+            Piece::Tet { cell, .. } | Piece::Slab { cell, .. } | Piece::Frag { cell, .. } => {
+                tets[*cell as usize] += 1
+            }
         }
     }
     for c in 0..mesh.cells.len() {

@@ -178,12 +178,14 @@ pub fn print_stats(stats: &RenderStats, load_s: f64) {
     }
     if let Some(e) = &stats.exact {
         eprintln!(
-            "sort         {:.3} s  ({} pieces, {} split cells, {} problem cells, {} cycles, {} cycle groups of {} pieces over {} pixels)",
+            "sort         {:.3} s  ({} pieces, {} split cells, {} problem cells, {} cycles, {} cut by planes into {} fragments, {} cycle groups of {} pieces over {} pixels)",
             e.sort_s,
             e.pieces,
             e.order.split_cells,
             e.order.problem_cells,
             e.order.cycles_found,
+            e.order.cycles_resolved_by_planes,
+            e.order.fragments,
             e.order.cycle_groups,
             e.order.pieces_in_groups,
             e.group_pixels

@@ -135,3 +135,21 @@ pub const TF_SLOPE_REL: f64 = 1e-9;
 /// coverage is decided by rounding anyway; it still gets drawn, with its
 /// vertices' (well-conditioned) values.
 pub const SLIVER_WIDTH_PX: f64 = 1e-6;
+
+/// Plane cuts of visibility cycles (`visibility::bsp`): a cut part whose
+/// volume is below this fraction of its tet's volume is dropped. Cut points
+/// are rounded to f64, so a cut through (or next to) an existing vertex can
+/// leave a sliver of zero volume whose rounded corners straddle later
+/// planes; such slivers hold ~1e-16 of the tet, cannot be ordered (they have
+/// no interior), and are invisible at any image resolution.
+pub const BSP_SLIVER_REL: f64 = 1e-12;
+
+/// Plane cuts of visibility cycles (`visibility::bsp`): a vertex within this
+/// fraction of the group's bounding-box diagonal (times the plane normal's
+/// length) of a cutting plane counts as on it. Cut points carry rounding of
+/// ~1e-16 of the group's size; without a band, a second plane through
+/// (nearly) the same line would cut next to an earlier cut point and leave
+/// near-duplicate vertices, slivers and caps whose order rounding decides.
+/// Treating points 1e-10 of the size away as on the plane moves a cut by at
+/// most that much: invisible at any image resolution.
+pub const BSP_ON_PLANE_REL: f64 = 1e-10;

@@ -46,6 +46,8 @@ use crate::numeric::predicates::{orient2d, Side};
 use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL, TF_SLOPE_REL};
 use crate::projection::{refine, slice_tet, ClipValue, Clipper, Polyhedron, Projected, Projector};
 use crate::tf::TransferFunction;
+use crate::visibility::bsp::Fragment;
+use crate::visibility::slabs::{bands as slab_bands, slab_order};
 use crate::visibility::{Piece, Sorter, SplitPolicy, NO_LEVEL};
 
 use super::group::composite_group;
@@ -93,6 +95,8 @@ pub(super) struct Ctx<'a> {
     breakpoints: &'a [f64],
     /// The order's slab bounds ([`crate::visibility::Order::levels`]).
     levels: &'a [f64],
+    /// The order's fragments ([`crate::visibility::Order::fragments`]).
+    fragments: &'a [Fragment],
     /// The frame's length unit ([`FrameOptions::length_unit`]).
     pub(super) length_unit: f64,
 }
@@ -142,7 +146,29 @@ impl Ctx<'_> {
                     Err(e) => Err(format!("cell {cell}: {e}")),
                 }
             }
+            Piece::Frag { tet, frag, .. } => self.fragment(cell, tet, frag, poly),
         }
+    }
+
+    /// The view-space polyhedron of fragment `frag` of a tet.
+    fn fragment(
+        &self,
+        cell: u32,
+        tet: [u32; 4],
+        frag: u32,
+        poly: &mut Polyhedron,
+    ) -> Result<(), String> {
+        let f = self
+            .fragments
+            .get(frag as usize)
+            .ok_or_else(|| format!("cell {cell}: no fragment {frag}"))?;
+        let (p, s) = self.tet_view(cell, tet);
+        poly.clear();
+        poly.points = f.positions(&p);
+        poly.scalars = f.values(&s);
+        poly.triangles.extend_from_slice(&f.triangles);
+        poly.orient_outward();
+        Ok(())
     }
 
     /// View-space corners and scalars of a tet of cell `cell`.
@@ -373,6 +399,54 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                     push_projected(ctx, &mut proj, &mut vals, &mut out);
                 }
             }
+            Piece::Frag { tet, frag, .. } => {
+                if let Err(e) = ctx.fragment(cell, tet, frag, &mut whole) {
+                    out.error = Some(e);
+                    return out;
+                }
+                let (lo, hi) = whole
+                    .scalars
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &s| {
+                        (lo.min(s), hi.max(s))
+                    });
+                if ctx.invisible(lo, hi) {
+                    out.culled += 1;
+                    continue;
+                }
+                // Breakpoints inside: the fragment's bands, back to front
+                // along the tet's gradient.
+                let mut levels: Vec<f64> = ctx
+                    .breakpoints
+                    .iter()
+                    .copied()
+                    .filter(|&b| b > lo && b < hi)
+                    .collect();
+                levels.sort_by(f64::total_cmp);
+                levels.dedup();
+                let bands = slab_bands(&levels);
+                let (p, s) = ctx.tet_view(cell, tet);
+                for i in slab_order(&p, &s, &bands, ctx.camera.ortho) {
+                    let (blo, bhi) = bands[i];
+                    let piece = if bands.len() == 1 {
+                        &whole
+                    } else {
+                        match clipper.clip(&whole, ClipValue::Scalar, blo, bhi, &mut poly) {
+                            Ok(true) => &poly,
+                            Ok(false) => continue,
+                            Err(e) => {
+                                out.error = Some(format!("cell {cell}: {e}"));
+                                return out;
+                            }
+                        }
+                    };
+                    if let Err(e) = projector.project(piece, ctx.camera, &mut proj) {
+                        out.error = Some(format!("cell {cell}: {e}"));
+                        return out;
+                    }
+                    push_projected(ctx, &mut proj, &mut vals, &mut out);
+                }
+            }
             Piece::Slab { tet, lo, hi, .. } => {
                 let (p, s) = ctx.tet_view(cell, tet);
                 let (blo, bhi) = ctx.band(lo, hi);
@@ -506,6 +580,7 @@ pub fn render_exact(
         camera,
         breakpoints: &breakpoints,
         levels: &order.levels,
+        fragments: &order.fragments,
         length_unit: scene.unit_distance as f32 as f64,
     };
     let mut opts = FrameOptions::new(camera.width, camera.height, format);
@@ -614,6 +689,7 @@ mod tests {
             camera: &camera,
             breakpoints: &breakpoints,
             levels: &order.levels,
+            fragments: &order.fragments,
             length_unit: scene.unit_distance,
         };
         // Piece by piece, up to the first one that makes such a sliver (the

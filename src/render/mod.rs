@@ -149,6 +149,14 @@ impl<'s> Renderer<'s> {
         }
     }
 
+    /// The visibility sorter of the exact mode (made on first use), e.g. to
+    /// change its options ([`Sorter::plane_split`], [`Sorter::nonconvex`]).
+    pub fn sorter(&mut self) -> &mut Sorter {
+        let scene = self.scene;
+        self.sorter
+            .get_or_insert_with(|| Sorter::new(&scene.mesh, &scene.topology))
+    }
+
     /// Renders one image with the camera of `opts.camera` (fitted to the
     /// mesh bounds, DESIGN.md Conventions).
     pub fn render(

@@ -44,18 +44,22 @@
 //! 5. **Cycles**: pieces Kahn cannot emit are grouped into strongly connected
 //!    components (Tarjan, [`scc`]). Whole cells in a cycle are split into
 //!    consistent tets and everything is re-sorted (at most
-//!    [`MAX_SPLIT_ROUNDS`] rounds). A cycle that remains (tets only, or after
-//!    the last round) is emitted as one **group**: a range of
-//!    [`Order::pieces`] listed in [`Order::groups`] (inside, by centroid
-//!    depth); the order between the group and every other piece is still
-//!    exact, so the renderer composites each group **per pixel** into one
-//!    layer drawn at the group's place (`render::group`: every pixel-centre
-//!    ray clipped against the group's pieces, segments sorted along the
-//!    ray, exact segment integrals), which is exact at pixel centres for
-//!    pieces that do not overlap (tested on interlocked tets,
-//!    `generate::interlocked_tets`). Tets that really overlap
-//!    (self-intersecting meshes such as a crushed can, where no
-//!    back-to-front order exists even along one ray) are ordered by segment
+//!    [`MAX_SPLIT_ROUNDS`] rounds). A cycle of tets that remains is cut by
+//!    planes through faces of its members ([`bsp`], an auto-partition
+//!    restricted to the cycle): the far side of a plane is drawn before the
+//!    near side, so the fragments ([`Piece::Frag`], [`Order::fragments`])
+//!    come out in an exact order (tested on interlocked tets,
+//!    `generate::interlocked_tets`). A cycle the cuts cannot order (its
+//!    pieces overlap in space, as in self-intersecting meshes such as a
+//!    crushed can, or it is too large, [`bsp::MAX_GROUP`]) is emitted as one
+//!    **group**: a range of [`Order::pieces`] listed in [`Order::groups`]
+//!    (inside, by centroid depth). The order between a group and every
+//!    other piece is still exact, so the renderer composites each group
+//!    **per pixel** into one layer drawn at the group's place
+//!    (`render::group`: every pixel-centre ray clipped against the group's
+//!    pieces, segments sorted along the ray, exact segment integrals), exact
+//!    at pixel centres for pieces that do not overlap; overlapping pieces,
+//!    for which no order exists even along one ray, are ordered by segment
 //!    midpoint. The sort always terminates.
 //!
 //! Subdivisions persist between views inside the [`Sorter`] (a pool of split
@@ -73,6 +77,7 @@
 //! rays it intersects the ray exactly with every piece's triangles, orders the
 //! pieces met by depth and checks that they are drawn back to front.
 
+pub mod bsp;
 pub mod exact;
 mod geometry;
 mod input;
@@ -115,6 +120,10 @@ pub enum Piece {
         lo: u32,
         hi: u32,
     },
+    /// A convex part of a consistent tet, cut off by planes through members
+    /// of a visibility cycle ([`bsp`]): `Order::fragments[frag]` (vertices
+    /// as barycentric weights of `tet`'s corners).
+    Frag { cell: u32, tet: [u32; 4], frag: u32 },
 }
 
 /// An open end of a [`Piece::Slab`].
@@ -125,7 +134,7 @@ impl Piece {
     pub fn cell(&self) -> u32 {
         match *self {
             Piece::Cell(c) => c,
-            Piece::Tet { cell, .. } | Piece::Slab { cell, .. } => cell,
+            Piece::Tet { cell, .. } | Piece::Slab { cell, .. } | Piece::Frag { cell, .. } => cell,
         }
     }
 
@@ -133,7 +142,7 @@ impl Piece {
     pub fn tet(&self) -> Option<[u32; 4]> {
         match *self {
             Piece::Cell(_) => None,
-            Piece::Tet { tet, .. } | Piece::Slab { tet, .. } => Some(tet),
+            Piece::Tet { tet, .. } | Piece::Slab { tet, .. } | Piece::Frag { tet, .. } => Some(tet),
         }
     }
 }
@@ -187,6 +196,10 @@ pub struct OrderStats {
     pub cycles_found: usize,
     /// Of those, the ones resolved by splitting cells into tets.
     pub cycles_resolved_by_split: usize,
+    /// Of those, the ones ordered by cutting their tets with planes through
+    /// members ([`bsp`]), and the fragments they became.
+    pub cycles_resolved_by_planes: usize,
+    pub fragments: usize,
     /// Cycles left as per-pixel groups ([`Order::groups`]).
     pub cycle_groups: usize,
     /// Pieces inside those groups.
@@ -218,6 +231,8 @@ pub struct OrderStats {
 pub struct Order {
     /// Pieces back to front (draw in this order with "over").
     pub pieces: Vec<Piece>,
+    /// The fragments of [`Piece::Frag`] pieces.
+    pub fragments: Vec<bsp::Fragment>,
     /// The breakpoints the slabs are cut at (sorted, distinct, finite): the
     /// bounds of every [`Piece::Slab`].
     pub levels: Vec<f64>,

@@ -24,8 +24,8 @@ use super::exact::orient_dir;
 use super::geometry::{Geometry, BOUNDARY, CONCAVE, FLIP, PLANAR};
 use super::raster::{exit_entry_pairs, rasterize};
 use super::scc::tarjan;
-use super::slabs;
 use super::split::SplitPool;
+use super::{bsp, slabs};
 use super::{Order, OrderStats, Piece, SplitPolicy, VisibilityError, MAX_SPLIT_ROUNDS, NO_LEVEL};
 use crate::camera::Camera;
 use crate::mesh::topology::Topology;
@@ -47,6 +47,12 @@ enum View {
     Eye(DVec3),
     /// Orthographic: the direction of projection.
     Dir(DVec3),
+}
+
+impl super::bsp::EyeSide for View {
+    fn side(&self, a: DVec3, b: DVec3, c: DVec3) -> Side {
+        View::side(self, a, b, c)
+    }
 }
 
 impl View {
@@ -91,6 +97,10 @@ pub struct Sorter {
     pub(super) invalid: Option<VisibilityError>,
     /// How non-convex meshes are handled (default: exact pixel constraints).
     pub nonconvex: NonConvex,
+    /// Whether cycles of tets are cut by planes through their members
+    /// ([`super::bsp`]) before being left to per-pixel compositing
+    /// (default: true).
+    pub plane_split: bool,
     // Per-view scratch.
     tri_sign: Vec<i8>,
     face_target: Vec<u32>,
@@ -143,6 +153,7 @@ impl Sorter {
             pool: SplitPool::new(if invalid.is_some() { 0 } else { n }),
             invalid,
             nonconvex: NonConvex::PixelConstraints,
+            plane_split: true,
             tri_sign: vec![0; nt],
             face_target: vec![NONE; nf],
             slot_target: Vec::new(),
@@ -693,6 +704,12 @@ impl Sorter {
         for &v in &emitted {
             out.push(self.piece(extra, v));
         }
+        let view = if camera.ortho {
+            View::Dir(camera.forward)
+        } else {
+            View::Eye(camera.position)
+        };
+        let mut fragments = Vec::new();
         let mut groups = Vec::new();
         for comp in comps.into_iter().rev() {
             if comp.len() == 1 {
@@ -708,8 +725,27 @@ impl Sorter {
                 })
                 .collect();
             members.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let members: Vec<Piece> = members.into_iter().map(|m| m.1).collect();
+            if self.plane_split {
+                if let Some(frags) = bsp::order_group(&members, &self.mesh.points, &view) {
+                    stats.cycles_resolved_by_planes += 1;
+                    stats.fragments += frags.len();
+                    for (src, frag) in frags {
+                        let Piece::Tet { cell, tet } = members[src] else {
+                            continue;
+                        };
+                        out.pieces.push(Piece::Frag {
+                            cell,
+                            tet,
+                            frag: fragments.len() as u32,
+                        });
+                        fragments.push(frag);
+                    }
+                    continue;
+                }
+            }
             for m in members {
-                out.push(m.1);
+                out.push(m);
             }
             groups.push(start..out.pieces.len());
         }
@@ -726,6 +762,7 @@ impl Sorter {
             .count();
         Order {
             pieces,
+            fragments,
             levels,
             groups,
             stats: OrderStats::default(),
@@ -758,7 +795,7 @@ impl Sorter {
                     nodes.len(),
                 )
             }
-            Piece::Tet { tet, .. } | Piece::Slab { tet, .. } => {
+            Piece::Tet { tet, .. } | Piece::Slab { tet, .. } | Piece::Frag { tet, .. } => {
                 (tet.iter().map(|&v| p[v as usize]).sum::<DVec3>(), 4)
             }
         };

@@ -91,20 +91,45 @@ pub fn sample_pixels(camera: &Camera, count: usize, seed: u64) -> Vec<(u32, u32)
     out
 }
 
-/// The triangles (point ids) bounding a piece.
-fn piece_triangles(mesh: &Mesh, piece: &Piece, out: &mut Vec<[u32; 3]>) {
+/// The triangles bounding a piece (corner positions); empty when the piece
+/// refers to points or fragments that do not exist.
+fn piece_triangles(mesh: &Mesh, order: &Order, piece: &Piece, out: &mut Vec<[DVec3; 3]>) {
     out.clear();
+    let p = &mesh.points;
+    let ok = |t: &[u32]| t.iter().all(|&v| (v as usize) < p.len());
     match *piece {
         Piece::Cell(c) => {
             if (c as usize) < mesh.cells.len() {
+                let mut bad = false;
                 mesh.cells.for_each_face(c as usize, |_, face| {
-                    triangulate_face(face, |t| out.push(t));
+                    triangulate_face(face, |t| {
+                        if ok(&t) {
+                            out.push(t.map(|v| p[v as usize]));
+                        } else {
+                            bad = true;
+                        }
+                    });
                 });
+                if bad {
+                    out.clear();
+                }
             }
         }
         Piece::Tet { tet, .. } | Piece::Slab { tet, .. } => {
-            let [a, b, c, d] = tet;
-            out.extend_from_slice(&[[a, b, c], [a, b, d], [a, c, d], [b, c, d]]);
+            if ok(&tet) {
+                let [a, b, c, d] = tet.map(|v| p[v as usize]);
+                out.extend_from_slice(&[[a, b, c], [a, b, d], [a, c, d], [b, c, d]]);
+            }
+        }
+        Piece::Frag { tet, frag, .. } => {
+            if let (true, Some(f)) = (ok(&tet), order.fragments.get(frag as usize)) {
+                let x = f.positions(&tet.map(|v| p[v as usize]));
+                for t in &f.triangles {
+                    if t.iter().all(|&v| (v as usize) < x.len()) {
+                        out.push(t.map(|v| x[v as usize]));
+                    }
+                }
+            }
         }
     }
 }
@@ -134,7 +159,6 @@ pub fn validate(mesh: &Mesh, order: &Order, camera: &Camera, pixels: &[(u32, u32
     let mut segs: HashMap<u32, Vec<(f64, f64, u32)>> = HashMap::new();
     let mut bad = vec![false; pixels.len()];
     let mut odd = vec![false; pixels.len()];
-    let p = &mesh.points;
     let mut tris = Vec::new();
     let mut ts: Vec<f64> = Vec::new();
     for (pos, piece) in order.pieces.iter().enumerate() {
@@ -148,15 +172,15 @@ pub fn validate(mesh: &Mesh, order: &Order, camera: &Camera, pixels: &[(u32, u32
                 continue;
             }
         }
-        piece_triangles(mesh, piece, &mut tris);
-        if tris.iter().flatten().any(|&v| v as usize >= p.len()) {
+        piece_triangles(mesh, order, piece, &mut tris);
+        if tris.is_empty() {
             continue;
         }
         // Candidate pixels: the projected bounding box, or everything.
         let proj: Option<Vec<(f64, f64)>> = tris
             .iter()
             .flatten()
-            .map(|&v| camera.project(p[v as usize]).map(|(x, y, _)| (x, y)))
+            .map(|&v| camera.project(v).map(|(x, y, _)| (x, y)))
             .collect();
         let (i0, i1, j0, j1) = match proj {
             Some(pts) if !pts.is_empty() => {
@@ -186,8 +210,7 @@ pub fn validate(mesh: &Mesh, order: &Order, camera: &Camera, pixels: &[(u32, u32
                 let (o, q) = rays[k as usize];
                 ts.clear();
                 let mut degenerate = false;
-                for t in &tris {
-                    let [a, b, c] = t.map(|v| p[v as usize]);
+                for &[a, b, c] in &tris {
                     match ray_triangle(o, q, a, b, c) {
                         RayHit::Miss => {}
                         RayHit::Degenerate => degenerate = true,
