@@ -33,6 +33,7 @@ pub const TARGETS: &[(&str, Target)] = &[
     ("tf_json", tf_json),
     ("projection", projection),
     ("visibility", visibility),
+    ("cycles", cycles),
 ];
 
 /// Legacy VTK reader: a mesh that comes back only references existing points.
@@ -322,6 +323,82 @@ pub fn visibility(data: &[u8]) {
         sorter.sanity_check().expect("sanity");
         let v = validate(&mesh, &order, &cam, &sample_pixels(&cam, usize::MAX, 0));
         assert!(v.ok(), "{} violations: {:?}", v.count, v.examples.first());
+    }
+}
+
+/// Plane cuts of a group of tets (`visibility::bsp`): 2 to 6 tets with
+/// corners on a 1/16 lattice (coincident points, shared planes and
+/// degenerate tets are common) and an eye point or direction. When the cuts
+/// give an order, every fragment must be a closed surface inside its tet,
+/// and the fragments of a tet must fill it.
+pub fn cycles(data: &[u8]) {
+    use crate::numeric::predicates::Side;
+    use crate::visibility::bsp::{order_group, EyeSide};
+    use crate::visibility::Piece;
+    struct Eye(DVec3, bool);
+    impl EyeSide for Eye {
+        fn side(&self, a: DVec3, b: DVec3, c: DVec3) -> Side {
+            if self.1 {
+                crate::visibility::exact::orient_dir(a, b, c, -self.0)
+            } else {
+                crate::numeric::predicates::orient3d(a, b, c, self.0)
+            }
+        }
+    }
+    let Some((&head, rest)) = data.split_first() else {
+        return;
+    };
+    let n = 2 + head as usize % 5;
+    if rest.len() < 12 * n + 4 {
+        return;
+    }
+    let c = |b: u8| b as f64 / 16.0;
+    let points: Vec<DVec3> = rest[..12 * n]
+        .chunks(3)
+        .map(|b| DVec3::new(c(b[0]), c(b[1]), c(b[2])))
+        .collect();
+    let e = &rest[12 * n..];
+    let eye = Eye(
+        DVec3::new(c(e[0]) - 8.0, c(e[1]) - 8.0, c(e[2]) - 8.0),
+        e[3] & 1 == 0,
+    );
+    if eye.1 && eye.0 == DVec3::ZERO {
+        return;
+    }
+    let pieces: Vec<Piece> = (0..n as u32)
+        .map(|k| Piece::Tet {
+            cell: k,
+            tet: [4 * k, 4 * k + 1, 4 * k + 2, 4 * k + 3],
+        })
+        .collect();
+    let Some(frags) = order_group(&pieces, &points, &eye) else {
+        return;
+    };
+    let mut vol = vec![0.0; n];
+    for (src, f) in &frags {
+        let k = *src;
+        let q = [0, 1, 2, 3].map(|i| points[4 * k + i]);
+        let x = f.positions(&q);
+        for w in &f.weights {
+            let sum: f64 = w.iter().sum();
+            assert!((sum - 1.0).abs() < 1e-9, "weights {w:?}");
+            assert!(w.iter().all(|&v| v > -1e-9), "outside its tet: {w:?}");
+        }
+        let o = x[0];
+        for t in &f.triangles {
+            let [a, b, cc] = t.map(|i| x[i as usize] - o);
+            vol[k] += a.dot(b.cross(cc)) / 6.0;
+        }
+    }
+    for k in 0..n {
+        let q = [0, 1, 2, 3].map(|i| points[4 * k + i]);
+        let want = ((q[1] - q[0]).dot((q[2] - q[0]).cross(q[3] - q[0])) / 6.0).abs();
+        let scale = 16.0f64.powi(3);
+        assert!(
+            (vol[k] - want).abs() <= 1e-9 * scale,
+            "tet {k}: fragments hold {} of {want}",
+            vol[k]
+        );
     }
 }
 
