@@ -4,7 +4,7 @@
 //! perspective at the default 30-degree view angle) and fitted to a box 50
 //! times the cell's size, as for one cell of a ~50^3 mesh.
 
-use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use criterion::{black_box, criterion_group, Criterion};
 use glam::{DMat3, DVec3};
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::{CellKind, Cells};
@@ -111,18 +111,19 @@ fn pieces(kind: CellKind, ortho: bool, seed: u64) -> Vec<(Polyhedron, Camera)> {
         .collect()
 }
 
+const KINDS: [(CellKind, &str); 6] = [
+    (CellKind::Tetra, "tet"),
+    (CellKind::Pyramid, "pyramid"),
+    (CellKind::Wedge, "wedge"),
+    (CellKind::Hexahedron, "hex"),
+    (CellKind::PentagonalPrism, "penta_prism"),
+    (CellKind::HexagonalPrism, "hexa_prism"),
+];
+
 fn bench(c: &mut Criterion) {
-    let kinds = [
-        (CellKind::Tetra, "tet"),
-        (CellKind::Pyramid, "pyramid"),
-        (CellKind::Wedge, "wedge"),
-        (CellKind::Hexahedron, "hex"),
-        (CellKind::PentagonalPrism, "penta_prism"),
-        (CellKind::HexagonalPrism, "hexa_prism"),
-    ];
     let mut pr = Projector::new();
     let mut out = Projected::default();
-    for (kind, name) in kinds {
+    for (kind, name) in KINDS {
         for ortho in [true, false] {
             let set = pieces(kind, ortho, 42);
             let (mut regions, mut verts, mut tris) = (0, 0, 0);
@@ -153,5 +154,46 @@ fn bench(c: &mut Criterion) {
     }
 }
 
+/// `PROJECTION_ITERS=n [PROJECTION_KIND=hex_ortho]`: project every set (or
+/// the one named) `n` times over and exit, without criterion: a fixed
+/// amount of work for instruction counts (`valgrind --tool=callgrind`) and
+/// profiles, which a machine shared with other jobs cannot time reliably.
+fn fixed_iterations(n: usize) {
+    let kind = std::env::var("PROJECTION_KIND").ok();
+    let mut pr = Projector::new();
+    let mut out = Projected::default();
+    let mut tris = 0;
+    for (k, name) in KINDS {
+        for ortho in [true, false] {
+            let mode = if ortho { "ortho" } else { "persp" };
+            if kind
+                .as_ref()
+                .is_some_and(|x| *x != format!("{name}_{mode}"))
+            {
+                continue;
+            }
+            let set = pieces(k, ortho, 42);
+            for _ in 0..n {
+                for (p, cam) in &set {
+                    pr.project(black_box(p), cam, &mut out).unwrap();
+                    tris += out.triangles.len();
+                }
+            }
+        }
+    }
+    println!("{tris} triangles");
+}
+
 criterion_group!(benches, bench);
-criterion_main!(benches);
+
+fn main() {
+    if let Some(n) = std::env::var("PROJECTION_ITERS")
+        .ok()
+        .and_then(|n| n.parse().ok())
+    {
+        fixed_iterations(n);
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

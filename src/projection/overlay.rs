@@ -28,19 +28,21 @@
 //!    (an extreme point of `S`) inside any edge.
 //!
 //! Then every crossing is a proper crossing of an edge between two front
-//! triangles and an edge between two back triangles (four exact `orient2d`,
-//! computed when a walk first asks, cached like every point/edge
-//! orientation). Its position is computed in `f64` from the two edges'
-//! original endpoints (the general path's formula). Regions are traced
-//! counter-clockwise from neighbour to neighbour, starting with the front
-//! and back triangle of one silhouette edge (whose intersection has the
-//! edge's start as a corner). Leaving a vertex along an edge of one
-//! triangle, the next vertex is that edge's exit crossing from the other
-//! triangle (the crossed edge whose left side holds the edge's start; then
-//! follow the crossed edge), or else the edge's end, strictly inside the
-//! other triangle (continue along the same triangle) or a shared corner
-//! (continue along the more counter-clockwise of the two triangles' next
-//! edges, `orient2d`). Each piece of boundary followed along a non-silhouette
+//! triangles and an edge between two back triangles. Its position is
+//! computed once, in `f64` from the two edges' original endpoints (the
+//! general path's formula). Regions are traced counter-clockwise from
+//! neighbour to neighbour, starting with the front and back triangle of one
+//! silhouette edge (whose intersection has the edge's start as a corner).
+//! Leaving a vertex along edge `g` of one triangle into the other, `T`: the
+//! line of `g` leaves `T` across the edge of `T` whose start lies strictly
+//! right of `g` and whose end strictly left (the sides of `T`'s corners,
+//! cached `orient2d` of original points; a corner on the line is a shared
+//! endpoint or lies beyond `g`'s ends). If `g`'s end is outside that edge,
+//! `g` crosses it: the next vertex is the crossing, then follow the crossed
+//! edge. Otherwise the next vertex is `g`'s end, strictly inside `T`
+//! (continue along the same triangle) or a shared corner (continue along the
+//! more counter-clockwise of the two triangles' next edges, `orient2d`).
+//! Each piece of boundary followed along a non-silhouette
 //! edge is also a piece of the boundary of the region across it (the
 //! triangle across the edge, intersected with the same other triangle),
 //! which is queued with its walk's start (the piece's end, along the edge
@@ -85,6 +87,9 @@ struct TriEdge {
     nbr: u32,
     nbr_k: u8,
 }
+
+/// The next corner (edge) of a triangle.
+const NEXT: [usize; 3] = [1, 2, 0];
 
 /// Longest region walk: the intersection of two triangles has at most six
 /// corners.
@@ -434,6 +439,7 @@ impl Overlay {
 
     /// Marks region `t1 ∩ t2` (a front and a back triangle, either order)
     /// as found; `false` when it was already.
+    #[inline]
     fn visit(&mut self, t1: u32, t2: u32) -> bool {
         let (f, b) = if self.is_front[t1 as usize] {
             (t1, t2)
@@ -446,12 +452,19 @@ impl Overlay {
     }
 
     /// `orient2d` of point `v` and edge `e` (from its smaller end), cached.
+    #[inline(always)]
     fn side(&mut self, pix: &[DVec2], v: u32, e: u32) -> i8 {
         let i = v as usize * self.edges.len() + e as usize;
         let s = self.side[i];
         if s != 2 {
             return s;
         }
+        self.compute_side(pix, v, e, i)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn compute_side(&mut self, pix: &[DVec2], v: u32, e: u32, i: usize) -> i8 {
         let Edge { a, b, .. } = self.edges[e as usize];
         let s = sign(orient2d(pix[a as usize], pix[b as usize], pix[v as usize]));
         self.side[i] = s;
@@ -475,45 +488,28 @@ impl Overlay {
         row.iter().all(|&h| self.tri_side(pix, v, h) > 0)
     }
 
-    /// The crossing vertex of triangle edges `g` and `h` (one of a front
-    /// and one of a back triangle, `g` of a front one when `g_front`), or
-    /// `NIL` (computed once).
+    /// The crossing vertex of triangle edges `g` and `h`, known to cross
+    /// properly (one of a front and one of a back triangle, `g` of a front
+    /// one when `g_front`): its position is computed once, from the front
+    /// edge's ends and the back edge's.
     #[inline]
     fn crossing(&mut self, pix: &[DVec2], g: TriEdge, h: TriEdge, g_front: bool) -> u32 {
-        if g.class == NIL || h.class == NIL {
-            return NIL;
-        }
         let (fe, be) = if g_front { (g, h) } else { (h, g) };
         let slot = fe.class as usize * self.back_edges.len() + be.class as usize;
         let x = self.cross[slot];
         if x != UNKNOWN {
             return x;
         }
-        let x = self.compute_crossing(pix, fe.e, be.e);
+        let (fe, be) = (self.edges[fe.e as usize], self.edges[be.e as usize]);
+        self.pos.push(segment_crossing(
+            pix[fe.a as usize],
+            pix[fe.b as usize],
+            pix[be.a as usize],
+            pix[be.b as usize],
+        ));
+        let x = (self.pos.len() - 1) as u32;
         self.cross[slot] = x;
         x
-    }
-
-    /// The crossing vertex of front edge `i` and back edge `j`, or `NIL`.
-    fn compute_crossing(&mut self, pix: &[DVec2], i: u32, j: u32) -> u32 {
-        let (fe, be) = (self.edges[i as usize], self.edges[j as usize]);
-        if fe.a == be.a || fe.a == be.b || fe.b == be.a || fe.b == be.b {
-            return NIL;
-        }
-        let (p0, p1) = (pix[fe.a as usize], pix[fe.b as usize]);
-        let (q0, q1) = (pix[be.a as usize], pix[be.b as usize]);
-        let (plo, phi) = (p0.min(p1), p0.max(p1));
-        let (qlo, qhi) = (q0.min(q1), q0.max(q1));
-        if phi.x < qlo.x || qhi.x < plo.x || phi.y < qlo.y || qhi.y < plo.y {
-            return NIL;
-        }
-        if self.side(pix, be.a, i) * self.side(pix, be.b, i) >= 0
-            || self.side(pix, fe.a, j) * self.side(pix, fe.b, j) >= 0
-        {
-            return NIL;
-        }
-        self.pos.push(segment_crossing(p0, p1, q0, q1));
-        (self.pos.len() - 1) as u32
     }
 
     /// Traces region `t1 ∩ t2` counter-clockwise from `st` and queues its
@@ -529,18 +525,33 @@ impl Overlay {
         let mut closed = false;
         for _ in 0..MAX_WALK {
             // Along edge g = k of t1 (s -> e), inside t2.
-            let (s, e) = (self.ccw[t1][k], self.ccw[t1][(k + 1) % 3]);
+            let e = self.ccw[t1][NEXT[k]];
             let g = self.te[t1][k];
             let other = t2;
-            // Exit from t2 across one of its edges: then follow that edge.
+            // The line of g leaves t2 across the edge whose start is on its
+            // right and whose end on its left (strictly: a corner of t2 on
+            // the line is a shared endpoint, or beyond g's ends); g itself
+            // leaves there when e is outside that edge. A silhouette edge
+            // never leaves.
             let mut exit = None;
+            let mut inside = false;
             if g.class != NIL {
-                for j in 0..3 {
+                let c = self.ccw[t2];
+                let o = c.map(|v| {
+                    let s = self.side(pix, v, g.e);
+                    if g.fwd {
+                        s
+                    } else {
+                        -s
+                    }
+                });
+                if let Some(j) = (0..3).find(|&j| o[j] < 0 && o[NEXT[j]] > 0) {
                     let h = self.te[t2][j];
-                    let x = self.crossing(pix, g, h, t1_front);
-                    if x != NIL && self.tri_side(pix, s, h) > 0 {
-                        exit = Some((x, j));
-                        break;
+                    match self.tri_side(pix, e, h) {
+                        -1 => exit = Some((self.crossing(pix, g, h, t1_front), j)),
+                        0 => return false,
+                        // e before the exit: strictly inside t2.
+                        _ => inside = true,
                     }
                 }
             }
@@ -551,14 +562,14 @@ impl Overlay {
             } else if let Some(j) = (0..3).find(|&j| self.ccw[t2][j] == e) {
                 // A shared corner: the region's wedge there starts at the
                 // more counter-clockwise of the two next edges.
-                let (a, c) = (self.ccw[t1][(k + 2) % 3], self.ccw[t2][(j + 1) % 3]);
+                let (a, c) = (self.ccw[t1][NEXT[NEXT[k]]], self.ccw[t2][NEXT[j]]);
                 let turn = if a == c {
                     Side::Negative
                 } else {
                     orient2d(pix[e as usize], pix[a as usize], pix[c as usize])
                 };
                 match turn {
-                    Side::Negative => k = (k + 1) % 3,
+                    Side::Negative => k = NEXT[k],
                     Side::Positive => {
                         (t1, t2, k) = (t2, t1, j);
                         t1_front = !t1_front;
@@ -566,8 +577,8 @@ impl Overlay {
                     Side::On => return false,
                 }
                 e
-            } else if self.strictly_inside(pix, e, t2) {
-                k = (k + 1) % 3;
+            } else if inside || self.strictly_inside(pix, e, t2) {
+                k = NEXT[k];
                 e
             } else {
                 return false;

@@ -92,11 +92,8 @@ pub struct Projector {
     region_start: Vec<u32>,
     cycles: Vec<(u32, f64)>,
     face_fb: Vec<[u32; 2]>,
-    vmap: Vec<u32>,
     on_hull: Vec<bool>,
-    /// Per subdivision vertex, for its front and back values: the region
-    /// whose triangle is widest, and that width.
-    best: Vec<WidestFaces>,
+    emit: EmitScratch,
     refine: super::refine::RefineScratch,
     window: WindowScratch,
 }
@@ -126,9 +123,8 @@ impl Default for Projector {
             region_start: Vec::new(),
             cycles: Vec::new(),
             face_fb: Vec::new(),
-            vmap: Vec::new(),
             on_hull: Vec::new(),
-            best: Vec::new(),
+            emit: EmitScratch::default(),
             refine: Default::default(),
             window: Default::default(),
         }
@@ -226,14 +222,7 @@ impl Projector {
                 start: &o.region_start,
                 faces: &o.face_fb,
             };
-            emit(
-                poly,
-                &self.pix,
-                regions,
-                &mut self.vmap,
-                &mut self.best,
-                out,
-            );
+            emit(poly, &self.pix, regions, &mut self.emit, out);
         } else {
             self.general_regions(poly, out)?;
         }
@@ -361,14 +350,7 @@ impl Projector {
             start: &self.region_start,
             faces: &self.face_fb,
         };
-        emit(
-            poly,
-            &self.pix,
-            regions,
-            &mut self.vmap,
-            &mut self.best,
-            out,
-        );
+        emit(poly, &self.pix, regions, &mut self.emit, out);
         Ok(())
     }
 
@@ -471,6 +453,17 @@ impl Projector {
     }
 }
 
+/// Scratch of [`emit`].
+#[derive(Clone, Debug, Default)]
+struct EmitScratch {
+    vmap: Vec<u32>,
+    /// Per subdivision vertex, for its front and back values: the region
+    /// whose triangle is widest, and that width.
+    best: Vec<WidestFaces>,
+    /// Per boundary triangle: its [`FaceTri`] and width, once computed.
+    tri_faces: Vec<Option<(FaceTri, f64)>>,
+}
+
 /// Regions as lists of subdivision vertices, with their front and back
 /// triangles.
 struct Regions<'a> {
@@ -490,10 +483,23 @@ fn emit(
     poly: &Polyhedron,
     pix: &[DVec2],
     regions: Regions,
-    vmap: &mut Vec<u32>,
-    best: &mut Vec<WidestFaces>,
+    scratch: &mut EmitScratch,
     out: &mut Projected,
 ) {
+    let EmitScratch {
+        vmap,
+        best,
+        tri_faces,
+    } = scratch;
+    // Each boundary triangle as seen on screen, with its width, once.
+    tri_faces.clear();
+    tri_faces.resize(poly.triangles.len(), None);
+    let mut face = |t: u32| {
+        *tri_faces[t as usize].get_or_insert_with(|| {
+            let f = FaceTri::new(poly, pix, t);
+            (f, f.width())
+        })
+    };
     let nv = regions.pos.len();
     vmap.clear();
     vmap.resize(nv, NIL);
@@ -505,9 +511,8 @@ fn emit(
     best.resize(nv, [(NIL, -1.0); 2]);
     let verts = |f: usize| &regions.verts[regions.start[f] as usize..regions.start[f + 1] as usize];
     for (f, &[ft, bt]) in regions.faces.iter().enumerate() {
-        let front = FaceTri::new(poly, pix, ft);
-        let back = FaceTri::new(poly, pix, bt);
-        let w = [front.width(), back.width()];
+        let ((front, wf), (back, wb)) = (face(ft), face(bt));
+        let w = [wf, wb];
         out.region_faces.push([front, back]);
         for &v in verts(f) {
             let best = &mut best[v as usize];

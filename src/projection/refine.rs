@@ -24,7 +24,11 @@
 //!   `|dz| / (4 min z)` of their variation along an edge, and the ray-length
 //!   factor `sqrt(1 + u^2 + v^2)` by at most `|d(u, v)|^2 / 8`; edges whose
 //!   resulting error bound exceeds [`PERSPECTIVE_INTERP_REL`] of the piece's
-//!   scalar range (diameter, for `l`) are split;
+//!   scalar range (diameter, for `l`) are split. The projector's
+//!   refinement computes each vertex's view-plane position and ray-length
+//!   factor once, and compares with the denominators multiplied out (no
+//!   square root or division per edge; [`perspective_split`] decides the
+//!   same way);
 //! - colour accuracy in the exact mode ([`refine`] with the caller's
 //!   predicate, e.g. optical depth times colour spread, math README 8.1).
 
@@ -45,6 +49,9 @@ pub struct RefineScratch {
     widths: Vec<[f64; 2]>,
     /// Per split edge: the region with the widest front (back) triangle.
     best: Vec<super::WidestFaces>,
+    /// Per vertex (perspective): view-plane position and ray length per
+    /// unit of depth.
+    plane: Vec<(DVec2, f64)>,
 }
 
 /// Whether the perspective interpolation bound asks to split edge `a`-`b`
@@ -70,21 +77,39 @@ pub fn perspective_split(
     if view.ortho {
         return false;
     }
-    let dev = |za: f64, zb: f64| (za - zb).abs() / (4.0 * za.min(zb));
-    let d = view.plane(a.pos()) - view.plane(b.pos());
-    let curv = d.length_squared() / 8.0;
-    let (dev_f, dev_b) = (dev(a.z_front, b.z_front), dev(a.z_back, b.z_back));
+    let at = |v: &RegionVertex| (view.plane(v.pos()), view.length_per_depth(v.pos()));
+    split_at(scalar_range, diameter, a, b, at(a), at(b))
+}
+
+/// [`perspective_split`] with each vertex's view-plane position and ray
+/// length per unit of depth given.
+#[inline]
+fn split_at(
+    scalar_range: f64,
+    diameter: f64,
+    a: &RegionVertex,
+    b: &RegionVertex,
+    (ua, ga): (DVec2, f64),
+    (ub, gb): (DVec2, f64),
+) -> bool {
     if a.profile && b.profile {
         // l = 0 all along a silhouette edge: its values carry no weight.
         return false;
     }
-    let es = (dev_f * (a.s_front - b.s_front).abs()).max(dev_b * (a.s_back - b.s_back).abs());
-    let g = view
-        .length_per_depth(a.pos())
-        .max(view.length_per_depth(b.pos()));
-    let el = g * (dev_f * (a.z_front - b.z_front).abs() + dev_b * (a.z_back - b.z_back).abs())
-        + curv * a.l.max(b.l);
-    es > PERSPECTIVE_INTERP_REL * scalar_range || el > PERSPECTIVE_INTERP_REL * diameter
+    // dev = |dz| / (4 min z) on each face, compared with the denominators
+    // multiplied out (depths are positive): no division per edge.
+    let (dzf, dzb) = ((a.z_front - b.z_front).abs(), (a.z_back - b.z_back).abs());
+    let (mf, mb) = (4.0 * a.z_front.min(b.z_front), 4.0 * a.z_back.min(b.z_back));
+    let ts = PERSPECTIVE_INTERP_REL * scalar_range;
+    if dzf * (a.s_front - b.s_front).abs() > ts * mf || dzb * (a.s_back - b.s_back).abs() > ts * mb
+    {
+        return true;
+    }
+    let curv = (ua - ub).length_squared() / 8.0;
+    let g = ga.max(gb);
+    // el = g (dzf^2 / mf + dzb^2 / mb) + curv l, times mf mb.
+    let el = g * (dzf * dzf * mb + dzb * dzb * mf) + curv * a.l.max(b.l) * mf * mb;
+    el > PERSPECTIVE_INTERP_REL * diameter * mf * mb
 }
 
 pub(crate) fn refine_perspective(
@@ -95,12 +120,26 @@ pub(crate) fn refine_perspective(
     s: &mut RefineScratch,
 ) {
     let view = out.view;
+    if view.ortho {
+        return;
+    }
+    // View-plane positions and ray-length factors once per vertex (the
+    // same values `perspective_split` computes per edge).
+    let mut plane = std::mem::take(&mut s.plane);
+    plane.clear();
     refine_with(
         out,
         max_depth,
-        |a, b| perspective_split(&view, scalar_range, diameter, a, b),
+        |v: &[RegionVertex], a: u32, b: u32| {
+            for w in &v[plane.len()..] {
+                plane.push((view.plane(w.pos()), view.length_per_depth(w.pos())));
+            }
+            let (a, b) = (a as usize, b as usize);
+            split_at(scalar_range, diameter, &v[a], &v[b], plane[a], plane[b])
+        },
         s,
     );
+    s.plane = plane;
 }
 
 /// Splits region triangles at edge midpoints, recursively (at most
@@ -110,36 +149,38 @@ pub(crate) fn refine_perspective(
 pub fn refine(
     out: &mut Projected,
     max_depth: u32,
-    split: impl FnMut(&RegionVertex, &RegionVertex) -> bool,
+    mut split: impl FnMut(&RegionVertex, &RegionVertex) -> bool,
 ) {
     let mut s = RefineScratch::default();
-    refine_with(out, max_depth, split, &mut s);
+    refine_with(
+        out,
+        max_depth,
+        |v: &[RegionVertex], a: u32, b: u32| split(&v[a as usize], &v[b as usize]),
+        &mut s,
+    );
 }
 
+/// [`refine`] with scratch buffers; `split(vertices, a, b)` decides for the
+/// edge between vertices `a < b`.
 pub(crate) fn refine_with(
     out: &mut Projected,
     max_depth: u32,
-    mut split: impl FnMut(&RegionVertex, &RegionVertex) -> bool,
+    mut split: impl FnMut(&[RegionVertex], u32, u32) -> bool,
     s: &mut RefineScratch,
 ) {
     s.widths.clear();
-    s.widths.extend(
-        out.region_faces
-            .iter()
-            .map(|f| [f[0].width(), f[1].width()]),
-    );
     for _ in 0..max_depth {
         s.edges.clear();
         for t in &out.triangles {
             let [a, b, c] = t.map(|i| out.vertices[i as usize].pos());
-            if triangle_width(a, b, c) < SLIVER_WIDTH_PX {
+            if is_sliver(a, b, c) {
                 // Negligible: split only where a neighbour asks (conforming).
                 continue;
             }
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 let key = (a.min(b), a.max(b));
-                if split(&out.vertices[key.0 as usize], &out.vertices[key.1 as usize]) {
+                if split(&out.vertices, key.0, key.1) {
                     s.edges.push(key);
                 }
             }
@@ -149,6 +190,13 @@ pub(crate) fn refine_with(
         }
         s.edges.sort_unstable();
         s.edges.dedup();
+        if s.widths.is_empty() {
+            s.widths.extend(
+                out.region_faces
+                    .iter()
+                    .map(|f| [f[0].width(), f[1].width()]),
+            );
+        }
         s.mids.clear();
         s.mids.resize(s.edges.len(), NIL);
         // Front and back values of a midpoint come from the widest front
@@ -194,19 +242,17 @@ pub(crate) fn refine_with(
     }
 }
 
-/// Twice the area over the longest edge: the triangle's smallest width.
-fn triangle_width(a: DVec2, b: DVec2, c: DVec2) -> f64 {
-    let area2 = (b - a).perp_dot(c - a).abs();
-    let lmax = (b - a)
+/// Whether the triangle's smallest width (twice its area over its longest
+/// edge) is below [`SLIVER_WIDTH_PX`] (compared squared: no square root or
+/// division per triangle).
+#[inline]
+fn is_sliver(a: DVec2, b: DVec2, c: DVec2) -> bool {
+    let area2 = (b - a).perp_dot(c - a);
+    let lmax2 = (b - a)
         .length_squared()
         .max((c - b).length_squared())
-        .max((a - c).length_squared())
-        .sqrt();
-    if lmax > 0.0 {
-        area2 / lmax
-    } else {
-        0.0
-    }
+        .max((a - c).length_squared());
+    lmax2 == 0.0 || area2 * area2 < SLIVER_WIDTH_PX * SLIVER_WIDTH_PX * lmax2
 }
 
 /// Creates the midpoint vertex of edge `a`-`b`, with its front values from
