@@ -36,12 +36,18 @@ pub fn inner_levels(scalars: &[f64], levels: &[f64]) -> Range<usize> {
 /// its range): `levels.len() + 1` bands, the outer ones unbounded.
 pub fn bands(levels: &[f64]) -> Vec<(f64, f64)> {
     let mut out = Vec::with_capacity(levels.len() + 1);
+    bands_into(levels, &mut out);
+    out
+}
+
+/// [`bands`] into a reused buffer.
+pub fn bands_into(levels: &[f64], out: &mut Vec<(f64, f64)>) {
+    out.clear();
     let mut lo = f64::NEG_INFINITY;
     for &b in levels.iter().chain(std::iter::once(&f64::INFINITY)) {
         out.push((lo, b));
         lo = b;
     }
-    out
 }
 
 /// Back-to-front order of the `bands` of the view-space tet `points` with
@@ -52,6 +58,20 @@ pub fn slab_order(
     bands: &[(f64, f64)],
     ortho: bool,
 ) -> Vec<usize> {
+    let mut keyed = Vec::with_capacity(bands.len());
+    slab_order_into(points, scalars, bands, ortho, &mut keyed);
+    keyed.into_iter().map(|k| k.1).collect()
+}
+
+/// [`slab_order`] into a reused buffer: `keyed[k].1` is the `k`-th band to
+/// draw.
+pub fn slab_order_into(
+    points: &[DVec3; 4],
+    scalars: &[f64; 4],
+    bands: &[(f64, f64)],
+    ortho: bool,
+    keyed: &mut Vec<(f64, usize)>,
+) {
     let p = points;
     let s = scalars;
     let m = DMat3::from_cols(p[1] - p[0], p[2] - p[0], p[3] - p[0]).transpose();
@@ -82,12 +102,13 @@ pub fn slab_order(
             0.0
         }
     };
-    let mut keyed: Vec<(f64, usize)> = bands
-        .iter()
-        .enumerate()
-        .map(|(i, &(lo, hi))| (key(lo, hi, i), i))
-        .collect();
+    keyed.clear();
+    keyed.extend(
+        bands
+            .iter()
+            .enumerate()
+            .map(|(i, &(lo, hi))| (key(lo, hi, i), i)),
+    );
     // Larger key = further back = drawn first.
     keyed.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-    keyed.into_iter().map(|k| k.1).collect()
 }

@@ -700,6 +700,8 @@ impl Sorter {
             points: &self.mesh.points,
             camera,
             sliced: 0,
+            bands: Vec::new(),
+            keyed: Vec::new(),
         };
         for &v in &emitted {
             out.push(self.piece(extra, v));
@@ -816,6 +818,9 @@ struct Emit<'a> {
     points: &'a [DVec3],
     camera: &'a Camera,
     sliced: usize,
+    /// Scratch for the bands of one tet and their order.
+    bands: Vec<(f64, f64)>,
+    keyed: Vec<(f64, usize)>,
 }
 
 impl Emit<'_> {
@@ -831,16 +836,18 @@ impl Emit<'_> {
             return;
         }
         self.sliced += 1;
-        let bands = slabs::bands(&self.levels[inner.clone()]);
+        slabs::bands_into(&self.levels[inner.clone()], &mut self.bands);
         let view = tet.map(|v| self.camera.to_view(self.points[v as usize]));
-        for i in slabs::slab_order(&view, &s, &bands, self.camera.ortho) {
+        slabs::slab_order_into(&view, &s, &self.bands, self.camera.ortho, &mut self.keyed);
+        let last = self.bands.len() - 1;
+        for &(_, i) in &self.keyed {
             // Band i lies between inner levels i - 1 and i.
             let lo = if i == 0 {
                 NO_LEVEL
             } else {
                 (inner.start + i - 1) as u32
             };
-            let hi = if i + 1 == bands.len() {
+            let hi = if i == last {
                 NO_LEVEL
             } else {
                 (inner.start + i) as u32
