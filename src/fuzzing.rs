@@ -155,7 +155,8 @@ fn quantised(data: &[u8], i: usize) -> f64 {
 
 /// Random convex polyhedra (affine images of the zoo cells, or breakpoint
 /// slabs of a tet) under random views: a consistent subdivision after every
-/// insertion.
+/// insertion; the renderer's projector (fast path where it applies) covers
+/// the same area.
 pub fn projection(data: &[u8]) {
     if data.len() < 20 {
         return;
@@ -241,12 +242,29 @@ pub fn projection(data: &[u8]) {
     }
     let mut pr = Projector::new();
     pr.check_each_insertion = true;
+    // The renderer's projector: the fast path for pieces in general position
+    // (`check_each_insertion` forces the general path above).
+    let mut fast = Projector::new();
+    let mut fast_out = Projected::default();
     let mut out = Projected::default();
     for p in &pieces {
+        let fast_result = fast.project(p, &cam, &mut fast_out);
+        if let Err(e @ (ProjectionError::Topology(_) | ProjectionError::UnassignedRegion)) =
+            &fast_result
+        {
+            panic!("{kind:?} (fast path): {e}")
+        }
         match pr.project(p, &cam, &mut out) {
             Ok(()) => {
                 pr.arrangement().sanity_check().expect("sanity_check");
                 let area = out.region_area();
+                if fast_result.is_ok() {
+                    let fa = fast_out.region_area();
+                    assert!(
+                        (fa - area).abs() <= 1e-9 * area.max(1.0),
+                        "{kind:?}: fast path regions {fa} vs general {area}"
+                    );
+                }
                 assert!(area.is_finite() && area >= 0.0);
                 // Orthographic, whole cell (nothing clipped): the regions
                 // tile the silhouette, the hull of the projected corners.

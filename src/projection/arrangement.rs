@@ -660,7 +660,7 @@ impl Arrangement {
     /// relative to its first vertex: its rounding error scales with the
     /// face's size, not with the pixel coordinates (a piece a fraction of a
     /// pixel wide far from the image origin would otherwise give its slivers
-    /// areas of rounding noise larger than [`is_outer`]'s threshold).
+    /// areas of rounding noise larger than `is_outer`'s threshold).
     pub fn cycle_area(&self, h0: u32) -> f64 {
         let o = self.pt(self.sub.origin(h0));
         let mut a = 0.0;

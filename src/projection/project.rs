@@ -357,7 +357,7 @@ impl Projector {
     /// Traces face cycles; bounded faces get ids: every cycle except the
     /// unbounded face's, found exactly ([`Arrangement::outer_half_edge`]),
     /// and except any other clearly negative one (a second component, a bug;
-    /// [`super::arrangement::is_outer`]).
+    /// `arrangement::is_outer`).
     fn trace_regions(&mut self) {
         let sub = &self.arr.sub;
         let nh = sub.half_edge_count();
