@@ -136,3 +136,41 @@ fn backend_and_cpu_adapter_select_the_adapter() {
         assert_eq!(ctx.info().device_type, "Cpu", "{}", ctx.info());
     }
 }
+
+/// A context opened on another thread while the scene is built
+/// (`Context::spawn`, what the CLI does) is the one the render uses, and
+/// the image is the same as with a context opened on the spot; a pending
+/// context for other options is not used.
+#[test]
+fn pending_context_is_used_and_gives_the_same_image() {
+    if gpu(&GpuOptions::default()).is_none() {
+        return;
+    }
+    let mesh = io::read(&mesh_file("zoo_3x3x3.vtu"), &ReadOptions::default()).unwrap();
+    let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+    let opts = RenderOptions {
+        camera: CameraParams {
+            width: 96,
+            height: 96,
+            azimuth: 20.0,
+            elevation: 35.0,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let (direct, _) = Renderer::new(&scene).render(&opts, |_, _| {}).unwrap();
+    let mut r = Renderer::new(&scene);
+    r.set_pending_gpu(Context::spawn(&opts.gpu));
+    let (img, stats) = r.render(&opts, |_, _| {}).unwrap();
+    assert!(stats.gpu_adapter.is_some());
+    assert_eq!(img.pixels, direct.pixels);
+    // Options that differ from the render's: a context of its own.
+    let mut r = Renderer::new(&scene);
+    let other = GpuOptions {
+        cpu_adapter: !opts.gpu.cpu_adapter,
+        ..opts.gpu
+    };
+    r.set_pending_gpu(Context::spawn(&other));
+    let (img, _) = r.render(&opts, |_, _| {}).unwrap();
+    assert_eq!(img.pixels, direct.pixels);
+}

@@ -226,11 +226,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.output.is_none() && args.float.is_none() {
         bail!("nothing to write: give -o out.png and/or --float out.exr");
     }
+    let opts = args.view.render_options();
+    // The exact mode's GPU device opens while the file is read and sorted.
+    let pending = (opts.mode == Mode::Exact).then(|| zoovr::gpu::Context::spawn(&opts.gpu));
     let t0 = std::time::Instant::now();
     let scene = args.view.load_scene(&args.file)?;
     let load_s = t0.elapsed().as_secs_f64();
     let mut renderer = Renderer::new(&scene);
-    let opts = args.view.render_options();
+    if let Some(p) = pending {
+        renderer.set_pending_gpu(p);
+    }
     match opts.mode {
         Mode::Exact if args.view.model.is_some_and(|m| m != FieldModel::Faces) => eprintln!(
             "zoovr: note: --model is the ray caster's; the exact mode integrates the `faces` \

@@ -62,7 +62,40 @@ pub struct Context {
     lost: Arc<Mutex<Option<String>>>,
 }
 
+/// A [`Context`] being opened on another thread ([`Context::spawn`]):
+/// opening a device (and compiling the pipeline, which on a software
+/// adapter is LLVM work) takes a few tenths of a second that a caller can
+/// overlap with reading and sorting a mesh.
+#[derive(Debug)]
+pub struct PendingContext {
+    opts: GpuOptions,
+    handle: std::thread::JoinHandle<Result<Context, GpuError>>,
+}
+
+impl PendingContext {
+    /// The options it was opened with.
+    pub fn options(&self) -> &GpuOptions {
+        &self.opts
+    }
+
+    /// Waits for the context.
+    pub fn wait(self) -> Result<Context, GpuError> {
+        self.handle
+            .join()
+            .unwrap_or_else(|_| Err(GpuError::Wgpu("opening the device panicked".into())))
+    }
+}
+
 impl Context {
+    /// Starts opening a context on a new thread.
+    pub fn spawn(opts: &GpuOptions) -> PendingContext {
+        let o = *opts;
+        PendingContext {
+            opts: o,
+            handle: std::thread::spawn(move || Context::new(&o)),
+        }
+    }
+
     /// Opens a headless device (see the module docs).
     pub fn new(opts: &GpuOptions) -> Result<Context, GpuError> {
         pollster::block_on(Self::new_async(opts))

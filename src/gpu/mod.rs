@@ -43,7 +43,7 @@ mod frame;
 mod readback;
 mod vertex;
 
-pub use context::{Context, ContextInfo};
+pub use context::{Context, ContextInfo, PendingContext};
 pub use frame::{Frame, FrameOptions, FrameStats};
 pub use vertex::{ClipMapper, ExactVertex};
 

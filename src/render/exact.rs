@@ -38,7 +38,9 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::camera::Camera;
-use crate::gpu::{AccumFormat, Context, ExactVertex, Frame, FrameOptions, FrameStats};
+use crate::gpu::{
+    AccumFormat, Context, ExactVertex, Frame, FrameOptions, FrameStats, GpuOptions, PendingContext,
+};
 use crate::image::Image;
 use crate::integrate::{vertex_values, VertexValues};
 use crate::mesh::Mesh;
@@ -68,6 +70,8 @@ pub struct ExactStats {
     /// Pixels of the per-pixel layers of cycle groups ([`composite_group`]).
     pub group_pixels: usize,
     pub sort_s: f64,
+    /// Time spent opening (or waiting for) the GPU context.
+    pub gpu_open_s: f64,
     pub project_s: f64,
     pub gpu: FrameStats,
     pub gpu_total_s: f64,
@@ -546,11 +550,17 @@ fn push_out(frame: &mut Frame, out: ChunkOut, stats: &mut ExactStats) -> Result<
     Ok(())
 }
 
-/// Renders the scene in the exact mode through `ctx`.
+/// Renders the scene in the exact mode. The GPU context is `gpu`, or, when
+/// that is empty, `pending` (a context opening on another thread, waited
+/// for after the sort, which it overlaps) or a new one opened with
+/// `gpu_opts`; it is left in `gpu`.
+#[allow(clippy::too_many_arguments)]
 pub fn render_exact(
     scene: &Scene,
     sorter: &mut Sorter,
-    gpu: &Context,
+    gpu: &mut Option<Context>,
+    pending: &mut Option<PendingContext>,
+    gpu_opts: &GpuOptions,
     camera: &Camera,
     split_all: bool,
     format: AccumFormat,
@@ -583,6 +593,17 @@ pub fn render_exact(
         fragments: &order.fragments,
         length_unit: scene.unit_distance as f32 as f64,
     };
+    let t_open = Instant::now();
+    if gpu.is_none() {
+        *gpu = Some(match pending.take() {
+            Some(p) if p.options() == gpu_opts => p.wait()?,
+            _ => Context::new(gpu_opts)?,
+        });
+    }
+    let Some(gpu) = gpu.as_ref() else {
+        unreachable!("opened above")
+    };
+    stats.gpu_open_s = t_open.elapsed().as_secs_f64();
     let mut opts = FrameOptions::new(camera.width, camera.height, format);
     opts.length_unit = scene.unit_distance as f32;
     let t_gpu = Instant::now();

@@ -18,7 +18,7 @@ use std::time::Instant;
 use thiserror::Error;
 
 use crate::camera::{Camera, CameraParams};
-use crate::gpu::{AccumFormat, Context, GpuError, GpuOptions};
+use crate::gpu::{AccumFormat, Context, GpuError, GpuOptions, PendingContext};
 use crate::image::Image;
 use crate::raycast::{self, FieldModel, RaycastOptions, Raycaster};
 use crate::visibility::{Sorter, VisibilityError};
@@ -135,6 +135,7 @@ pub struct Renderer<'s> {
     scene: &'s Scene,
     sorter: Option<Sorter>,
     gpu: Option<Context>,
+    pending_gpu: Option<PendingContext>,
     raycaster: Option<(FieldModel, Raycaster<'s>)>,
 }
 
@@ -145,7 +146,17 @@ impl<'s> Renderer<'s> {
             scene,
             sorter: None,
             gpu: None,
+            pending_gpu: None,
             raycaster: None,
+        }
+    }
+
+    /// Hands over a GPU context that is still opening ([`Context::spawn`]);
+    /// the exact mode waits for it after sorting, when its options are the
+    /// render's (otherwise it opens its own).
+    pub fn set_pending_gpu(&mut self, pending: PendingContext) {
+        if self.gpu.is_none() {
+            self.pending_gpu = Some(pending);
         }
     }
 
@@ -188,28 +199,26 @@ impl<'s> Renderer<'s> {
                 if scene.tf.model() == crate::tf::EmissionModel::Independent {
                     return Err(RenderError::Unsupported("exact"));
                 }
-                let gpu = match self.gpu.take() {
-                    Some(g) => g,
-                    None => Context::new(&opts.gpu)?,
-                };
                 let mut sorter = self
                     .sorter
                     .take()
                     .unwrap_or_else(|| Sorter::new(&scene.mesh, &scene.topology));
-                stats.setup_s = t0.elapsed().as_secs_f64();
-                stats.gpu_adapter = Some(gpu.info().to_string());
+                let sorter_s = t0.elapsed().as_secs_f64();
                 let result = exact::render_exact(
                     scene,
                     &mut sorter,
-                    &gpu,
+                    &mut self.gpu,
+                    &mut self.pending_gpu,
+                    &opts.gpu,
                     &camera,
                     opts.split_all,
                     opts.accum,
                     progress,
                 );
-                self.gpu = Some(gpu);
                 self.sorter = Some(sorter);
+                stats.gpu_adapter = self.gpu.as_ref().map(|g| g.info().to_string());
                 let (img, es) = result?;
+                stats.setup_s = sorter_s + es.gpu_open_s;
                 stats.exact = Some(es);
                 img
             }

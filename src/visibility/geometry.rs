@@ -6,6 +6,7 @@
 use std::collections::HashMap;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::mesh::tetra::triangulate_face;
 use crate::mesh::topology::Topology;
@@ -113,6 +114,7 @@ impl Geometry {
         let p = &mesh.points;
         let nf = topo.face_count();
         let vol: Vec<f64> = (0..mesh.cells.len())
+            .into_par_iter()
             .map(|c| cell_volume6(mesh, c))
             .collect();
         let mut g = Geometry {
@@ -173,6 +175,7 @@ impl Geometry {
             g.tri_off.push(g.planes.len() as u32);
         }
         g.nonconvex_cells = (0..mesh.cells.len())
+            .into_par_iter()
             .filter(|&c| mesh.cells.kinds[c] != crate::mesh::CellKind::Tetra)
             .filter(|&c| cell_nonconvex(mesh, c, vol[c] < 0.0))
             .map(|c| c as u32)
