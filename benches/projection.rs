@@ -23,52 +23,10 @@ impl Rng {
     }
 }
 
-fn reference(kind: CellKind) -> Vec<DVec3> {
-    let v = DVec3::new;
-    let ngon = |n: usize| -> Vec<DVec3> {
-        (0..2 * n)
-            .map(|i| {
-                let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
-                v(a.cos(), a.sin(), (i / n) as f64)
-            })
-            .collect()
-    };
-    match kind {
-        CellKind::Tetra => vec![v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.), v(0., 0., 1.)],
-        CellKind::Pyramid => vec![
-            v(0., 0., 0.),
-            v(1., 0., 0.),
-            v(1., 1., 0.),
-            v(0., 1., 0.),
-            v(0.5, 0.5, 1.),
-        ],
-        CellKind::Wedge => vec![
-            v(0., 0., 0.),
-            v(1., 0., 0.),
-            v(0., 1., 0.),
-            v(0., 0., 1.),
-            v(1., 0., 1.),
-            v(0., 1., 1.),
-        ],
-        CellKind::Hexahedron => vec![
-            v(0., 0., 0.),
-            v(1., 0., 0.),
-            v(1., 1., 0.),
-            v(0., 1., 0.),
-            v(0., 0., 1.),
-            v(1., 0., 1.),
-            v(1., 1., 1.),
-            v(0., 1., 1.),
-        ],
-        CellKind::PentagonalPrism => ngon(5),
-        _ => ngon(6),
-    }
-}
-
 /// 64 random pieces of `kind` with their cameras.
 fn pieces(kind: CellKind, ortho: bool, seed: u64) -> Vec<(Polyhedron, Camera)> {
     let mut rng = Rng(seed);
-    let r = reference(kind);
+    let r = kind.reference_corners();
     (0..64)
         .map(|_| {
             let m = loop {

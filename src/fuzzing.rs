@@ -161,14 +161,7 @@ pub fn projection(data: &[u8]) {
     if data.len() < 20 {
         return;
     }
-    let kinds = [
-        CellKind::Tetra,
-        CellKind::Pyramid,
-        CellKind::Wedge,
-        CellKind::Hexahedron,
-        CellKind::PentagonalPrism,
-        CellKind::HexagonalPrism,
-    ];
+    let kinds = CellKind::FIXED;
     let kind = kinds[data[0] as usize % kinds.len()];
     let m = DMat3::from_cols_array(&std::array::from_fn(|k| quantised(data, 1 + k)));
     let params = CameraParams {
@@ -180,47 +173,7 @@ pub fn projection(data: &[u8]) {
         ortho: data[13] & 1 == 0,
         ..Default::default()
     };
-    let reference: Vec<DVec3> = match kind {
-        CellKind::Tetra => vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
-        CellKind::Pyramid => vec![
-            DVec3::ZERO,
-            DVec3::X,
-            DVec3::new(1., 1., 0.),
-            DVec3::Y,
-            DVec3::new(0.5, 0.5, 1.),
-        ],
-        CellKind::Wedge => vec![
-            DVec3::ZERO,
-            DVec3::X,
-            DVec3::Y,
-            DVec3::Z,
-            DVec3::new(1., 0., 1.),
-            DVec3::new(0., 1., 1.),
-        ],
-        CellKind::Hexahedron => vec![
-            DVec3::ZERO,
-            DVec3::X,
-            DVec3::new(1., 1., 0.),
-            DVec3::Y,
-            DVec3::Z,
-            DVec3::new(1., 0., 1.),
-            DVec3::new(1., 1., 1.),
-            DVec3::new(0., 1., 1.),
-        ],
-        _ => {
-            let n = if kind == CellKind::PentagonalPrism {
-                5
-            } else {
-                6
-            };
-            (0..2 * n)
-                .map(|i| {
-                    let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
-                    DVec3::new(a.cos(), a.sin(), (i / n) as f64)
-                })
-                .collect()
-        }
-    };
+    let reference = kind.reference_corners();
     let pts: Vec<DVec3> = reference.iter().map(|&p| m * p).collect();
     if m.determinant().abs() < 1e-3 {
         return;

@@ -150,6 +150,65 @@ const HEXA_PRISM_EDGES: &[[u8; 2]] = &[
 ];
 
 impl CellKind {
+    /// The kinds with a fixed node list (every kind but
+    /// [`CellKind::Polyhedron`]), all convex in their reference shape.
+    pub const FIXED: [CellKind; 6] = [
+        CellKind::Tetra,
+        CellKind::Pyramid,
+        CellKind::Wedge,
+        CellKind::Hexahedron,
+        CellKind::PentagonalPrism,
+        CellKind::HexagonalPrism,
+    ];
+
+    /// Corners of the kind's unit reference cell in its VTK node order:
+    /// convex with planar faces (unit simplex corners, unit square base and
+    /// apex above its centre, unit cube; the prisms on the unit circle from
+    /// `z = 0` to `z = 1`). Empty for [`CellKind::Polyhedron`]. Tests,
+    /// benchmarks and fuzzing map it affinely to make random cells.
+    pub fn reference_corners(self) -> Vec<glam::DVec3> {
+        let v = glam::DVec3::new;
+        let ngon = |n: usize| -> Vec<glam::DVec3> {
+            (0..2 * n)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
+                    v(a.cos(), a.sin(), (i / n) as f64)
+                })
+                .collect()
+        };
+        match self {
+            CellKind::Tetra => vec![v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.), v(0., 0., 1.)],
+            CellKind::Pyramid => vec![
+                v(0., 0., 0.),
+                v(1., 0., 0.),
+                v(1., 1., 0.),
+                v(0., 1., 0.),
+                v(0.5, 0.5, 1.),
+            ],
+            CellKind::Wedge => vec![
+                v(0., 0., 0.),
+                v(1., 0., 0.),
+                v(0., 1., 0.),
+                v(0., 0., 1.),
+                v(1., 0., 1.),
+                v(0., 1., 1.),
+            ],
+            CellKind::Hexahedron => vec![
+                v(0., 0., 0.),
+                v(1., 0., 0.),
+                v(1., 1., 0.),
+                v(0., 1., 0.),
+                v(0., 0., 1.),
+                v(1., 0., 1.),
+                v(1., 1., 1.),
+                v(0., 1., 1.),
+            ],
+            CellKind::PentagonalPrism => ngon(5),
+            CellKind::HexagonalPrism => ngon(6),
+            CellKind::Polyhedron => Vec::new(),
+        }
+    }
+
     /// Number of corner nodes; `None` for general polyhedra (variable).
     pub fn corner_count(self) -> Option<usize> {
         match self {
@@ -296,14 +355,7 @@ mod tests {
 
     #[test]
     fn every_edge_is_in_exactly_two_faces() {
-        for kind in [
-            CellKind::Tetra,
-            CellKind::Pyramid,
-            CellKind::Wedge,
-            CellKind::Hexahedron,
-            CellKind::PentagonalPrism,
-            CellKind::HexagonalPrism,
-        ] {
+        for kind in CellKind::FIXED {
             for e in kind.edges() {
                 let mut n = 0;
                 for f in kind.faces() {

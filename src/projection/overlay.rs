@@ -634,56 +634,7 @@ mod tests {
         }
     }
 
-    fn reference(kind: CellKind) -> Vec<DVec3> {
-        let v = DVec3::new;
-        let ngon = |n: usize| -> Vec<DVec3> {
-            (0..2 * n)
-                .map(|i| {
-                    let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
-                    v(a.cos(), a.sin(), (i / n) as f64)
-                })
-                .collect()
-        };
-        match kind {
-            CellKind::Tetra => vec![v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.), v(0., 0., 1.)],
-            CellKind::Pyramid => vec![
-                v(0., 0., 0.),
-                v(1., 0., 0.),
-                v(1., 1., 0.),
-                v(0., 1., 0.),
-                v(0.5, 0.5, 1.),
-            ],
-            CellKind::Wedge => vec![
-                v(0., 0., 0.),
-                v(1., 0., 0.),
-                v(0., 1., 0.),
-                v(0., 0., 1.),
-                v(1., 0., 1.),
-                v(0., 1., 1.),
-            ],
-            CellKind::Hexahedron => vec![
-                v(0., 0., 0.),
-                v(1., 0., 0.),
-                v(1., 1., 0.),
-                v(0., 1., 0.),
-                v(0., 0., 1.),
-                v(1., 0., 1.),
-                v(1., 1., 1.),
-                v(0., 1., 1.),
-            ],
-            CellKind::PentagonalPrism => ngon(5),
-            _ => ngon(6),
-        }
-    }
-
-    const KINDS: [CellKind; 6] = [
-        CellKind::Tetra,
-        CellKind::Pyramid,
-        CellKind::Wedge,
-        CellKind::Hexahedron,
-        CellKind::PentagonalPrism,
-        CellKind::HexagonalPrism,
-    ];
+    const KINDS: [CellKind; 6] = CellKind::FIXED;
 
     /// A random affine image of `kind`'s reference cell (or the reference
     /// itself, axis-aligned views then see faces edge-on, or nearly: tilted
@@ -695,7 +646,7 @@ mod tests {
         axis: bool,
         tilt: f64,
     ) -> (Polyhedron, Camera) {
-        let r = reference(kind);
+        let r = kind.reference_corners();
         let m = if axis {
             DMat3::IDENTITY
         } else {

@@ -49,7 +49,7 @@ use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL, TF_SLO
 use crate::projection::{refine, slice_tet, ClipValue, Clipper, Polyhedron, Projected, Projector};
 use crate::tf::TransferFunction;
 use crate::visibility::bsp::Fragment;
-use crate::visibility::slabs::{bands as slab_bands, slab_order};
+use crate::visibility::slabs::{bands as slab_bands, inner_levels, slab_order};
 use crate::visibility::{Piece, Sorter, SplitPolicy, NO_LEVEL};
 
 use super::group::composite_group;
@@ -76,6 +76,15 @@ pub struct ExactStats {
     pub gpu: FrameStats,
     pub gpu_total_s: f64,
     pub order: crate::visibility::OrderStats,
+}
+
+/// The smallest and largest of `values` (`(inf, -inf)` when empty).
+pub(super) fn value_range(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
+    values
+        .into_iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        })
 }
 
 /// Output of one chunk: vertices and triangles ready for the GPU.
@@ -138,20 +147,37 @@ impl Ctx<'_> {
                 Ok(())
             }
             Piece::Slab { tet, lo, hi, .. } => {
-                let (p, s) = self.tet_view(cell, tet);
-                let whole = Polyhedron::from_tet(p, s);
-                let (lo, hi) = self.band(lo, hi);
-                match Clipper::default().clip(&whole, ClipValue::Scalar, lo, hi, poly) {
-                    Ok(true) => Ok(()),
-                    Ok(false) => {
-                        poly.clear();
-                        Ok(())
-                    }
-                    Err(e) => Err(format!("cell {cell}: {e}")),
+                let mut whole = Polyhedron::default();
+                let mut clipper = Clipper::default();
+                if !self.slab(cell, tet, lo, hi, &mut clipper, &mut whole, poly)? {
+                    poly.clear();
                 }
+                Ok(())
             }
             Piece::Frag { tet, frag, .. } => self.fragment(cell, tet, frag, poly),
         }
+    }
+
+    /// Clips tet `tet` of `cell` to the band of a slab ([`Piece::Slab`]),
+    /// through `whole` (scratch), into `poly`; `Ok(false)` when nothing of
+    /// positive volume is left.
+    #[allow(clippy::too_many_arguments)]
+    fn slab(
+        &self,
+        cell: u32,
+        tet: [u32; 4],
+        lo: u32,
+        hi: u32,
+        clipper: &mut Clipper,
+        whole: &mut Polyhedron,
+        poly: &mut Polyhedron,
+    ) -> Result<bool, String> {
+        let (p, s) = self.tet_view(cell, tet);
+        let (lo, hi) = self.band(lo, hi);
+        whole.set_tet(p, s);
+        clipper
+            .clip(whole, ClipValue::Scalar, lo, hi, poly)
+            .map_err(|e| format!("cell {cell}: {e}"))
     }
 
     /// The view-space polyhedron of fragment `frag` of a tet.
@@ -237,11 +263,7 @@ fn push_projected(
     let depth = vals.iter().map(|v| v.depth).fold(0.0, f64::max).min(1.0);
     let spread = (0..3)
         .map(|k| {
-            let (lo, hi) = vals
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                    (lo.min(v.glow[k]), hi.max(v.glow[k]))
-                });
+            let (lo, hi) = value_range(vals.iter().map(|v| v.glow[k]));
             hi - lo
         })
         .fold(0.0, f64::max);
@@ -347,13 +369,7 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
         match *piece {
             Piece::Cell(c) => {
                 let nodes = ctx.mesh.cells.nodes(c as usize);
-                let (lo, hi) =
-                    nodes
-                        .iter()
-                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &n| {
-                            let s = ctx.scalar(c, n);
-                            (lo.min(s), hi.max(s))
-                        });
+                let (lo, hi) = value_range(nodes.iter().map(|&n| ctx.scalar(c, n)));
                 if ctx.invisible(lo, hi) {
                     out.culled += 1;
                     continue;
@@ -376,8 +392,7 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
             }
             Piece::Tet { tet, .. } => {
                 let (p, s) = ctx.tet_view(cell, tet);
-                let lo = s.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = s.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let (lo, hi) = value_range(s);
                 if ctx.invisible(lo, hi) {
                     out.culled += 1;
                     continue;
@@ -408,27 +423,14 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                     out.error = Some(e);
                     return out;
                 }
-                let (lo, hi) = whole
-                    .scalars
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &s| {
-                        (lo.min(s), hi.max(s))
-                    });
+                let (lo, hi) = value_range(whole.scalars.iter().copied());
                 if ctx.invisible(lo, hi) {
                     out.culled += 1;
                     continue;
                 }
                 // Breakpoints inside: the fragment's bands, back to front
                 // along the tet's gradient.
-                let mut levels: Vec<f64> = ctx
-                    .breakpoints
-                    .iter()
-                    .copied()
-                    .filter(|&b| b > lo && b < hi)
-                    .collect();
-                levels.sort_by(f64::total_cmp);
-                levels.dedup();
-                let bands = slab_bands(&levels);
+                let bands = slab_bands(&ctx.levels[inner_levels(&whole.scalars, ctx.levels)]);
                 let (p, s) = ctx.tet_view(cell, tet);
                 for i in slab_order(&p, &s, &bands, ctx.camera.ortho) {
                     let (blo, bhi) = bands[i];
@@ -452,20 +454,17 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                 }
             }
             Piece::Slab { tet, lo, hi, .. } => {
-                let (p, s) = ctx.tet_view(cell, tet);
                 let (blo, bhi) = ctx.band(lo, hi);
-                let smin = s.iter().copied().fold(f64::INFINITY, f64::min).max(blo);
-                let smax = s.iter().copied().fold(f64::NEG_INFINITY, f64::max).min(bhi);
-                if ctx.invisible(smin, smax) {
+                let (smin, smax) = value_range(tet.map(|n| ctx.scalar(cell, n)));
+                if ctx.invisible(smin.max(blo), smax.min(bhi)) {
                     out.culled += 1;
                     continue;
                 }
-                whole.set_tet(p, s);
-                match clipper.clip(&whole, ClipValue::Scalar, blo, bhi, &mut poly) {
+                match ctx.slab(cell, tet, lo, hi, &mut clipper, &mut whole, &mut poly) {
                     Ok(true) => {}
                     Ok(false) => continue,
                     Err(e) => {
-                        out.error = Some(format!("cell {cell}: {e}"));
+                        out.error = Some(e);
                         return out;
                     }
                 }

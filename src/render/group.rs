@@ -44,7 +44,7 @@ use crate::integrate::segment;
 use crate::projection::Polyhedron;
 use crate::visibility::Piece;
 
-use super::exact::{ChunkOut, Ctx};
+use super::exact::{value_range, ChunkOut, Ctx};
 
 /// Optical depth given to a fully opaque pixel (alpha = 1 - exp(-depth) is 1
 /// in f32 well before this; the exponential table clamps far above it).
@@ -84,12 +84,7 @@ pub(super) fn composite_group(ctx: &Ctx, pieces: &[Piece], out: &mut ChunkOut) -
             out.error = Some(e);
             return 0;
         }
-        let (lo, hi) = poly
-            .scalars
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &s| {
-                (lo.min(s), hi.max(s))
-            });
+        let (lo, hi) = value_range(poly.scalars.iter().copied());
         if ctx.invisible(lo, hi) {
             out.culled += 1;
             continue;

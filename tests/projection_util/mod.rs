@@ -25,60 +25,7 @@ impl Rng {
     }
 }
 
-pub const KINDS: [CellKind; 6] = [
-    CellKind::Tetra,
-    CellKind::Pyramid,
-    CellKind::Wedge,
-    CellKind::Hexahedron,
-    CellKind::PentagonalPrism,
-    CellKind::HexagonalPrism,
-];
-
-/// Reference corners of a cell kind (convex, planar faces).
-pub fn reference(kind: CellKind) -> Vec<DVec3> {
-    let v = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
-    let ngon = |n: usize| -> Vec<DVec3> {
-        let mut p = Vec::new();
-        for z in [0.0, 1.0] {
-            for k in 0..n {
-                let a = std::f64::consts::TAU * k as f64 / n as f64;
-                p.push(v(a.cos(), a.sin(), z));
-            }
-        }
-        p
-    };
-    match kind {
-        CellKind::Tetra => vec![v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.), v(0., 0., 1.)],
-        CellKind::Pyramid => vec![
-            v(0., 0., 0.),
-            v(1., 0., 0.),
-            v(1., 1., 0.),
-            v(0., 1., 0.),
-            v(0.5, 0.5, 1.),
-        ],
-        CellKind::Wedge => vec![
-            v(0., 0., 0.),
-            v(1., 0., 0.),
-            v(0., 1., 0.),
-            v(0., 0., 1.),
-            v(1., 0., 1.),
-            v(0., 1., 1.),
-        ],
-        CellKind::Hexahedron => vec![
-            v(0., 0., 0.),
-            v(1., 0., 0.),
-            v(1., 1., 0.),
-            v(0., 1., 0.),
-            v(0., 0., 1.),
-            v(1., 0., 1.),
-            v(1., 1., 1.),
-            v(0., 1., 1.),
-        ],
-        CellKind::PentagonalPrism => ngon(5),
-        CellKind::HexagonalPrism => ngon(6),
-        CellKind::Polyhedron => Vec::new(),
-    }
-}
+pub const KINDS: [CellKind; 6] = CellKind::FIXED;
 
 /// A random well-conditioned affine map.
 pub fn random_affine(rng: &mut Rng) -> (DMat3, DVec3) {
@@ -99,7 +46,7 @@ pub fn random_affine(rng: &mut Rng) -> (DMat3, DVec3) {
 /// One random convex cell of `kind`: world points (ids shuffled so the
 /// diagonals vary), cells, scalars.
 pub fn random_cell(kind: CellKind, rng: &mut Rng) -> (Vec<DVec3>, Cells, Vec<f64>) {
-    let r = reference(kind);
+    let r = kind.reference_corners();
     let (m, t) = random_affine(rng);
     let n = r.len();
     // Random global ids: a permutation of 0..n.
