@@ -46,7 +46,7 @@ use crate::integrate::{vertex_values, VertexValues};
 use crate::mesh::Mesh;
 use crate::numeric::predicates::{orient2d, Side};
 use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL, TF_SLOPE_REL};
-use crate::projection::{refine, slice_tet, ClipValue, Clipper, Polyhedron, Projected, Projector};
+use crate::projection::{refine, ClipValue, Clipper, Polyhedron, Projected, Projector};
 use crate::tf::TransferFunction;
 use crate::visibility::bsp::Fragment;
 use crate::visibility::slabs::{bands as slab_bands, inner_levels, slab_order};
@@ -397,26 +397,14 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                     out.culled += 1;
                     continue;
                 }
-                if !ctx.breakpoints.iter().any(|&b| b > lo && b < hi) {
-                    poly.set_tet(p, s);
-                    if let Err(e) = projector.project(&poly, ctx.camera, &mut proj) {
-                        out.error = Some(format!("cell {cell}: {e}"));
-                        return out;
-                    }
-                    push_projected(ctx, &mut proj, &mut vals, &mut out);
-                    continue;
+                // A tet holding a breakpoint comes as its slabs
+                // (`Piece::Slab`): the TF is linear on this one.
+                poly.set_tet(p, s);
+                if let Err(e) = projector.project(&poly, ctx.camera, &mut proj) {
+                    out.error = Some(format!("cell {cell}: {e}"));
+                    return out;
                 }
-                // A tet the order did not slice (an order made without the
-                // nodal scalars): sliced here, back to front.
-                let slabs = slice_tet(p, s, ctx.breakpoints, ctx.camera);
-                out.slabs += slabs.len();
-                for slab in &slabs {
-                    if let Err(e) = projector.project(slab, ctx.camera, &mut proj) {
-                        out.error = Some(format!("cell {cell}: {e}"));
-                        return out;
-                    }
-                    push_projected(ctx, &mut proj, &mut vals, &mut out);
-                }
+                push_projected(ctx, &mut proj, &mut vals, &mut out);
             }
             Piece::Frag { tet, frag, .. } => {
                 if let Err(e) = ctx.fragment(cell, tet, frag, &mut whole) {

@@ -125,10 +125,9 @@ pub(super) fn composite_group(ctx: &Ctx, pieces: &[Piece], out: &mut ChunkOut) -
                     continue;
                 }
                 hits.sort_by(|a, b| (a.t_in + a.t_out).total_cmp(&(b.t_in + b.t_out)));
-                let speed = d.length();
                 let (mut color, mut depth, mut trans) = ([0.0; 3], 0.0, 1.0);
                 for h in &hits {
-                    let seg = segment(ctx.tf, (h.t_out - h.t_in) * speed, h.s_in, h.s_out);
+                    let seg = segment(ctx.tf, h.t_out - h.t_in, h.s_in, h.s_out);
                     for (c, sc) in color.iter_mut().zip(seg.color) {
                         *c += trans * sc;
                     }
@@ -169,18 +168,12 @@ pub(super) fn composite_group(ctx: &Ctx, pieces: &[Piece], out: &mut ChunkOut) -
     pixels
 }
 
-/// The ray through continuous pixel position `(px, py)` in view space:
-/// origin and (unnormalised) direction; perspective directions have `z = 1`
-/// so the parameter is the view depth.
+/// The pixel-centre ray through continuous pixel position `(px, py)`
+/// ([`Camera::ray_at`]) in view space: origin and unit direction.
 fn view_ray(camera: &Camera, px: f64, py: f64) -> (DVec3, DVec3) {
-    let (hw, hh) = camera.half_extent();
-    let x = (2.0 * px / camera.width as f64 - 1.0) * hw;
-    let y = (1.0 - 2.0 * py / camera.height as f64) * hh;
-    if camera.ortho {
-        (DVec3::new(x, y, 0.0), DVec3::Z)
-    } else {
-        (DVec3::ZERO, DVec3::new(x, y, 1.0))
-    }
+    let r = camera.ray_at(px, py);
+    let o = camera.to_view(r.origin);
+    (o, camera.to_view(r.origin + r.dir) - o)
 }
 
 /// Planes and pixel box of a piece; `None` when it has no volume or lies
