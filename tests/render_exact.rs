@@ -220,3 +220,62 @@ fn shared_datasets() {
         check_file(&path, rel.split('/').next().unwrap_or(rel), whole, whole);
     }
 }
+
+/// Coverage culling (`projection::coverage`) only leaves out triangles that
+/// contain no pixel centre, so the image is the same with and without it,
+/// in both projections, with slabs (kinked TF) and whole cells: bit for
+/// bit; and it does leave triangles out (so this test can fail).
+#[test]
+fn coverage_culling_changes_no_pixel() {
+    if !gpu_available() {
+        return;
+    }
+    let mut files = vec![
+        mesh_file("curvilinear_4x4x4.vtu"),
+        mesh_file("zoo_3x3x3.vtu"),
+    ];
+    files.extend(shared_file("bluntfin/bluntfin_converted.vts"));
+    for path in files {
+        let mesh = io::read(&path, &ReadOptions::default()).unwrap();
+        let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        for kinked in [false, true] {
+            if kinked {
+                scene.tf = kinked_tf(scene.range, scene.unit_distance);
+            }
+            for ortho in [false, true] {
+                let mut triangles = [0u64; 2];
+                let mut images = Vec::new();
+                for (k, cull) in [false, true].into_iter().enumerate() {
+                    let opts = RenderOptions {
+                        camera: CameraParams {
+                            // Small enough that many triangles miss every
+                            // pixel centre.
+                            width: 96,
+                            height: 80,
+                            azimuth: 20.0,
+                            elevation: 35.0,
+                            ortho,
+                            ..Default::default()
+                        },
+                        cull_to_pixels: cull,
+                        ..Default::default()
+                    };
+                    let (img, stats) = Renderer::new(&scene).render(&opts, |_, _| {}).unwrap();
+                    triangles[k] = stats.exact.unwrap().gpu.triangles;
+                    images.push(img);
+                }
+                let tag = format!("{} kinked={kinked} ortho={ortho}", path.display());
+                assert!(
+                    triangles[1] < triangles[0],
+                    "{tag}: culling dropped nothing ({triangles:?})"
+                );
+                let (a, b) = (&images[0], &images[1]);
+                for j in 0..a.height {
+                    for i in 0..a.width {
+                        assert_eq!(a.get(i, j), b.get(i, j), "{tag}: pixel ({i}, {j})");
+                    }
+                }
+            }
+        }
+    }
+}

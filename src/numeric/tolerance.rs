@@ -59,6 +59,16 @@ pub const NEAR_CLIP_SCALE: f64 = 2.0;
 /// any margin of at least half a pixel loses nothing. A few pixels keep the
 /// window's own edges well away from every centre.
 pub const IMAGE_CLIP_MARGIN_PX: f64 = 4.0;
+/// Coverage culling ([`crate::projection::coverage`]): a region triangle is
+/// dropped only when no pixel centre lies within this many pixels of it.
+/// The GPU rasterises `f32` clip coordinates snapped to its sub-pixel grid:
+/// with 8 bits of sub-pixel precision (D3D12 and Metal require it; Mesa's
+/// lavapipe and llvmpipe and the desktop Vulkan/GL drivers have it) a vertex
+/// moves by at most `sqrt(2) / 512 = 0.0028` px, and `f32` rounding of
+/// positions adds at most ~1e-3 px up to 16384-pixel images. 1/64 px is
+/// four times their sum; a device with only Vulkan's minimum of 4 bits
+/// (0.044 px) could differ at centres within 0.03 px of a dropped sliver.
+pub const COVERAGE_MARGIN_PX: f64 = 1.0 / 64.0;
 
 /// Projection (perspective): region values are interpolated linearly in
 /// screen space. Region edges whose interpolation error bound (screen-space

@@ -17,6 +17,7 @@
 //!   per-vertex values, fan triangles);
 //! - `refine`: conforming midpoint refinement of region triangles, for the
 //!   perspective error bound and for colour accuracy ([`refine`]);
+//! - `coverage`: which triangles can colour a pixel centre (culling);
 //! - `clip`: band clipping (near plane, slabs); `slabs`: [`slice_tet`];
 //! - `polyhedron`: the input type and its builders.
 //!
@@ -38,6 +39,7 @@
 
 mod arrangement;
 mod clip;
+pub mod coverage;
 mod exact;
 mod overlay;
 mod polyhedron;

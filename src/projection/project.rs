@@ -35,12 +35,19 @@
 //!    [`Projector::clip_to_image`] the regions are then clipped to the image
 //!    rectangle plus a margin (near-plane caps project ~1e9 pixels away);
 //! 7. perspective only: conforming midpoint refinement (`refine`) until the
-//!    screen-space interpolation error bound holds.
+//!    screen-space interpolation error bound holds;
+//! 8. with [`Projector::cull_to_pixels`] (renderers), what cannot colour a
+//!    pixel centre is left out (`coverage`): the whole piece right after
+//!    step 2 when its bounding box holds no centre, and triangles that
+//!    contain none after step 6 and again after step 7 (refinement decides
+//!    per edge from the edge's own vertices, so dropping a neighbour
+//!    changes nothing in what is kept).
 
 use glam::DVec2;
 
 use super::arrangement::{is_outer, Arrangement, Piece};
 use super::clip::{ClipValue, Clipper};
+use super::coverage::PixelGrid;
 use super::overlay::Overlay;
 use super::polyhedron::Polyhedron;
 use super::subdivision::NIL;
@@ -68,6 +75,12 @@ pub struct Projector {
     /// image-sized. New vertices get exact values from their region's
     /// triangles, like refinement midpoints.
     pub clip_to_image: bool,
+    /// Leave out what cannot colour a pixel centre of the image
+    /// ([`super::coverage`]): a piece whose projected points' bounding box
+    /// holds no centre yields nothing, and triangles that contain none are
+    /// dropped (before and after the perspective refinement). Off by
+    /// default (regions then tile the silhouette); renderers turn it on.
+    pub cull_to_pixels: bool,
     /// Take the fast path (`overlay`) for pieces in general position (on by
     /// default; the general path, through the arrangement, is always taken
     /// when [`Self::check_each_insertion`] is set).
@@ -105,6 +118,7 @@ impl Default for Projector {
             perspective_refine: true,
             max_refine_depth: 6,
             clip_to_image: false,
+            cull_to_pixels: false,
             fast_path: true,
             took_fast_path: false,
             clipper: Clipper::default(),
@@ -191,6 +205,16 @@ impl Projector {
             }
             self.pix.push(DVec2::new(px, py));
         }
+        let grid = PixelGrid::new(camera.width, camera.height);
+        if self.cull_to_pixels {
+            let (lo, hi) = self.pix.iter().fold(
+                (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+                |(lo, hi), &p| (lo.min(p), hi.max(p)),
+            );
+            if !grid.box_reaches(lo, hi) {
+                return Ok(()); // draws no pixel
+            }
+        }
         self.canon.clear();
         let mut distinct = true;
         for i in 0..n {
@@ -232,6 +256,9 @@ impl Projector {
         if self.clip_to_image {
             self.window.clip(out);
         }
+        if self.cull_to_pixels {
+            out.cull_to_pixels(&grid);
+        }
         // 7. Perspective refinement.
         if !camera.ortho && self.perspective_refine {
             let (smin, smax) = poly
@@ -256,6 +283,7 @@ impl Projector {
             } else {
                 srange
             };
+            let before = out.triangles.len();
             super::refine::refine_perspective(
                 out,
                 srange,
@@ -263,6 +291,9 @@ impl Projector {
                 self.max_refine_depth,
                 &mut self.refine,
             );
+            if self.cull_to_pixels && out.triangles.len() != before {
+                out.cull_to_pixels(&grid);
+            }
         }
         Ok(())
     }

@@ -38,14 +38,13 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::camera::Camera;
-use crate::gpu::{
-    AccumFormat, Context, ExactVertex, Frame, FrameOptions, FrameStats, GpuOptions, PendingContext,
-};
+use crate::gpu::{Context, ExactVertex, Frame, FrameOptions, FrameStats, PendingContext};
 use crate::image::Image;
 use crate::integrate::{vertex_values, VertexValues};
 use crate::mesh::Mesh;
 use crate::numeric::predicates::{orient2d, Side};
 use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL, TF_SLOPE_REL};
+use crate::projection::coverage::PixelGrid;
 use crate::projection::{refine, ClipValue, Clipper, Polyhedron, Projected, Projector};
 use crate::tf::TransferFunction;
 use crate::visibility::bsp::Fragment;
@@ -54,7 +53,7 @@ use crate::visibility::{Piece, Sorter, SplitPolicy, NO_LEVEL};
 
 use super::group::composite_group;
 use super::scene::{ScalarsRef, Scene};
-use super::RenderError;
+use super::{RenderError, RenderOptions};
 
 /// Pieces processed per parallel chunk.
 const CHUNK: usize = 2048;
@@ -98,6 +97,10 @@ pub(super) struct ChunkOut {
     /// Triangles dropped as degenerate in f32 ([`gpu_area_positive`]).
     degenerate: usize,
     pub(super) error: Option<String>,
+    /// Scratch of [`push_projected`]: vertices used by a triangle, and
+    /// their index in `vertices`.
+    scratch_used: Vec<bool>,
+    scratch_remap: Vec<u32>,
 }
 
 pub(super) struct Ctx<'a> {
@@ -112,6 +115,10 @@ pub(super) struct Ctx<'a> {
     fragments: &'a [Fragment],
     /// The frame's length unit ([`FrameOptions::length_unit`]).
     pub(super) length_unit: f64,
+    /// Leave out triangles that colour no pixel centre of `grid`
+    /// ([`crate::projection::coverage`]).
+    cull: bool,
+    grid: PixelGrid,
 }
 
 impl Ctx<'_> {
@@ -252,18 +259,35 @@ fn push_projected(
         return;
     }
     let tf = ctx.tf;
+    // Values only where a triangle uses the vertex (coverage culling leaves
+    // vertices of dropped triangles behind); `used` keeps the flags.
+    let used = &mut out.scratch_used;
+    used.clear();
+    used.resize(proj.vertices.len(), false);
+    for t in &proj.triangles {
+        for &i in t {
+            used[i as usize] = true;
+        }
+    }
     vals.clear();
-    vals.extend(
-        proj.vertices
-            .iter()
-            .map(|v| vertex_values(tf, v.l, v.s_front, v.s_back)),
-    );
+    vals.extend(proj.vertices.iter().zip(used.iter()).map(|(v, &u)| {
+        if u {
+            vertex_values(tf, v.l, v.s_front, v.s_back)
+        } else {
+            VertexValues::default()
+        }
+    }));
     // Refine only pieces whose optical depth and glow spread could make the
     // interpolated C/alpha err (the common thin or uniform piece skips it).
     let depth = vals.iter().map(|v| v.depth).fold(0.0, f64::max).min(1.0);
     let spread = (0..3)
         .map(|k| {
-            let (lo, hi) = value_range(vals.iter().map(|v| v.glow[k]));
+            let (lo, hi) = value_range(
+                vals.iter()
+                    .zip(used.iter())
+                    .filter(|(_, &u)| u)
+                    .map(|(v, _)| v.glow[k]),
+            );
             hi - lo
         })
         .fold(0.0, f64::max);
@@ -278,8 +302,12 @@ fn push_projected(
                 .fold(0.0, f64::max);
             depth * spread > COLOR_REFINE_TOL
         });
+        if ctx.cull {
+            proj.cull_to_pixels(&ctx.grid);
+        }
         out.refined += proj.triangles.len().saturating_sub(before);
         let n = vals.len();
+        used.resize(proj.vertices.len(), true);
         vals.extend(
             proj.vertices[n..]
                 .iter()
@@ -287,9 +315,16 @@ fn push_projected(
         );
     }
     let (w, h) = (ctx.camera.width as f64, ctx.camera.height as f64);
-    let base = out.vertices.len() as u32;
-    let k = depth_balance(proj, vals, ctx.length_unit);
-    for (v, vv) in proj.vertices.iter().zip(vals.iter()) {
+    let k = depth_balance(proj, ctx);
+    // Index of each used vertex in `out.vertices` (u32::MAX: not emitted).
+    let remap = &mut out.scratch_remap;
+    remap.clear();
+    for ((v, vv), &u) in proj.vertices.iter().zip(vals.iter()).zip(used.iter()) {
+        if !u {
+            remap.push(u32::MAX);
+            continue;
+        }
+        remap.push(out.vertices.len() as u32);
         let x = 2.0 * v.px / w - 1.0;
         let y = 1.0 - 2.0 * v.py / h;
         out.vertices.push(ExactVertex::new(
@@ -300,31 +335,38 @@ fn push_projected(
         ));
     }
     for t in &proj.triangles {
-        let [a, b, c] = t.map(|i| &out.vertices[(base + i) as usize]);
+        let idx = t.map(|i| remap[i as usize]);
+        let [a, b, c] = idx.map(|i| &out.vertices[i as usize]);
         if gpu_area_positive(a, b, c) {
-            out.indices.extend(t.iter().map(|&i| base + i));
+            out.indices.extend_from_slice(&idx);
         } else {
             out.degenerate += 1;
         }
     }
 }
 
-/// The factor `k` by which one piece's thicknesses are multiplied and its
-/// mean extinctions divided before they reach the GPU.
-///
-/// The fragment's opacity `1 - exp(-l tau)` depends on the product only,
-/// and a constant `k` over a triangle leaves the product of the two
-/// interpolants unchanged at every pixel. But the exponential table
-/// addresses `l' = l / unit` and `tau' = tau unit` on separate axes, each
-/// clamped to [`crate::gpu::exptable::AXIS_MAX`] = 1e6: a piece 1e-12 of
-/// the unit thin with extinction 1e12 per unit (optical depth 1) would
-/// read as depth 1e-6. Balancing the piece's largest `l'` and `tau'` to the
-/// same value, `sqrt(max l' max tau')`, keeps both inside the table for
-/// every optical depth up to 1e12 and puts them where its relative accuracy
-/// is best. `k = 1` when either maximum is zero or not finite.
-fn depth_balance(proj: &Projected, vals: &[VertexValues], unit: f64) -> f64 {
-    let l_max = proj.vertices.iter().map(|v| v.l).fold(0.0, f64::max) / unit;
-    let tau_max = vals.iter().map(|v| v.tau_mean).fold(0.0, f64::max) * unit;
+/// Per-piece scale `k` sending `l k` and `tau / k` to the shader (their
+/// product, the optical depth, is unchanged): it brings the largest `l` and
+/// the largest extinction of the TF over the piece's scalar range to the
+/// same size, so neither table axis clamps. It depends on every region
+/// vertex, not on which triangles coverage culling keeps, so culling changes
+/// no pixel.
+fn depth_balance(proj: &Projected, ctx: &Ctx) -> f64 {
+    let mut l_max: f64 = 0.0;
+    let (mut s_lo, mut s_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in &proj.vertices {
+        l_max = l_max.max(v.l);
+        s_lo = s_lo.min(v.s_front.min(v.s_back));
+        s_hi = s_hi.max(v.s_front.max(v.s_back));
+    }
+    let tf = ctx.tf;
+    let mut tau_max = tf.tau_at(s_lo).max(tf.tau_at(s_hi));
+    for &b in ctx.breakpoints {
+        if b > s_lo && b < s_hi {
+            tau_max = tau_max.max(tf.tau_at(b));
+        }
+    }
+    let (l_max, tau_max) = (l_max / ctx.length_unit, tau_max * ctx.length_unit);
     let k = (tau_max / l_max).sqrt();
     if l_max > 0.0 && tau_max > 0.0 && k.is_finite() && k > 0.0 {
         k
@@ -358,6 +400,7 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
     // regions to the image so that screen-space interpolation stays exact
     // up to the perspective refinement's bound.
     projector.clip_to_image = true;
+    projector.cull_to_pixels = ctx.cull;
     let mut poly = Polyhedron::default();
     let mut whole = Polyhedron::default();
     let mut clipper = Clipper::default();
@@ -547,10 +590,8 @@ pub fn render_exact(
     sorter: &mut Sorter,
     gpu: &mut Option<Context>,
     pending: &mut Option<PendingContext>,
-    gpu_opts: &GpuOptions,
+    opts: &RenderOptions,
     camera: &Camera,
-    split_all: bool,
-    format: AccumFormat,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<(Image, ExactStats), RenderError> {
     let mut stats = ExactStats::default();
@@ -561,7 +602,7 @@ pub fn render_exact(
     };
     let t0 = Instant::now();
     let policy = SplitPolicy {
-        all: split_all,
+        all: opts.split_all,
         breakpoints: &breakpoints,
         point_scalars,
     };
@@ -579,22 +620,24 @@ pub fn render_exact(
         levels: &order.levels,
         fragments: &order.fragments,
         length_unit: scene.unit_distance as f32 as f64,
+        cull: opts.cull_to_pixels,
+        grid: PixelGrid::new(camera.width, camera.height),
     };
     let t_open = Instant::now();
     if gpu.is_none() {
         *gpu = Some(match pending.take() {
-            Some(p) if p.options() == gpu_opts => p.wait()?,
-            _ => Context::new(gpu_opts)?,
+            Some(p) if p.options() == &opts.gpu => p.wait()?,
+            _ => Context::new(&opts.gpu)?,
         });
     }
     let Some(gpu) = gpu.as_ref() else {
         unreachable!("opened above")
     };
     stats.gpu_open_s = t_open.elapsed().as_secs_f64();
-    let mut opts = FrameOptions::new(camera.width, camera.height, format);
-    opts.length_unit = scene.unit_distance as f32;
+    let mut fopts = FrameOptions::new(camera.width, camera.height, opts.accum);
+    fopts.length_unit = scene.unit_distance as f32;
     let t_gpu = Instant::now();
-    let mut frame = gpu.begin_frame_with(&opts)?;
+    let mut frame = gpu.begin_frame_with(&fopts)?;
     let window = CHUNK * rayon::current_num_threads().max(1) * 2;
     let mut project_s = 0.0;
     let total = order.pieces.len();
@@ -699,6 +742,8 @@ mod tests {
             levels: &order.levels,
             fragments: &order.fragments,
             length_unit: scene.unit_distance,
+            cull: false,
+            grid: PixelGrid::new(camera.width, camera.height),
         };
         // Piece by piece, up to the first one that makes such a sliver (the
         // whole view refines into ~1e5 triangles).

@@ -92,6 +92,10 @@ pub struct RenderOptions {
     pub split_all: bool,
     pub gpu: GpuOptions,
     pub accum: AccumFormat,
+    /// Exact mode: leave out region triangles that contain no pixel centre
+    /// ([`crate::projection::coverage`]; on by default). The image is the
+    /// same either way; off only to check that.
+    pub cull_to_pixels: bool,
 }
 
 impl Default for RenderOptions {
@@ -103,6 +107,7 @@ impl Default for RenderOptions {
             split_all: false,
             gpu: GpuOptions::default(),
             accum: AccumFormat::Auto,
+            cull_to_pixels: true,
         }
     }
 }
@@ -209,10 +214,8 @@ impl<'s> Renderer<'s> {
                     &mut sorter,
                     &mut self.gpu,
                     &mut self.pending_gpu,
-                    &opts.gpu,
+                    opts,
                     &camera,
-                    opts.split_all,
-                    opts.accum,
                     progress,
                 );
                 self.sorter = Some(sorter);

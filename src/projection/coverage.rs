@@ -1,0 +1,251 @@
+//! Pixel-centre coverage: which pieces and triangles can colour a pixel.
+//!
+//! The rasteriser samples each pixel at its centre only (no multisampling),
+//! so a triangle that contains no pixel centre of the image draws nothing:
+//! dropping it changes no pixel, and spares its vertex integrals, its upload
+//! and the rasteriser's per-triangle setup (on a fine mesh most region
+//! triangles are thinner than a pixel: on the hex_shell benchmark 60% of
+//! them contain no centre).
+//!
+//! The tests are conservative. The GPU does not rasterise our `f64`
+//! positions but their `f32` clip coordinates snapped to its sub-pixel grid,
+//! so a centre just outside the `f64` triangle may be inside the drawn one;
+//! every test therefore grows the triangle by
+//! [`COVERAGE_MARGIN_PX`] (see there for the bound it covers). Rounding in
+//! the tests themselves (`f64`, ~1e-13 px) is far below that margin.
+//!
+//! - [`PixelGrid::box_reaches`]: whether the pixel-centre lattice of the
+//!   image has a point in a (grown) bounding box; a piece whose projected
+//!   points' box has none draws nothing at all.
+//! - [`PixelGrid::triangle_reaches`]: the lattice points in the triangle's
+//!   grown box, each tested against the three edge lines moved outwards by
+//!   the margin (signed distances, either winding; a degenerate triangle
+//!   keeps every centre near its line). Triangles whose box holds more than
+//!   [`MAX_CANDIDATES`] centres are kept untested: they are wide enough to
+//!   cover one except as long slivers, which cost little to draw.
+
+use glam::DVec2;
+
+use super::Projected;
+use crate::numeric::tolerance::COVERAGE_MARGIN_PX;
+
+/// Beyond this many candidate centres a triangle is kept without testing.
+pub const MAX_CANDIDATES: i64 = 16;
+
+/// The pixel centres `(i + 0.5, j + 0.5)`, `0 <= i < width`,
+/// `0 <= j < height`, in continuous pixel coordinates
+/// ([`crate::camera::Camera::view_to_pixel`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelGrid {
+    pub width: u32,
+    pub height: u32,
+}
+
+impl PixelGrid {
+    /// The grid of a `width` x `height` image.
+    pub fn new(width: u32, height: u32) -> PixelGrid {
+        PixelGrid { width, height }
+    }
+
+    /// Indices `i` of the centres `i + 0.5` in `[lo - m, hi + m]` within
+    /// `0..n` (`m` the margin), or `None` (also for NaN).
+    #[inline]
+    fn span(lo: f64, hi: f64, n: u32) -> Option<(i64, i64)> {
+        let last = n as f64 - 1.0;
+        let a = lo - COVERAGE_MARGIN_PX - 0.5;
+        let b = hi + COVERAGE_MARGIN_PX - 0.5;
+        // NaN compares false: no span.
+        if !(a <= last && b >= 0.0) {
+            return None;
+        }
+        let (a, b) = (a.max(0.0), b.min(last));
+        // ceil(a) and floor(b) of values in [0, n - 1] by truncation
+        // (`f64::ceil` is a library call on baseline x86-64).
+        let ia = a as i64;
+        let ia = ia + ((ia as f64) < a) as i64;
+        let ib = b as i64;
+        (ia <= ib).then_some((ia, ib))
+    }
+
+    /// Whether a pixel centre lies in the box `[min, max]` grown by the
+    /// margin.
+    pub fn box_reaches(&self, min: DVec2, max: DVec2) -> bool {
+        Self::span(min.x, max.x, self.width).is_some()
+            && Self::span(min.y, max.y, self.height).is_some()
+    }
+
+    /// Whether a pixel centre lies in triangle `a, b, c` (either winding)
+    /// grown by the margin (see module docs).
+    pub fn triangle_reaches(&self, a: DVec2, b: DVec2, c: DVec2) -> bool {
+        let min = a.min(b).min(c);
+        let max = a.max(b).max(c);
+        let (Some((i0, i1)), Some((j0, j1))) = (
+            Self::span(min.x, max.x, self.width),
+            Self::span(min.y, max.y, self.height),
+        ) else {
+            return false;
+        };
+        if (i1 - i0 + 1) * (j1 - j0 + 1) > MAX_CANDIDATES {
+            return true;
+        }
+        // Edge k from p[k] to p[k + 1]: the signed distance of q to its line
+        // is cross(d, q - p) / |d| (positive on the left); compared squared,
+        // `e < -m |d|` is `e < 0 && e^2 > m^2 |d|^2`.
+        let p = [a, b, c];
+        let d = [b - a, c - b, a - c];
+        let m2 = COVERAGE_MARGIN_PX * COVERAGE_MARGIN_PX;
+        let lim = d.map(|d| m2 * d.length_squared());
+        for j in j0..=j1 {
+            let y = j as f64 + 0.5;
+            for i in i0..=i1 {
+                let q = DVec2::new(i as f64 + 0.5, y);
+                let (mut left, mut right) = (true, true);
+                for k in 0..3 {
+                    let e = d[k].perp_dot(q - p[k]);
+                    let far = e * e > lim[k];
+                    left &= !(e < 0.0 && far);
+                    right &= !(e > 0.0 && far);
+                }
+                if left || right {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+impl Projected {
+    /// Drops the triangles that contain no pixel centre of `grid`
+    /// ([`PixelGrid::triangle_reaches`]); vertices and regions stay (a
+    /// vertex may now be used by no triangle). Returns how many were dropped.
+    pub fn cull_to_pixels(&mut self, grid: &PixelGrid) -> usize {
+        let before = self.triangles.len();
+        let mut w = 0;
+        for r in 0..before {
+            let t = self.triangles[r];
+            let [a, b, c] = t.map(|i| self.vertices[i as usize].pos());
+            if grid.triangle_reaches(a, b, c) {
+                self.triangles[w] = t;
+                self.triangle_region[w] = self.triangle_region[r];
+                w += 1;
+            }
+        }
+        self.triangles.truncate(w);
+        self.triangle_region.truncate(w);
+        before - w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Brute force: whether a pixel centre of the image lies within
+    /// `margin` of the closed triangle (true Euclidean distance).
+    fn brute(grid: &PixelGrid, p: [DVec2; 3], margin: f64) -> bool {
+        let seg = |q: DVec2, a: DVec2, b: DVec2| {
+            let d = b - a;
+            let t = if d.length_squared() > 0.0 {
+                ((q - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (q - (a + d * t)).length()
+        };
+        for j in 0..grid.height {
+            for i in 0..grid.width {
+                let q = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+                let e: Vec<f64> = (0..3)
+                    .map(|k| (p[(k + 1) % 3] - p[k]).perp_dot(q - p[k]))
+                    .collect();
+                let inside = e.iter().all(|&e| e >= 0.0) || e.iter().all(|&e| e <= 0.0);
+                let dist = (0..3)
+                    .map(|k| seg(q, p[k], p[(k + 1) % 3]))
+                    .fold(f64::INFINITY, f64::min);
+                if inside || dist <= margin {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    struct Lcg(u64);
+    impl Lcg {
+        fn f(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    #[test]
+    fn small_triangles_agree_with_brute_force() {
+        let grid = PixelGrid::new(12, 9);
+        let mut rng = Lcg(7);
+        let (mut kept, mut dropped, mut spared) = (0, 0, 0);
+        for _ in 0..20000 {
+            // Sub-pixel to few-pixel triangles, some reaching off the image.
+            let o = DVec2::new(rng.f() * 14.0 - 1.0, rng.f() * 11.0 - 1.0);
+            let s = 0.05 + 2.0 * rng.f() * rng.f();
+            let p = [
+                o,
+                o + DVec2::new(rng.f(), rng.f()) * s,
+                o + DVec2::new(rng.f(), rng.f()) * s,
+            ];
+            let fast = grid.triangle_reaches(p[0], p[1], p[2]);
+            // Never drops a triangle that reaches a centre with the margin.
+            if brute(&grid, p, COVERAGE_MARGIN_PX) {
+                assert!(fast, "{p:?} reaches a centre but was dropped");
+                kept += 1;
+            } else if fast {
+                // Kept though it misses: a centre in the grown box and
+                // within the margin of all three edge lines (past an acute
+                // corner), or too many candidates. Must stay rare.
+                spared += 1;
+            } else {
+                dropped += 1;
+            }
+        }
+        assert!(
+            spared * 50 < dropped,
+            "{spared} kept needlessly against {dropped} dropped"
+        );
+        // Both outcomes are exercised.
+        assert!(
+            kept > 1000 && dropped > 1000,
+            "{kept} kept, {dropped} dropped"
+        );
+    }
+
+    #[test]
+    fn centres_on_edges_and_degenerate_triangles_are_kept() {
+        let grid = PixelGrid::new(4, 4);
+        let c = DVec2::new(1.5, 1.5);
+        // A centre exactly on an edge, on a vertex, and a segment through it.
+        assert!(grid.triangle_reaches(c, DVec2::new(2.5, 1.5), DVec2::new(2.0, 1.0)));
+        assert!(grid.triangle_reaches(c, DVec2::new(1.9, 1.9), DVec2::new(1.9, 1.6)));
+        assert!(grid.triangle_reaches(DVec2::new(1.0, 1.0), DVec2::new(2.0, 2.0), c));
+        // Just inside the margin, and just outside it.
+        let e = COVERAGE_MARGIN_PX;
+        let tri = |dx: f64| {
+            let a = DVec2::new(1.5 + dx, 1.0);
+            grid.triangle_reaches(a, DVec2::new(1.5 + dx, 2.0), DVec2::new(1.9, 1.5))
+        };
+        assert!(tri(0.5 * e));
+        assert!(!tri(1.5 * e));
+        // Off the image: pixel centres outside 0..W do not count.
+        assert!(!grid.triangle_reaches(
+            DVec2::new(-3.0, 0.0),
+            DVec2::new(-0.6, 3.0),
+            DVec2::new(-0.6, 0.0)
+        ));
+        assert!(!grid.box_reaches(DVec2::new(4.1, 0.0), DVec2::new(9.0, 9.0)));
+        assert!(grid.box_reaches(DVec2::new(3.45, 0.0), DVec2::new(9.0, 9.0)));
+        // NaN reaches nothing rather than panicking.
+        assert!(!grid.box_reaches(DVec2::NAN, DVec2::NAN));
+    }
+}
