@@ -192,11 +192,11 @@ pub fn print_stats(stats: &RenderStats, load_s: f64) {
             e.group_pixels
         );
         eprintln!(
-            "project      {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles)",
+            "project+draw {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles)",
             e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles
         );
         eprintln!(
-            "gpu          {:.3} s  (upload {:.3}, wait {:.3}, readback {:.3}, {} batches)",
+            "gpu finish   {:.3} s  (upload {:.3}, wait {:.3}, readback {:.3}, {} batches)",
             e.gpu_total_s, e.gpu.upload_s, e.gpu.gpu_wait_s, e.gpu.readback_s, e.gpu.batches
         );
     }

@@ -71,8 +71,12 @@ pub struct ExactStats {
     pub sort_s: f64,
     /// Time spent opening (or waiting for) the GPU context.
     pub gpu_open_s: f64,
+    /// Projection, integrals and the draw calls, which overlap (window
+    /// k + 1 is projected while window k is uploaded and drawn).
     pub project_s: f64,
     pub gpu: FrameStats,
+    /// What the GPU had left after the last draw call: finishing and
+    /// reading the image back.
     pub gpu_total_s: f64,
     pub order: crate::visibility::OrderStats,
 }
@@ -639,7 +643,6 @@ pub fn render_exact(
     let t_gpu = Instant::now();
     let mut frame = gpu.begin_frame_with(&fopts)?;
     let window = CHUNK * rayon::current_num_threads().max(1) * 2;
-    let mut project_s = 0.0;
     let total = order.pieces.len();
     let mut done = 0;
     // Stretches of ordinary pieces, each followed by at most one group.
@@ -650,30 +653,41 @@ pub fn render_exact(
         start = g.end;
     }
     stretches.push((start..total, None));
+    // Window k + 1 is projected (on the rayon pool, from a scoped thread)
+    // while this thread hands window k to the GPU, so the pool never waits
+    // for uploads.
+    let tp = Instant::now();
+    let mut ready: Vec<ChunkOut> = Vec::new();
     for (plain, group) in stretches {
         for win in order.pieces[plain].chunks(window) {
-            let tp = Instant::now();
-            let outs: Vec<ChunkOut> = win
-                .par_chunks(CHUNK)
-                .map(|c| process_chunk(&ctx, c))
-                .collect();
-            project_s += tp.elapsed().as_secs_f64();
-            for out in outs {
-                push_out(&mut frame, out, &mut stats)?;
-            }
+            let projected = std::thread::scope(|s| {
+                let next = s.spawn(|| {
+                    win.par_chunks(CHUNK)
+                        .map(|c| process_chunk(&ctx, c))
+                        .collect::<Vec<ChunkOut>>()
+                });
+                let pushed = ready
+                    .drain(..)
+                    .try_for_each(|out| push_out(&mut frame, out, &mut stats));
+                let next = next.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+                pushed.map(|()| next)
+            })?;
+            ready = projected;
             done += win.len();
             progress(done, total);
         }
+        for out in ready.drain(..) {
+            push_out(&mut frame, out, &mut stats)?;
+        }
         if let Some(g) = group {
-            let tp = Instant::now();
             let mut out = ChunkOut::default();
             stats.group_pixels += composite_group(&ctx, &order.pieces[g.clone()], &mut out);
-            project_s += tp.elapsed().as_secs_f64();
             push_out(&mut frame, out, &mut stats)?;
             done += g.len();
             progress(done, total);
         }
     }
+    let project_s = tp.elapsed().as_secs_f64();
     let (image, fstats) = frame.finish_with_stats()?;
     stats.gpu = fstats;
     stats.project_s = project_s;
