@@ -206,7 +206,13 @@ impl Camera {
     /// depth; `None` when a perspective point is not in front of the near plane.
     #[inline]
     pub fn view_to_pixel(&self, v: DVec3) -> Option<(f64, f64, f64)> {
-        let (hw, hh) = self.half_extent();
+        self.view_to_pixel_with(v, self.half_extent())
+    }
+
+    /// [`Self::view_to_pixel`] with [`Self::half_extent`] given (computed
+    /// once for many points: the same operations, bit-identical results).
+    #[inline]
+    pub fn view_to_pixel_with(&self, v: DVec3, (hw, hh): (f64, f64)) -> Option<(f64, f64, f64)> {
         let (x, y) = if self.ortho {
             (v.x, v.y)
         } else {

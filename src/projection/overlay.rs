@@ -141,9 +141,8 @@ pub(super) struct Overlay {
     fronts: Vec<u32>,
     backs: Vec<u32>,
     succ: Vec<u32>,
-    /// `orient2d(a, b, v)` of point `v` and edge `a < b` (index
-    /// `v * edges + e`), 2 while not computed.
-    side: Vec<i8>,
+    /// `orient2d(a, b, v)` of point `v` and edge `a < b`, cached.
+    sides: Sides,
     /// Crossing vertex of front edge `i` and back edge `j` (`i * nb + j`),
     /// `NIL` for none, [`UNKNOWN`] before it is computed.
     cross: Vec<u32>,
@@ -163,6 +162,57 @@ pub(super) struct Overlay {
     pub region_start: Vec<u32>,
     /// Front and back triangle of each region.
     pub face_fb: Vec<[u32; 2]>,
+}
+
+/// Cached exact sides of points against edges: `orient2d(a, b, v)` of
+/// point `v` and edge `a < b`, as a sign, computed on first use.
+#[derive(Clone, Debug, Default)]
+struct Sides {
+    /// Index `e * MAX_POINTS + v`; 2 while not computed.
+    s: Vec<i8>,
+    /// Ends `a < b` of each edge.
+    ends: Vec<[u32; 2]>,
+}
+
+impl Sides {
+    fn reset(&mut self, edges: &[Edge]) {
+        self.ends.clear();
+        self.ends.extend(edges.iter().map(|e| [e.a, e.b]));
+        self.s.clear();
+        self.s.resize(edges.len() * MAX_POINTS, 2);
+    }
+
+    /// Side of point `v` of edge `e` (from its smaller end).
+    #[inline(always)]
+    fn get(&mut self, pix: &[DVec2], v: u32, e: u32) -> i8 {
+        let i = e as usize * MAX_POINTS + v as usize;
+        let s = self.s[i];
+        if s != 2 {
+            return s;
+        }
+        self.compute(pix, v, e, i)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn compute(&mut self, pix: &[DVec2], v: u32, e: u32, i: usize) -> i8 {
+        let [a, b] = self.ends[e as usize];
+        let s = sign(orient2d(pix[a as usize], pix[b as usize], pix[v as usize]));
+        self.s[i] = s;
+        s
+    }
+
+    /// Side of point `v` of a triangle's edge `h` (counter-clockwise:
+    /// positive is the triangle's side).
+    #[inline(always)]
+    fn tri(&mut self, pix: &[DVec2], v: u32, h: TriEdge) -> i8 {
+        let s = self.get(pix, v, h.e);
+        if h.fwd {
+            s
+        } else {
+            -s
+        }
+    }
 }
 
 fn sign(s: Side) -> i8 {
@@ -350,9 +400,7 @@ impl Overlay {
         // degenerate), nor a silhouette vertex (an extreme point of `S`)
         // inside any: only vertices of one kind against edges of the other
         // remain.
-        let ne = self.edges.len();
-        self.side.clear();
-        self.side.resize(n * ne, 2);
+        self.sides.reset(&self.edges);
         self.vkind.clear();
         self.vkind.resize(n, 0);
         for (t, c) in self.ccw.iter().enumerate() {
@@ -383,7 +431,7 @@ impl Overlay {
                 {
                     continue;
                 }
-                if self.side(pix, v as u32, e) == 0 {
+                if self.sides.get(pix, v as u32, e) == 0 {
                     return false;
                 }
             }
@@ -451,83 +499,44 @@ impl Overlay {
         !std::mem::replace(&mut self.visited[i], true)
     }
 
-    /// `orient2d` of point `v` and edge `e` (from its smaller end), cached.
-    #[inline(always)]
-    fn side(&mut self, pix: &[DVec2], v: u32, e: u32) -> i8 {
-        let i = v as usize * self.edges.len() + e as usize;
-        let s = self.side[i];
-        if s != 2 {
-            return s;
-        }
-        self.compute_side(pix, v, e, i)
-    }
-
-    #[cold]
-    #[inline(never)]
-    fn compute_side(&mut self, pix: &[DVec2], v: u32, e: u32, i: usize) -> i8 {
-        let Edge { a, b, .. } = self.edges[e as usize];
-        let s = sign(orient2d(pix[a as usize], pix[b as usize], pix[v as usize]));
-        self.side[i] = s;
-        s
-    }
-
-    /// Side of point `v` of triangle `t`'s edge `k` (counter-clockwise:
-    /// positive is the triangle's side).
-    #[inline]
-    fn tri_side(&mut self, pix: &[DVec2], v: u32, h: TriEdge) -> i8 {
-        let s = self.side(pix, v, h.e);
-        if h.fwd {
-            s
-        } else {
-            -s
-        }
-    }
-
-    fn strictly_inside(&mut self, pix: &[DVec2], v: u32, t: usize) -> bool {
-        let row = self.te[t];
-        row.iter().all(|&h| self.tri_side(pix, v, h) > 0)
-    }
-
-    /// The crossing vertex of triangle edges `g` and `h`, known to cross
-    /// properly (one of a front and one of a back triangle, `g` of a front
-    /// one when `g_front`): its position is computed once, from the front
-    /// edge's ends and the back edge's.
-    #[inline]
-    fn crossing(&mut self, pix: &[DVec2], g: TriEdge, h: TriEdge, g_front: bool) -> u32 {
-        let (fe, be) = if g_front { (g, h) } else { (h, g) };
-        let slot = fe.class as usize * self.back_edges.len() + be.class as usize;
-        let x = self.cross[slot];
-        if x != UNKNOWN {
-            return x;
-        }
-        let (fe, be) = (self.edges[fe.e as usize], self.edges[be.e as usize]);
-        self.pos.push(segment_crossing(
-            pix[fe.a as usize],
-            pix[fe.b as usize],
-            pix[be.a as usize],
-            pix[be.b as usize],
-        ));
-        let x = (self.pos.len() - 1) as u32;
-        self.cross[slot] = x;
-        x
-    }
-
     /// Traces region `t1 ∩ t2` counter-clockwise from `st` and queues its
     /// neighbours not found yet; `false` when something unexpected declines
-    /// the fast path.
+    /// the fast path. (The fields are borrowed one by one, so that the
+    /// walk's tables stay in registers.)
     fn region(&mut self, pix: &[DVec2], st: Start) -> bool {
+        let Overlay {
+            ccw,
+            is_front,
+            te,
+            edges,
+            back_edges,
+            backs,
+            class,
+            sides,
+            cross,
+            visited,
+            queue,
+            pos,
+            region_verts,
+            region_start,
+            face_fb,
+            ..
+        } = self;
+        let (ccw, is_front, te, class) = (&ccw[..], &is_front[..], &te[..], &class[..]);
+        let (n_back_edges, n_backs) = (back_edges.len(), backs.len());
         let Start { v: v0, t1, k, t2 } = st;
         let (mut t1, mut k, mut t2) = (t1 as usize, k as usize, t2 as usize);
-        let mut t1_front = self.is_front[t1];
+        let mut t1_front = is_front[t1];
         let (f, b) = if t1_front { (t1, t2) } else { (t2, t1) };
-        let begin = self.region_verts.len();
-        self.region_verts.push(v0);
+        let begin = region_verts.len();
+        region_verts.push(v0);
         let mut closed = false;
         for _ in 0..MAX_WALK {
             // Along edge g = k of t1 (s -> e), inside t2.
-            let e = self.ccw[t1][NEXT[k]];
-            let g = self.te[t1][k];
+            let e = ccw[t1][NEXT[k]];
+            let g = te[t1][k];
             let other = t2;
+            let c = ccw[t2];
             // The line of g leaves t2 across the edge whose start is on its
             // right and whose end on its left (strictly: a corner of t2 on
             // the line is a shared endpoint, or beyond g's ends); g itself
@@ -536,19 +545,43 @@ impl Overlay {
             let mut exit = None;
             let mut inside = false;
             if g.class != NIL {
-                let c = self.ccw[t2];
-                let o = c.map(|v| {
-                    let s = self.side(pix, v, g.e);
-                    if g.fwd {
-                        s
-                    } else {
-                        -s
-                    }
-                });
-                if let Some(j) = (0..3).find(|&j| o[j] < 0 && o[NEXT[j]] > 0) {
-                    let h = self.te[t2][j];
-                    match self.tri_side(pix, e, h) {
-                        -1 => exit = Some((self.crossing(pix, g, h, t1_front), j)),
+                let o = [
+                    sides.tri(pix, c[0], g),
+                    sides.tri(pix, c[1], g),
+                    sides.tri(pix, c[2], g),
+                ];
+                let j = if o[0] < 0 && o[1] > 0 {
+                    0
+                } else if o[1] < 0 && o[2] > 0 {
+                    1
+                } else if o[2] < 0 && o[0] > 0 {
+                    2
+                } else {
+                    3
+                };
+                if j < 3 {
+                    let h = te[t2][j];
+                    match sides.tri(pix, e, h) {
+                        -1 => {
+                            // g crosses h: the crossing vertex, computed
+                            // once from the front edge's ends and the back
+                            // edge's.
+                            let (fe, be) = if t1_front { (g, h) } else { (h, g) };
+                            let slot = fe.class as usize * n_back_edges + be.class as usize;
+                            let mut x = cross[slot];
+                            if x == UNKNOWN {
+                                let (fe, be) = (&edges[fe.e as usize], &edges[be.e as usize]);
+                                x = pos.len() as u32;
+                                pos.push(segment_crossing(
+                                    pix[fe.a as usize],
+                                    pix[fe.b as usize],
+                                    pix[be.a as usize],
+                                    pix[be.b as usize],
+                                ));
+                                cross[slot] = x;
+                            }
+                            exit = Some((x, j));
+                        }
                         0 => return false,
                         // e before the exit: strictly inside t2.
                         _ => inside = true,
@@ -559,10 +592,10 @@ impl Overlay {
                 (t1, t2, k) = (t2, t1, j);
                 t1_front = !t1_front;
                 x
-            } else if let Some(j) = (0..3).find(|&j| self.ccw[t2][j] == e) {
+            } else if let Some(j) = (0..3).find(|&j| c[j] == e) {
                 // A shared corner: the region's wedge there starts at the
                 // more counter-clockwise of the two next edges.
-                let (a, c) = (self.ccw[t1][NEXT[NEXT[k]]], self.ccw[t2][NEXT[j]]);
+                let (a, c) = (ccw[t1][NEXT[NEXT[k]]], c[NEXT[j]]);
                 let turn = if a == c {
                     Side::Negative
                 } else {
@@ -577,7 +610,7 @@ impl Overlay {
                     Side::On => return false,
                 }
                 e
-            } else if inside || self.strictly_inside(pix, e, t2) {
+            } else if inside || te[t2].iter().all(|&h| sides.tri(pix, e, h) > 0) {
                 k = NEXT[k];
                 e
             } else {
@@ -585,31 +618,35 @@ impl Overlay {
             };
             // The neighbour across the edge just followed shares this piece
             // of it, reversed: its walk can start at `v`.
-            if g.class != NIL && self.visit(g.nbr, other as u32) {
-                self.queue.push(Start {
-                    v,
-                    t1: g.nbr,
-                    k: g.nbr_k,
-                    t2: other as u32,
-                });
+            if g.class != NIL {
+                let (nf, nb) = if is_front[g.nbr as usize] {
+                    (g.nbr as usize, other)
+                } else {
+                    (other, g.nbr as usize)
+                };
+                let i = class[nf] as usize * n_backs + class[nb] as usize;
+                if !std::mem::replace(&mut visited[i], true) {
+                    queue.push(Start {
+                        v,
+                        t1: g.nbr,
+                        k: g.nbr_k,
+                        t2: other as u32,
+                    });
+                }
             }
             if v == v0 {
                 closed = true;
                 break;
             }
-            self.region_verts.push(v);
+            region_verts.push(v);
         }
-        let len = self.region_verts.len() - begin;
+        let len = region_verts.len() - begin;
         if !closed || len < 3 {
             return false;
         }
-        self.push_region(f, b);
+        region_start.push(region_verts.len() as u32);
+        face_fb.push([f as u32, b as u32]);
         true
-    }
-
-    fn push_region(&mut self, f: usize, b: usize) {
-        self.region_start.push(self.region_verts.len() as u32);
-        self.face_fb.push([f as u32, b as u32]);
     }
 }
 

@@ -109,6 +109,31 @@ pub struct Projector {
     emit: EmitScratch,
     refine: super::refine::RefineScratch,
     window: WindowScratch,
+    /// The last camera's [`ViewMap`] and what it was computed from (its
+    /// half extents take a `tan`; cameras repeat from piece to piece).
+    view: Option<(ViewKey, ViewMap)>,
+}
+
+/// What [`ViewMap::of`] reads of a camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ViewKey {
+    ortho: bool,
+    view_angle: f64,
+    parallel_scale: f64,
+    width: u32,
+    height: u32,
+}
+
+impl ViewKey {
+    fn of(c: &Camera) -> ViewKey {
+        ViewKey {
+            ortho: c.ortho,
+            view_angle: c.view_angle,
+            parallel_scale: c.parallel_scale,
+            width: c.width,
+            height: c.height,
+        }
+    }
 }
 
 impl Default for Projector {
@@ -141,6 +166,7 @@ impl Default for Projector {
             emit: EmitScratch::default(),
             refine: Default::default(),
             window: Default::default(),
+            view: None,
         }
     }
 }
@@ -167,7 +193,14 @@ impl Projector {
         poly.validate()?;
         self.took_fast_path = false;
         out.clear();
-        out.view = ViewMap::of(camera);
+        out.view = match self.view {
+            Some((key, view)) if key == ViewKey::of(camera) => view,
+            _ => {
+                let view = ViewMap::of(camera);
+                self.view = Some((ViewKey::of(camera), view));
+                view
+            }
+        };
         let zc = camera.near * NEAR_CLIP_SCALE;
         let needs_clip = poly.points.iter().any(|p| p.z < zc);
         if needs_clip {
@@ -196,9 +229,10 @@ impl Projector {
         let n = poly.points.len();
         // 2. Pixel positions and merged ids.
         self.pix.clear();
+        let extent = (out.view.half_width, out.view.half_height);
         for &p in &poly.points {
             let (px, py, _) = camera
-                .view_to_pixel(p)
+                .view_to_pixel_with(p, extent)
                 .ok_or(ProjectionError::BehindNearPlane)?;
             if !(px.is_finite() && py.is_finite()) {
                 return Err(ProjectionError::NonFinite);
@@ -488,11 +522,12 @@ impl Projector {
 #[derive(Clone, Debug, Default)]
 struct EmitScratch {
     vmap: Vec<u32>,
-    /// Per subdivision vertex, for its front and back values: the region
-    /// whose triangle is widest, and that width.
-    best: Vec<WidestFaces>,
-    /// Per boundary triangle: its [`FaceTri`] and width, once computed.
-    tri_faces: Vec<Option<(FaceTri, f64)>>,
+    /// Per subdivision vertex, for its front and back values: the boundary
+    /// triangle (of a region around it) that is widest, and that width.
+    best: Vec<[(u32, f64); 2]>,
+    /// Per boundary triangle: its [`FaceTri`] and width.
+    faces: Vec<FaceTri>,
+    widths: Vec<f64>,
 }
 
 /// Regions as lists of subdivision vertices, with their front and back
@@ -520,56 +555,63 @@ fn emit(
     let EmitScratch {
         vmap,
         best,
-        tri_faces,
+        faces,
+        widths,
     } = scratch;
     // Each boundary triangle as seen on screen, with its width, once.
-    tri_faces.clear();
-    tri_faces.resize(poly.triangles.len(), None);
-    let mut face = |t: u32| {
-        *tri_faces[t as usize].get_or_insert_with(|| {
-            let f = FaceTri::new(poly, pix, t);
-            (f, f.width())
-        })
-    };
+    faces.clear();
+    widths.clear();
+    for t in 0..poly.triangles.len() {
+        let f = FaceTri::new(poly, pix, t as u32);
+        faces.push(f);
+        widths.push(f.width());
+    }
     let nv = regions.pos.len();
     vmap.clear();
     vmap.resize(nv, NIL);
     // Every region around a vertex holds it under its front and back
     // triangles, whose planes all give the vertex's values; take them
     // from the widest ones (best conditioned, `FaceTri::width`), never
-    // from a sliver left by a face seen (nearly) edge-on.
+    // from a sliver left by a face seen (nearly) edge-on. (Regions are
+    // visited in order and only a strictly wider triangle replaces one:
+    // ties go to the first region's.)
     best.clear();
     best.resize(nv, [(NIL, -1.0); 2]);
     let verts = |f: usize| &regions.verts[regions.start[f] as usize..regions.start[f + 1] as usize];
-    for (f, &[ft, bt]) in regions.faces.iter().enumerate() {
-        let ((front, wf), (back, wb)) = (face(ft), face(bt));
-        let w = [wf, wb];
-        out.region_faces.push([front, back]);
+    out.region_faces
+        .resize(regions.faces.len(), [FaceTri::default(); 2]);
+    for (f, &ft) in regions.faces.iter().enumerate() {
+        let w = ft.map(|t| widths[t as usize]);
+        let rf = &mut out.region_faces[f];
+        rf[0] = faces[ft[0] as usize];
+        rf[1] = faces[ft[1] as usize];
         for &v in verts(f) {
             let best = &mut best[v as usize];
             for s in 0..2 {
                 if w[s] > best[s].1 {
-                    best[s] = (f as u32, w[s]);
+                    best[s] = (ft[s], w[s]);
                 }
             }
         }
     }
     for f in 0..regions.faces.len() {
         let r = out.push_region();
+        let region = &mut out.regions[r];
         for &v in verts(f) {
-            if vmap[v as usize] == NIL {
-                vmap[v as usize] = out.vertices.len() as u32;
-                let [(bf, _), (bb, _)] = best[v as usize];
-                let rv = RegionVertex::evaluate(
+            let mut id = vmap[v as usize];
+            if id == NIL {
+                id = out.vertices.len() as u32;
+                vmap[v as usize] = id;
+                let [(tf, _), (tb, _)] = best[v as usize];
+                out.vertices.push(RegionVertex::evaluate(
                     &out.view,
-                    &out.region_faces[bf as usize][0],
-                    &out.region_faces[bb as usize][1],
+                    &faces[tf as usize],
+                    &faces[tb as usize],
                     regions.pos[v as usize],
                     regions.on_hull.get(v as usize).copied().unwrap_or(false),
-                );
-                out.vertices.push(rv);
+                ));
             }
-            out.regions[r].push(vmap[v as usize]);
+            region.push(id);
         }
     }
     out.triangulate_regions();
