@@ -173,7 +173,15 @@ pub fn progress_bar(label: &str) -> impl FnMut(usize, usize) {
 /// Prints the stats of a render to stderr.
 pub fn print_stats(stats: &RenderStats, load_s: f64) {
     eprintln!("load+scene   {load_s:.3} s");
-    eprintln!("setup        {:.3} s", stats.setup_s);
+    match &stats.exact {
+        Some(e) => eprintln!(
+            "setup        {:.3} s  (visibility geometry {:.3}, waiting for the GPU device {:.3})",
+            stats.setup_s,
+            stats.setup_s - e.gpu_open_s,
+            e.gpu_open_s
+        ),
+        None => eprintln!("setup        {:.3} s", stats.setup_s),
+    }
     if let Some(a) = &stats.gpu_adapter {
         eprintln!("adapter      {a}");
     }
@@ -190,6 +198,13 @@ pub fn print_stats(stats: &RenderStats, load_s: f64) {
             e.order.cycle_groups,
             e.order.pieces_in_groups,
             e.group_pixels
+        );
+        eprintln!(
+            "             (classify faces {:.3}, non-convex constraints {:.3}, splits {:.3}, topological sort {:.3})",
+            e.order.time_classify.as_secs_f64(),
+            e.order.time_nonconvex.as_secs_f64(),
+            e.order.time_split.as_secs_f64(),
+            e.order.time_sort.as_secs_f64()
         );
         eprintln!(
             "project+draw {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles)",

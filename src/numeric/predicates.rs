@@ -4,6 +4,8 @@
 
 use glam::{DVec2, DVec3};
 
+use super::tolerance::PLANE_FILTER_EPS;
+
 /// The side of an oriented line or plane a point lies on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Side {
@@ -69,9 +71,88 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Side {
     Side::of(-v)
 }
 
+/// A plane through `a, b, c` for many [`orient3d`] tests against it: the
+/// normal is computed once and each test is one dot product, trusted when
+/// it clears a float-filter bound ([`PLANE_FILTER_EPS`] times `|n|_inf`
+/// bound times `|d - a|_inf`, a generous bound on the rounding of the 3x3
+/// determinant); otherwise the exact [`orient3d`] decides. Same answers as
+/// [`orient3d`]`(a, b, c, d)`, always.
+#[derive(Clone, Copy, Debug)]
+pub struct Plane3 {
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    n: DVec3,
+    /// `PLANE_FILTER_EPS * 2 |b - a|_inf |c - a|_inf`.
+    scale: f64,
+}
+
+impl Plane3 {
+    /// The plane through `a, b, c` (oriented by `(b - a) x (c - a)`).
+    #[inline]
+    pub fn new(a: DVec3, b: DVec3, c: DVec3) -> Plane3 {
+        let (u, w) = (b - a, c - a);
+        Plane3 {
+            a,
+            b,
+            c,
+            n: u.cross(w),
+            scale: PLANE_FILTER_EPS * 2.0 * u.abs().max_element() * w.abs().max_element(),
+        }
+    }
+
+    /// Exact side of `d` (as [`orient3d`]).
+    #[inline]
+    pub fn side(&self, d: DVec3) -> Side {
+        let x = d - self.a;
+        let s = self.n.dot(x);
+        let bound = self.scale * x.abs().max_element();
+        // Far from underflow, a value beyond the bound has the exact sign.
+        if bound > 1e-250 && s.abs() > bound {
+            Side::of(s)
+        } else {
+            orient3d(self.a, self.b, self.c, d)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn plane3_agrees_with_orient3d() {
+        let mut x: u64 = 99;
+        let mut f = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((x >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        let mut exact_calls = 0;
+        for i in 0..20000 {
+            let a = DVec3::new(f(), f(), f()) * 100.0;
+            let b = a + DVec3::new(f(), f(), f());
+            let c = a + DVec3::new(f(), f(), f());
+            // Points on, near and off the plane.
+            let t = (f(), f());
+            let on = a + (b - a) * t.0 + (c - a) * t.1;
+            let n = (b - a).cross(c - a);
+            let d = match i % 3 {
+                0 => on,
+                1 => on + n * (f() * 1e-15),
+                _ => on + n * f(),
+            };
+            let p = Plane3::new(a, b, c);
+            assert_eq!(p.side(d), orient3d(a, b, c, d), "{a} {b} {c} {d}");
+            exact_calls += (i % 3 != 2) as usize;
+        }
+        assert!(exact_calls > 0);
+        // Exactly on: grid points.
+        let p = Plane3::new(DVec3::ZERO, DVec3::X, DVec3::Y);
+        assert_eq!(p.side(DVec3::new(3.0, -7.0, 0.0)), Side::On);
+        assert_eq!(p.side(DVec3::new(3.0, -7.0, 1e-300)), Side::Positive);
+    }
 
     #[test]
     fn signs() {

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use crate::mesh::tetra::triangulate_face;
 use crate::mesh::topology::Topology;
 use crate::mesh::{Mesh, NONE};
-use crate::numeric::predicates::{orient3d, Side};
+use crate::numeric::predicates::{orient3d, Plane3, Side};
 
 /// Face flag: the stored winding of the face points *into* its first cell
 /// (the first cell has negative volume).
@@ -71,8 +71,9 @@ fn cell_nonconvex(mesh: &Mesh, c: usize, negative: bool) -> bool {
         }
         triangulate_face(face, |t| {
             let [a, b, cc] = t.map(|i| p[i as usize]);
+            let plane = Plane3::new(a, b, cc);
             for &v in nodes {
-                if !face.contains(&v) && orient3d(a, b, cc, p[v as usize]) == outside {
+                if !face.contains(&v) && plane.side(p[v as usize]) == outside {
                     bad = true;
                 }
             }
@@ -108,6 +109,85 @@ fn cell_volume6(mesh: &Mesh, c: usize) -> f64 {
     v
 }
 
+/// The per-face data of a block of faces (see [`Geometry::build`]).
+#[derive(Default)]
+struct FaceBlock {
+    /// End of each face's triangles, counted from the block's first.
+    tri_end: Vec<u32>,
+    planes: Vec<[f64; 4]>,
+    face_err: Vec<[f32; 2]>,
+    face_flags: Vec<u8>,
+    boundary: Vec<BoundaryTri>,
+}
+
+/// Planes, filter bounds, flags and boundary triangles of faces `range`
+/// (`vol`: six times each cell's signed volume).
+fn face_block(
+    mesh: &Mesh,
+    topo: &Topology,
+    vol: &[f64],
+    range: std::ops::Range<usize>,
+) -> FaceBlock {
+    let p = &mesh.points;
+    let mut out = FaceBlock {
+        tri_end: Vec::with_capacity(range.len()),
+        planes: Vec::with_capacity(range.len() * 2),
+        face_err: Vec::with_capacity(range.len()),
+        face_flags: Vec::with_capacity(range.len()),
+        boundary: Vec::new(),
+    };
+    for f in range {
+        let [c0, c1] = topo.face_cells[f];
+        let v0 = vol.get(c0 as usize).copied().unwrap_or(0.0);
+        let v1 = if c1 == NONE {
+            0.0
+        } else {
+            vol.get(c1 as usize).copied().unwrap_or(0.0)
+        };
+        let mut flags = 0u8;
+        if v0 < 0.0 || (v0 == 0.0 && v1 < 0.0) {
+            flags |= FLIP;
+        }
+        if c1 == NONE {
+            flags |= BOUNDARY;
+        }
+        let face = topo.face(f);
+        let mut m = 0.0f64;
+        let mut amax = 0.0f64;
+        let mut k = 0u8;
+        triangulate_face(face, |t| {
+            let [a, b, c] = t.map(|i| p[i as usize]);
+            let n = (b - a).cross(c - a);
+            out.planes.push([n.x, n.y, n.z, n.dot(a)]);
+            m = m.max(2.0 * (b - a).abs().max_element() * (c - a).abs().max_element());
+            amax = amax.max(a.abs().max_element());
+            if c1 == NONE {
+                let verts = if flags & FLIP != 0 {
+                    [t[0], t[2], t[1]]
+                } else {
+                    t
+                };
+                out.boundary.push(BoundaryTri {
+                    face: f as u32,
+                    k,
+                    verts,
+                });
+            }
+            k += 1;
+        });
+        if face.len() > 3 && face_planar(p, face) {
+            flags |= PLANAR;
+        }
+        if c1 == NONE && face.len() > 3 && boundary_face_concave(p, face, flags & FLIP != 0) {
+            flags |= CONCAVE;
+        }
+        out.face_err.push([round_up(m), round_up(amax)]);
+        out.face_flags.push(flags);
+        out.tri_end.push(out.planes.len() as u32);
+    }
+    out
+}
+
 impl Geometry {
     /// Builds the data for `mesh` (point ids already checked in range).
     pub fn build(mesh: &Mesh, topo: &Topology) -> Geometry {
@@ -117,6 +197,14 @@ impl Geometry {
             .into_par_iter()
             .map(|c| cell_volume6(mesh, c))
             .collect();
+        // Faces in parallel blocks (each block's planes, flags and boundary
+        // triangles in face order), concatenated in block order: the same
+        // arrays as one serial pass.
+        const BLOCK: usize = 8192;
+        let blocks: Vec<FaceBlock> = (0..nf.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|b| face_block(mesh, topo, &vol, b * BLOCK..((b + 1) * BLOCK).min(nf)))
+            .collect();
         let mut g = Geometry {
             tri_off: Vec::with_capacity(nf + 1),
             planes: Vec::with_capacity(nf * 2),
@@ -125,54 +213,13 @@ impl Geometry {
             ..Default::default()
         };
         g.tri_off.push(0);
-        for f in 0..nf {
-            let [c0, c1] = topo.face_cells[f];
-            let v0 = vol.get(c0 as usize).copied().unwrap_or(0.0);
-            let v1 = if c1 == NONE {
-                0.0
-            } else {
-                vol.get(c1 as usize).copied().unwrap_or(0.0)
-            };
-            let mut flags = 0u8;
-            if v0 < 0.0 || (v0 == 0.0 && v1 < 0.0) {
-                flags |= FLIP;
-            }
-            if c1 == NONE {
-                flags |= BOUNDARY;
-            }
-            let face = topo.face(f);
-            let mut m = 0.0f64;
-            let mut amax = 0.0f64;
-            let mut k = 0u8;
-            triangulate_face(face, |t| {
-                let [a, b, c] = t.map(|i| p[i as usize]);
-                let n = (b - a).cross(c - a);
-                g.planes.push([n.x, n.y, n.z, n.dot(a)]);
-                m = m.max(2.0 * (b - a).abs().max_element() * (c - a).abs().max_element());
-                amax = amax.max(a.abs().max_element());
-                if c1 == NONE {
-                    let verts = if flags & FLIP != 0 {
-                        [t[0], t[2], t[1]]
-                    } else {
-                        t
-                    };
-                    g.boundary.push(BoundaryTri {
-                        face: f as u32,
-                        k,
-                        verts,
-                    });
-                }
-                k += 1;
-            });
-            if face.len() > 3 && face_planar(p, face) {
-                flags |= PLANAR;
-            }
-            if c1 == NONE && face.len() > 3 && boundary_face_concave(p, face, flags & FLIP != 0) {
-                flags |= CONCAVE;
-            }
-            g.face_err.push([round_up(m), round_up(amax)]);
-            g.face_flags.push(flags);
-            g.tri_off.push(g.planes.len() as u32);
+        for b in blocks {
+            let base = g.planes.len() as u32;
+            g.tri_off.extend(b.tri_end.iter().map(|&e| base + e));
+            g.planes.extend_from_slice(&b.planes);
+            g.face_err.extend_from_slice(&b.face_err);
+            g.face_flags.extend_from_slice(&b.face_flags);
+            g.boundary.extend_from_slice(&b.boundary);
         }
         g.nonconvex_cells = (0..mesh.cells.len())
             .into_par_iter()
