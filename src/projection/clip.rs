@@ -37,10 +37,33 @@ struct PV {
     f: f64,
 }
 
+/// Pieces with at most this many points look output points up in a dense
+/// table (`n + 2 n^2` slots: every original point and every edge cut at
+/// either level); larger ones in a list.
+const DENSE_MAX: usize = 16;
+
+/// How output points are looked up (tests force either way).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Lookup {
+    /// Dense up to [`DENSE_MAX`] points, a list beyond.
+    #[default]
+    Auto,
+    #[cfg(test)]
+    List,
+    #[cfg(test)]
+    Dense,
+}
+
 /// Scratch for [`Clipper::clip`].
 #[derive(Clone, Debug, Default)]
 pub struct Clipper {
+    lookup: Lookup,
     map: Vec<(Key, u32)>,
+    /// Dense lookup (pieces of at most [`DENSE_MAX`] points): output index
+    /// + 1 per key slot, 0 when not made yet.
+    dense: Vec<u32>,
+    /// The clipped value of every source point.
+    vals: Vec<f64>,
     poly: Vec<PV>,
     tmp: Vec<PV>,
     level_edges: Vec<(u32, u32)>,
@@ -59,21 +82,32 @@ impl Clipper {
         out: &mut Polyhedron,
     ) -> Result<bool, ProjectionError> {
         out.clear();
-        let value = |i: u32| -> f64 {
-            match what {
-                ClipValue::Depth => src.points[i as usize].z,
-                ClipValue::Scalar => src.scalars[i as usize],
-            }
-        };
+        self.vals.clear();
+        match what {
+            ClipValue::Depth => self.vals.extend(src.points.iter().map(|p| p.z)),
+            ClipValue::Scalar => self.vals.extend_from_slice(&src.scalars),
+        }
         let (mut vmin, mut vmax) = (f64::INFINITY, f64::NEG_INFINITY);
-        for i in 0..src.points.len() as u32 {
-            vmin = vmin.min(value(i));
-            vmax = vmax.max(value(i));
+        for &v in &self.vals {
+            vmin = vmin.min(v);
+            vmax = vmax.max(v);
         }
         if !(vmax > lo && vmin < hi) {
             return Ok(false);
         }
+        let n = src.points.len();
         self.map.clear();
+        self.dense.clear();
+        let dense = match self.lookup {
+            Lookup::Auto => n <= DENSE_MAX,
+            #[cfg(test)]
+            Lookup::List => false,
+            #[cfg(test)]
+            Lookup::Dense => true,
+        };
+        if dense {
+            self.dense.resize(n + 2 * n * n, 0);
+        }
         self.level_edges.clear();
         let levels = [lo, hi];
         for t in &src.triangles {
@@ -81,7 +115,7 @@ impl Clipper {
             for &i in t {
                 self.poly.push(PV {
                     key: Key::Orig(i),
-                    f: value(i),
+                    f: self.vals[i as usize],
                 });
             }
             for lev in 0..2u8 {
@@ -115,7 +149,7 @@ impl Clipper {
             let m = self.poly.len().min(ids.len());
             for (k, id) in ids.iter_mut().enumerate().take(m) {
                 let key = self.poly[k].key;
-                *id = self.point_of(key, src, what, levels, value, out);
+                *id = self.point_of(key, src, what, levels, out);
             }
             for k in 1..m - 1 {
                 if ids[0] != ids[k] && ids[k] != ids[k + 1] && ids[0] != ids[k + 1] {
@@ -181,11 +215,21 @@ impl Clipper {
         src: &Polyhedron,
         what: ClipValue,
         levels: [f64; 2],
-        value: impl Fn(u32) -> f64,
         out: &mut Polyhedron,
     ) -> u32 {
-        if let Some(&(_, i)) = self.map.iter().find(|(k, _)| *k == key) {
-            return i;
+        let n = src.points.len();
+        let slot = (!self.dense.is_empty()).then(|| match key {
+            Key::Orig(i) => i as usize,
+            Key::Cut(i, j, lev) => n + ((i as usize * n + j as usize) << 1) + lev as usize,
+        });
+        match slot {
+            Some(k) if self.dense[k] != 0 => return self.dense[k] - 1,
+            Some(_) => {}
+            None => {
+                if let Some(&(_, i)) = self.map.iter().find(|(k, _)| *k == key) {
+                    return i;
+                }
+            }
         }
         let idx = out.points.len() as u32;
         match key {
@@ -199,7 +243,7 @@ impl Clipper {
                 // Canonical order by position, so that neighbours agree.
                 let (a, b) = if lex_less(pi, pj) { (i, j) } else { (j, i) };
                 let (pa, pb) = (src.points[a as usize], src.points[b as usize]);
-                let (fa, fb) = (value(a), value(b));
+                let (fa, fb) = (self.vals[a as usize], self.vals[b as usize]);
                 let mu = ((l - fa) / (fb - fa)).clamp(0.0, 1.0);
                 let mut p = pa + (pb - pa) * mu;
                 let (sa, sb) = (src.scalars[a as usize], src.scalars[b as usize]);
@@ -212,7 +256,10 @@ impl Clipper {
                 out.scalars.push(s);
             }
         }
-        self.map.push((key, idx));
+        match slot {
+            Some(k) => self.dense[k] = idx + 1,
+            None => self.map.push((key, idx)),
+        }
         idx
     }
 }
@@ -226,5 +273,74 @@ fn original_edge(p: Key, q: Key) -> (u32, u32) {
     match (p, q) {
         (Key::Cut(i, j, _), _) | (_, Key::Cut(i, j, _)) => (i, j),
         (Key::Orig(i), Key::Orig(j)) => (i, j),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A convex piece: the convex hull of `k` points on an ellipsoid
+    /// (`crate::mesh::hull`; points off the hull are simply unused).
+    fn piece(k: usize, seed: u64) -> Polyhedron {
+        let mut x = seed;
+        let mut f = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let pts: Vec<DVec3> = (0..k)
+            .map(|_| {
+                let (u, v) = (f() * std::f64::consts::TAU, f() * 2.0 - 1.0);
+                let r = (1.0 - v * v).sqrt();
+                DVec3::new(2.0 * r * u.cos(), r * u.sin(), 0.7 * v + 3.0)
+            })
+            .collect();
+        let tris = crate::mesh::hull::convex_hull(&pts, None)
+            .expect("hull")
+            .faces;
+        let scalars = pts.iter().map(|p| p.x + 0.3 * p.y * p.z).collect();
+        let mut poly = Polyhedron {
+            points: pts,
+            scalars,
+            triangles: tris,
+        };
+        poly.orient_outward();
+        poly
+    }
+
+    /// The dense and the list lookup give the same pieces, point for point,
+    /// for small and large pieces, scalar and depth bands.
+    #[test]
+    fn dense_and_list_lookups_agree() {
+        let mut made = 0;
+        for (k, seed) in [(4, 1), (6, 2), (8, 3), (12, 4), (16, 5), (24, 6), (40, 7)] {
+            let src = piece(k, seed);
+            for (what, lo, hi) in [
+                (ClipValue::Scalar, -0.5, 0.4),
+                (ClipValue::Scalar, 0.1, f64::INFINITY),
+                (ClipValue::Depth, 2.6, 3.3),
+            ] {
+                let mut out = Vec::new();
+                for lookup in [Lookup::Auto, Lookup::List, Lookup::Dense] {
+                    let mut c = Clipper {
+                        lookup,
+                        ..Default::default()
+                    };
+                    let mut poly = Polyhedron::default();
+                    let kept = c.clip(&src, what, lo, hi, &mut poly).unwrap();
+                    out.push((kept, poly));
+                }
+                assert_eq!(out[0], out[1], "{k} points, {what:?}");
+                assert_eq!(out[0], out[2], "{k} points, {what:?}");
+                made += out[0].0 as usize;
+                if out[0].0 {
+                    let v = out[0].1.volume();
+                    assert!(v > 0.0 && v < src.volume(), "{v}");
+                }
+            }
+        }
+        assert!(made >= 15, "{made}");
     }
 }

@@ -184,8 +184,22 @@ impl Ctx<'_> {
         poly: &mut Polyhedron,
     ) -> Result<bool, String> {
         let (p, s) = self.tet_view(cell, tet);
-        let (lo, hi) = self.band(lo, hi);
         whole.set_tet(p, s);
+        self.clip_band(cell, lo, hi, clipper, whole, poly)
+    }
+
+    /// Clips `whole` (the view-space tet of `cell`) to band `lo..hi` of
+    /// the order's levels.
+    fn clip_band(
+        &self,
+        cell: u32,
+        lo: u32,
+        hi: u32,
+        clipper: &mut Clipper,
+        whole: &Polyhedron,
+        poly: &mut Polyhedron,
+    ) -> Result<bool, String> {
+        let (lo, hi) = self.band(lo, hi);
         clipper
             .clip(whole, ClipValue::Scalar, lo, hi, poly)
             .map_err(|e| format!("cell {cell}: {e}"))
@@ -407,6 +421,9 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
     projector.cull_to_pixels = ctx.cull;
     let mut poly = Polyhedron::default();
     let mut whole = Polyhedron::default();
+    // The (cell, tet) `whole` holds for slab pieces (fragments reuse
+    // `whole` and reset this).
+    let mut whole_of: Option<(u32, [u32; 4])> = None;
     let mut clipper = Clipper::default();
     let mut proj = Projected::default();
     let mut vals = Vec::new();
@@ -454,6 +471,7 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                 push_projected(ctx, &mut proj, &mut vals, &mut out);
             }
             Piece::Frag { tet, frag, .. } => {
+                whole_of = None;
                 if let Err(e) = ctx.fragment(cell, tet, frag, &mut whole) {
                     out.error = Some(e);
                     return out;
@@ -495,7 +513,14 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                     out.culled += 1;
                     continue;
                 }
-                match ctx.slab(cell, tet, lo, hi, &mut clipper, &mut whole, &mut poly) {
+                // The slabs of a tet come one after another: its view-space
+                // piece is built once for them all.
+                if whole_of != Some((cell, tet)) {
+                    let (p, s) = ctx.tet_view(cell, tet);
+                    whole.set_tet(p, s);
+                    whole_of = Some((cell, tet));
+                }
+                match ctx.clip_band(cell, lo, hi, &mut clipper, &whole, &mut poly) {
                     Ok(true) => {}
                     Ok(false) => continue,
                     Err(e) => {
