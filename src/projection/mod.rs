@@ -172,17 +172,16 @@ pub struct FaceTri {
 }
 
 impl FaceTri {
+    #[inline]
     fn new(poly: &Polyhedron, pix: &[DVec2], t: u32) -> FaceTri {
-        let mut f = FaceTri::default();
-        if let Some(tri) = poly.triangles.get(t as usize) {
-            for (k, &i) in tri.iter().enumerate() {
-                let i = i as usize;
-                f.p[k] = pix[i];
-                f.z[k] = poly.points[i].z;
-                f.s[k] = poly.scalars[i];
-            }
+        match poly.triangles.get(t as usize) {
+            Some(&tri) => FaceTri {
+                p: tri.map(|i| pix[i as usize]),
+                z: tri.map(|i| poly.points[i as usize].z),
+                s: tri.map(|i| poly.scalars[i as usize]),
+            },
+            None => FaceTri::default(),
         }
-        f
     }
 
     /// Smallest width of the projected triangle (twice its area over its

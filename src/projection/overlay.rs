@@ -61,6 +61,10 @@ use crate::numeric::predicates::{orient2d, Side};
 /// `n * n`).
 pub(super) const MAX_POINTS: usize = 64;
 
+/// Pieces with more triangles take the general path (a closed surface of
+/// `MAX_POINTS` points without handles has `2 * MAX_POINTS - 4`).
+const MAX_TRIANGLES: usize = 1 << 15;
+
 /// Not computed yet (crossing table).
 const UNKNOWN: u32 = NIL - 1;
 
@@ -72,6 +76,33 @@ struct Start {
     t1: u32,
     k: u8,
     t2: u32,
+}
+
+/// A [`Start`] packed into one word (`v` in bits 0-31, `t1` 32-46, `t2`
+/// 47-61, `k` 62-63; triangle ids are below [`MAX_TRIANGLES`]): queued
+/// and taken back at once, so it is written and read by a single store
+/// and load (a struct written field by field and read as a block stalls).
+#[derive(Clone, Copy, Debug)]
+struct Packed(u64);
+
+impl Start {
+    #[inline]
+    fn pack(self) -> Packed {
+        Packed(
+            self.v as u64 | (self.t1 as u64) << 32 | (self.t2 as u64) << 47 | (self.k as u64) << 62,
+        )
+    }
+
+    #[inline]
+    fn unpack(p: Packed) -> Start {
+        let w = p.0;
+        Start {
+            v: w as u32,
+            t1: (w >> 32) as u32 & 0x7fff,
+            t2: (w >> 47) as u32 & 0x7fff,
+            k: (w >> 62) as u8,
+        }
+    }
 }
 
 /// A triangle's edge, as the walk needs it.
@@ -152,7 +183,7 @@ pub(super) struct Overlay {
     class: Vec<u32>,
     /// Regions found (front index * backs + back index).
     visited: Vec<bool>,
-    queue: Vec<Start>,
+    queue: Vec<Packed>,
     /// Positions of the vertices: the points, then the crossings.
     pub pos: Vec<DVec2>,
     /// Silhouette vertices.
@@ -230,7 +261,7 @@ impl Overlay {
     /// left then).
     pub(super) fn build(&mut self, pix: &[DVec2], tris: &[[u32; 3]], facing: &[Facing]) -> bool {
         let n = pix.len();
-        if n > MAX_POINTS || tris.is_empty() {
+        if n > MAX_POINTS || tris.is_empty() || tris.len() > MAX_TRIANGLES {
             return false;
         }
         // 1. Triangles counter-clockwise, edges and their kinds.
@@ -471,14 +502,17 @@ impl Overlay {
         };
         let u = self.ccw[f as usize][k];
         self.visit(f, b);
-        self.queue.push(Start {
-            v: u,
-            t1: f,
-            k: k as u8,
-            t2: b,
-        });
+        self.queue.push(
+            Start {
+                v: u,
+                t1: f,
+                k: k as u8,
+                t2: b,
+            }
+            .pack(),
+        );
         while let Some(st) = self.queue.pop() {
-            if !self.region(pix, st) {
+            if !self.region(pix, Start::unpack(st)) {
                 return false;
             }
         }
@@ -626,12 +660,15 @@ impl Overlay {
                 };
                 let i = class[nf] as usize * n_backs + class[nb] as usize;
                 if !std::mem::replace(&mut visited[i], true) {
-                    queue.push(Start {
-                        v,
-                        t1: g.nbr,
-                        k: g.nbr_k,
-                        t2: other as u32,
-                    });
+                    queue.push(
+                        Start {
+                            v,
+                            t1: g.nbr,
+                            k: g.nbr_k,
+                            t2: other as u32,
+                        }
+                        .pack(),
+                    );
                 }
             }
             if v == v0 {
