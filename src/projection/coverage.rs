@@ -17,10 +17,11 @@
 //! - [`PixelGrid::box_reaches`]: whether the pixel-centre lattice of the
 //!   image has a point in a (grown) bounding box; a piece whose projected
 //!   points' box has none draws nothing at all.
-//! - [`PixelGrid::triangle_reaches`]: the lattice points in the triangle's
-//!   grown box, each tested against the three edge lines moved outwards by
-//!   the margin (signed distances, either winding; a degenerate triangle
-//!   keeps every centre near its line). Triangles whose box holds more than
+//! - [`PixelGrid::polygon_reaches`] (convex polygons) and
+//!   [`PixelGrid::triangle_reaches`]: the
+//!   lattice points in the grown box, each tested against the edge lines
+//!   moved outwards by the margin (signed distances, either winding; a
+//!   degenerate polygon keeps every centre near its line). Triangles whose box holds more than
 //!   [`MAX_CANDIDATES`] centres are kept untested: they are wide enough to
 //!   cover one except as long slivers, which cost little to draw.
 
@@ -31,6 +32,8 @@ use crate::numeric::tolerance::COVERAGE_MARGIN_PX;
 
 /// Beyond this many candidate centres a triangle is kept without testing.
 pub const MAX_CANDIDATES: i64 = 16;
+/// Polygons with more points are kept without testing.
+pub const MAX_POLYGON: usize = 16;
 
 /// The pixel centres `(i + 0.5, j + 0.5)`, `0 <= i < width`,
 /// `0 <= j < height`, in continuous pixel coordinates
@@ -76,9 +79,30 @@ impl PixelGrid {
 
     /// Whether a pixel centre lies in triangle `a, b, c` (either winding)
     /// grown by the margin (see module docs).
+    #[inline]
     pub fn triangle_reaches(&self, a: DVec2, b: DVec2, c: DVec2) -> bool {
-        let min = a.min(b).min(c);
-        let max = a.max(b).max(c);
+        let p = [a, b, c];
+        self.polygon_reaches(3, |k| p[k])
+    }
+
+    /// Whether a pixel centre lies in the convex polygon of `n` points
+    /// `at(0..n)` (either winding) grown by the margin (see module docs).
+    /// Polygons of more than [`MAX_POLYGON`] points are kept untested.
+    pub fn polygon_reaches(&self, n: usize, at: impl Fn(usize) -> DVec2) -> bool {
+        if n == 0 {
+            return false;
+        }
+        if n > MAX_POLYGON {
+            return true;
+        }
+        let mut p = [DVec2::ZERO; MAX_POLYGON];
+        p[0] = at(0);
+        let (mut min, mut max) = (p[0], p[0]);
+        for (k, q) in p.iter_mut().enumerate().take(n).skip(1) {
+            *q = at(k);
+            min = min.min(*q);
+            max = max.max(*q);
+        }
         let (Some((i0, i1)), Some((j0, j1))) = (
             Self::span(min.x, max.x, self.width),
             Self::span(min.y, max.y, self.height),
@@ -91,16 +115,19 @@ impl PixelGrid {
         // Edge k from p[k] to p[k + 1]: the signed distance of q to its line
         // is cross(d, q - p) / |d| (positive on the left); compared squared,
         // `e < -m |d|` is `e < 0 && e^2 > m^2 |d|^2`.
-        let p = [a, b, c];
-        let d = [b - a, c - b, a - c];
         let m2 = COVERAGE_MARGIN_PX * COVERAGE_MARGIN_PX;
-        let lim = d.map(|d| m2 * d.length_squared());
+        let mut d = [DVec2::ZERO; MAX_POLYGON];
+        let mut lim = [0.0; MAX_POLYGON];
+        for k in 0..n {
+            d[k] = p[(k + 1) % n] - p[k];
+            lim[k] = m2 * d[k].length_squared();
+        }
         for j in j0..=j1 {
             let y = j as f64 + 0.5;
             for i in i0..=i1 {
                 let q = DVec2::new(i as f64 + 0.5, y);
                 let (mut left, mut right) = (true, true);
-                for k in 0..3 {
+                for k in 0..n {
                     let e = d[k].perp_dot(q - p[k]);
                     let far = e * e > lim[k];
                     left &= !(e < 0.0 && far);
@@ -219,6 +246,37 @@ mod tests {
             kept > 1000 && dropped > 1000,
             "{kept} kept, {dropped} dropped"
         );
+    }
+
+    /// A convex polygon reaches a centre exactly when one of its fan
+    /// triangles does (same margin tests on the shared outer edges).
+    #[test]
+    fn polygons_agree_with_their_fans() {
+        let grid = PixelGrid::new(10, 10);
+        let mut rng = Lcg(3);
+        let (mut yes, mut no) = (0, 0);
+        for _ in 0..20000 {
+            // A convex polygon: points on an ellipse at sorted angles.
+            let c = DVec2::new(rng.f() * 12.0 - 1.0, rng.f() * 12.0 - 1.0);
+            let (rx, ry) = (0.05 + rng.f() * 1.5, 0.05 + rng.f() * 1.5);
+            let n = 3 + (rng.f() * 6.0) as usize;
+            let mut ang: Vec<f64> = (0..n).map(|_| rng.f() * std::f64::consts::TAU).collect();
+            ang.sort_by(f64::total_cmp);
+            let p: Vec<DVec2> = ang
+                .iter()
+                .map(|a| c + DVec2::new(rx * a.cos(), ry * a.sin()))
+                .collect();
+            let whole = grid.polygon_reaches(n, |k| p[k]);
+            let fan = (1..n - 1).any(|k| brute(&grid, [p[0], p[k], p[k + 1]], COVERAGE_MARGIN_PX));
+            // Never drops a polygon whose area (grown) holds a centre.
+            if fan {
+                assert!(whole, "{p:?}");
+                yes += 1;
+            } else {
+                no += !whole as usize;
+            }
+        }
+        assert!(yes > 1000 && no > 1000, "{yes} {no}");
     }
 
     #[test]

@@ -267,9 +267,26 @@ impl Ctx<'_> {
     }
 }
 
+/// Projects `piece` and appends what it draws to `out`.
+fn draw(
+    ctx: &Ctx,
+    projector: &mut Projector,
+    piece: &Polyhedron,
+    proj: &mut Projected,
+    vals: &mut Vec<VertexValues>,
+    out: &mut ChunkOut,
+) -> Result<(), crate::projection::ProjectionError> {
+    projector.project(piece, ctx.camera, proj)?;
+    push_projected(ctx, proj, depth_balance(ctx, piece), vals, out);
+    Ok(())
+}
+
+/// Vertex integrals of the triangles of `proj` (`k`: [`depth_balance`]),
+/// refined for colour where needed, appended to `out`.
 fn push_projected(
     ctx: &Ctx,
     proj: &mut Projected,
+    k: f64,
     vals: &mut Vec<VertexValues>,
     out: &mut ChunkOut,
 ) {
@@ -333,7 +350,6 @@ fn push_projected(
         );
     }
     let (w, h) = (ctx.camera.width as f64, ctx.camera.height as f64);
-    let k = depth_balance(proj, ctx);
     // Index of each used vertex in `out.vertices` (u32::MAX: not emitted).
     let remap = &mut out.scratch_remap;
     remap.clear();
@@ -364,19 +380,18 @@ fn push_projected(
 }
 
 /// Per-piece scale `k` sending `l k` and `tau / k` to the shader (their
-/// product, the optical depth, is unchanged): it brings the largest `l` and
-/// the largest extinction of the TF over the piece's scalar range to the
-/// same size, so neither table axis clamps. It depends on every region
-/// vertex, not on which triangles coverage culling keeps, so culling changes
-/// no pixel.
-fn depth_balance(proj: &Projected, ctx: &Ctx) -> f64 {
-    let mut l_max: f64 = 0.0;
-    let (mut s_lo, mut s_hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in &proj.vertices {
-        l_max = l_max.max(v.l);
-        s_lo = s_lo.min(v.s_front.min(v.s_back));
-        s_hi = s_hi.max(v.s_front.max(v.s_back));
-    }
+/// product, the optical depth, is unchanged): it brings the piece's
+/// diameter (a bound on `l`) and the largest extinction of the TF over its
+/// scalar range to the same size, so neither table axis clamps. It depends
+/// on the piece alone, not on which regions and triangles coverage culling
+/// keeps, so culling changes no pixel.
+fn depth_balance(ctx: &Ctx, piece: &Polyhedron) -> f64 {
+    let (s_lo, s_hi) = value_range(piece.scalars.iter().copied());
+    let (lo, hi) = piece.points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let l_max = (hi - lo).length();
     let tf = ctx.tf;
     let mut tau_max = tf.tau_at(s_lo).max(tf.tau_at(s_hi));
     for &b in ctx.breakpoints {
@@ -448,11 +463,10 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                     out.error = Some(format!("cell {c}: {e}"));
                     return out;
                 }
-                if let Err(e) = projector.project(&poly, ctx.camera, &mut proj) {
+                if let Err(e) = draw(ctx, &mut projector, &poly, &mut proj, &mut vals, &mut out) {
                     out.error = Some(format!("cell {c}: {e}"));
                     return out;
                 }
-                push_projected(ctx, &mut proj, &mut vals, &mut out);
             }
             Piece::Tet { tet, .. } => {
                 let (p, s) = ctx.tet_view(cell, tet);
@@ -464,11 +478,10 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                 // A tet holding a breakpoint comes as its slabs
                 // (`Piece::Slab`): the TF is linear on this one.
                 poly.set_tet(p, s);
-                if let Err(e) = projector.project(&poly, ctx.camera, &mut proj) {
+                if let Err(e) = draw(ctx, &mut projector, &poly, &mut proj, &mut vals, &mut out) {
                     out.error = Some(format!("cell {cell}: {e}"));
                     return out;
                 }
-                push_projected(ctx, &mut proj, &mut vals, &mut out);
             }
             Piece::Frag { tet, frag, .. } => {
                 whole_of = None;
@@ -499,11 +512,11 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                             }
                         }
                     };
-                    if let Err(e) = projector.project(piece, ctx.camera, &mut proj) {
+                    if let Err(e) = draw(ctx, &mut projector, piece, &mut proj, &mut vals, &mut out)
+                    {
                         out.error = Some(format!("cell {cell}: {e}"));
                         return out;
                     }
-                    push_projected(ctx, &mut proj, &mut vals, &mut out);
                 }
             }
             Piece::Slab { tet, lo, hi, .. } => {
@@ -529,11 +542,10 @@ fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
                     }
                 }
                 out.slabs += 1;
-                if let Err(e) = projector.project(&poly, ctx.camera, &mut proj) {
+                if let Err(e) = draw(ctx, &mut projector, &poly, &mut proj, &mut vals, &mut out) {
                     out.error = Some(format!("cell {cell}: {e}"));
                     return out;
                 }
-                push_projected(ctx, &mut proj, &mut vals, &mut out);
             }
         }
     }
