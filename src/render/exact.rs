@@ -32,6 +32,7 @@
 //! composited per pixel on the CPU into one layer each, drawn at the group's
 //! place in the order ([`super::group`]).
 
+use std::sync::Mutex;
 use std::time::Instant;
 
 use glam::{DVec2, DVec3};
@@ -105,6 +106,19 @@ pub(super) struct ChunkOut {
     /// their index in `vertices`.
     scratch_used: Vec<bool>,
     scratch_remap: Vec<u32>,
+}
+
+impl ChunkOut {
+    /// Empties everything, keeping the buffers.
+    fn clear(&mut self) {
+        self.vertices.clear();
+        self.indices.clear();
+        self.culled = 0;
+        self.slabs = 0;
+        self.refined = 0;
+        self.degenerate = 0;
+        self.error = None;
+    }
 }
 
 pub(super) struct Ctx<'a> {
@@ -426,8 +440,8 @@ fn gpu_area_positive(a: &ExactVertex, b: &ExactVertex, c: &ExactVertex) -> bool 
     orient2d(p(a), p(b), p(c)) == Side::Positive
 }
 
-fn process_chunk(ctx: &Ctx, pieces: &[Piece]) -> ChunkOut {
-    let mut out = ChunkOut::default();
+/// Projects `pieces` into `out` (empty, its buffers possibly reused).
+fn process_chunk(ctx: &Ctx, pieces: &[Piece], mut out: ChunkOut) -> ChunkOut {
     let mut projector = Projector::new();
     // Pieces cut by the near plane reach ~1e9 pixels off screen: clip their
     // regions to the image so that screen-space interpolation stays exact
@@ -609,9 +623,9 @@ pub fn split_points(tf: &TransferFunction) -> Vec<f64> {
 }
 
 /// Sends one chunk's triangles to the frame and adds up its counts.
-fn push_out(frame: &mut Frame, out: ChunkOut, stats: &mut ExactStats) -> Result<(), RenderError> {
-    if let Some(e) = out.error {
-        return Err(RenderError::Projection(e));
+fn push_out(frame: &mut Frame, out: &ChunkOut, stats: &mut ExactStats) -> Result<(), RenderError> {
+    if let Some(e) = &out.error {
+        return Err(RenderError::Projection(e.clone()));
     }
     stats.culled_pieces += out.culled;
     stats.slabs += out.slabs;
@@ -695,17 +709,34 @@ pub fn render_exact(
     // for uploads.
     let tp = Instant::now();
     let mut ready: Vec<ChunkOut> = Vec::new();
+    // Buffers of drawn chunks, reused: fresh multi-megabyte vectors would
+    // be new pages for the kernel to fault in and zero, chunk after chunk.
+    let pool: Mutex<Vec<ChunkOut>> = Mutex::new(Vec::new());
+    let recycled = || {
+        pool.lock()
+            .ok()
+            .and_then(|mut p| p.pop())
+            .unwrap_or_default()
+    };
+    let recycle = |mut out: ChunkOut| {
+        out.clear();
+        if let Ok(mut p) = pool.lock() {
+            p.push(out);
+        }
+    };
     for (plain, group) in stretches {
         for win in order.pieces[plain].chunks(window) {
             let projected = std::thread::scope(|s| {
                 let next = s.spawn(|| {
                     win.par_chunks(CHUNK)
-                        .map(|c| process_chunk(&ctx, c))
+                        .map(|c| process_chunk(&ctx, c, recycled()))
                         .collect::<Vec<ChunkOut>>()
                 });
-                let pushed = ready
-                    .drain(..)
-                    .try_for_each(|out| push_out(&mut frame, out, &mut stats));
+                let pushed = ready.drain(..).try_for_each(|out| {
+                    push_out(&mut frame, &out, &mut stats)?;
+                    recycle(out);
+                    Ok::<(), RenderError>(())
+                });
                 let next = next.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
                 pushed.map(|()| next)
             })?;
@@ -714,12 +745,13 @@ pub fn render_exact(
             progress(done, total);
         }
         for out in ready.drain(..) {
-            push_out(&mut frame, out, &mut stats)?;
+            push_out(&mut frame, &out, &mut stats)?;
+            recycle(out);
         }
         if let Some(g) = group {
             let mut out = ChunkOut::default();
             stats.group_pixels += composite_group(&ctx, &order.pieces[g.clone()], &mut out);
-            push_out(&mut frame, out, &mut stats)?;
+            push_out(&mut frame, &out, &mut stats)?;
             done += g.len();
             progress(done, total);
         }
@@ -800,7 +832,7 @@ mod tests {
         // whole view refines into ~1e5 triangles).
         let mut degenerate = 0;
         for piece in &order.pieces {
-            let out = process_chunk(&ctx, std::slice::from_ref(piece));
+            let out = process_chunk(&ctx, std::slice::from_ref(piece), ChunkOut::default());
             assert_eq!(out.error, None);
             for t in out.indices.chunks(3) {
                 let [a, b, c] = [0, 1, 2].map(|k| &out.vertices[t[k] as usize]);
