@@ -10,12 +10,14 @@
 //!
 //! Run: `cargo bench --bench render` (`-- bluntfin` to filter).
 //!
-//! Measured 2026-12-01 (Mesa 22.3.6, 2 idle cores), frame after the first:
-//! bluntfin 0.57 s at 512^2 (Vulkan and GL alike), 0.69-0.72 s at 1024^2;
-//! hex_shell 5.9 s (Vulkan) / 6.2 s (GL) at 512^2, 12.0M triangles, of
-//! which projection and integrals take 4.4-5.4 s; grid_1m 6.7 / 7.2 s,
-//! 20.5M triangles. Projection dominates: the GPU work is streamed and
-//! overlaps it.
+//! Measured 2026-12-02 (Mesa 22.3.6, 2 idle cores), frame after the first
+//! (Vulkan / GL): bluntfin 0.27 / 0.27 s at 512^2, 0.49 / 0.49 s at
+//! 1024^2; hex_shell 3.32 / 3.29 s at 512^2 (2.95M triangles), 4.64 / 4.48
+//! s at 1024^2 (5.53M); grid_1m 5.28 / 5.36 s at 512^2 (9.69M), 7.37 /
+//! 7.42 s at 1024^2 (15.8M). Projection and integrals dominate (the draw
+//! calls overlap them; GL's uploads take 0.6-3.5 s of that overlapped
+//! time). Before coverage culling (2026-12-01): bluntfin 0.57 s, hex_shell
+//! 5.9 s (12.0M triangles), grid_1m 6.7 s (20.5M).
 
 use std::time::Duration;
 
