@@ -10,19 +10,24 @@
 //!    everywhere are skipped (they neither emit nor absorb in the glow
 //!    model).
 //! 3. Each piece becomes a view-space [`Polyhedron`] (a slab: its tet
-//!    clipped to the band, [`Clipper`]); each is projected into regions
-//!    ([`Projector`]).
+//!    clipped to the band, [`Clipper`]; the tet is built once for all its
+//!    slabs); each is projected into regions ([`Projector`]), leaving out
+//!    pieces and triangles that contain no pixel centre
+//!    ([`crate::projection::coverage`],
+//!    [`super::RenderOptions::cull_to_pixels`]).
 //! 4. Region triangles whose vertices differ much in optical depth and glow
 //!    colour are refined (math README 8.1: `C/alpha` is interpolated inside a
 //!    region), see [`COLOR_REFINE_TOL`].
-//! 5. At every region vertex the closed-form integral gives the glow colour
-//!    `C/alpha` and the mean extinction; the GPU evaluates
-//!    `alpha = 1 - exp(-l tau)` per pixel from its exponential table and
-//!    composites back to front.
+//! 5. At every region vertex a kept triangle uses, the closed-form
+//!    integral gives the glow colour `C/alpha` and the mean extinction; the
+//!    GPU evaluates `alpha = 1 - exp(-l tau)` per pixel from its
+//!    exponential table and composites back to front.
 //!
 //! Pieces are processed in parallel in windows of consecutive chunks; the
 //! chunks are pushed to the GPU in order, so memory stays bounded by the
-//! window, whatever the mesh size.
+//! window, whatever the mesh size. Window k + 1 is projected (from a scoped
+//! thread driving the rayon pool) while this thread uploads and draws
+//! window k; chunk buffers are reused from window to window.
 //!
 //! Interpolation: region vertices are sent with `w = 1` (positions already
 //! divided), so the GPU interpolates linearly in screen space, which is the
