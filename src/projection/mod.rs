@@ -13,6 +13,8 @@
 //!   (the general path, any piece and view);
 //! - `overlay`: the fast path for pieces in general position (checked
 //!   exactly): regions as intersections of a front and a back triangle;
+//! - `tet`: the fast path's shortcut for tetrahedra (Shirley-Tuchman
+//!   classes, regions built directly);
 //! - `project`: the [`Projector`] pipeline (near clip, projection, regions,
 //!   per-vertex values, fan triangles);
 //! - `refine`: conforming midpoint refinement of region triangles, for the
@@ -47,6 +49,7 @@ mod project;
 mod refine;
 mod slabs;
 pub mod subdivision;
+mod tet;
 
 use glam::DVec2;
 use thiserror::Error;

@@ -9,9 +9,10 @@
 //! 3. classify each boundary triangle by the exact orientation of its
 //!    projection: front (clockwise in pixel coordinates, whose y grows
 //!    downwards), back (counter-clockwise) or edge-on (skipped: zero area);
-//! 4. fast path (`overlay`, [`Projector::fast_path`]): when every point
-//!    is distinct, no triangle is edge-on and the exact checks of `overlay`
-//!    find the piece in general position, the regions are the intersections
+//! 4. fast path ([`Projector::fast_path`]): when every point is distinct
+//!    and no triangle is edge-on, a tetrahedron's regions come straight
+//!    from its Shirley-Tuchman class (`tet`); other pieces that the exact
+//!    checks of `overlay` find in general position get the intersections
 //!    of a front and a back triangle, traced directly (no arrangement);
 //!    anything else declines to the general path, step 5;
 //! 5. general path: build the arrangement of the front and back triangles'
@@ -51,6 +52,7 @@ use super::coverage::PixelGrid;
 use super::overlay::Overlay;
 use super::polyhedron::Polyhedron;
 use super::subdivision::NIL;
+use super::tet::TetRegions;
 use super::{FaceTri, Facing, Projected, ProjectionError, RegionVertex, ViewMap, WidestFaces};
 use crate::camera::Camera;
 use crate::numeric::predicates::{orient2d, Side};
@@ -91,6 +93,7 @@ pub struct Projector {
     clipped: Polyhedron,
     arr: Arrangement,
     overlay: Overlay,
+    tet: TetRegions,
     pix: Vec<DVec2>,
     canon: Vec<u32>,
     facing: Vec<Facing>,
@@ -150,6 +153,7 @@ impl Default for Projector {
             clipped: Polyhedron::default(),
             arr: Arrangement::default(),
             overlay: Overlay::default(),
+            tet: TetRegions::default(),
             pix: Vec::new(),
             canon: Vec::new(),
             facing: Vec::new(),
@@ -266,11 +270,22 @@ impl Projector {
                 Side::On => Facing::EdgeOn,
             });
         }
-        self.took_fast_path = distinct
-            && self.fast_path
-            && !self.check_each_insertion
-            && self.overlay.build(&self.pix, &poly.triangles, &self.facing);
-        if self.took_fast_path {
+        let fast = distinct && self.fast_path && !self.check_each_insertion;
+        let tet = fast && n == 4 && self.tet.build(&self.pix, &poly.triangles, &self.facing);
+        self.took_fast_path =
+            tet || (fast && self.overlay.build(&self.pix, &poly.triangles, &self.facing));
+        if tet {
+            // 4. Regions of a tetrahedron in general position (`tet`).
+            let t = &self.tet;
+            let regions = Regions {
+                pos: &t.pos,
+                on_hull: &t.on_hull,
+                verts: &t.verts,
+                start: &t.start,
+                faces: &t.faces,
+            };
+            emit(poly, &self.pix, regions, &mut self.emit, out);
+        } else if self.took_fast_path {
             // 4. Regions of a piece in general position (`overlay`).
             let o = &self.overlay;
             let regions = Regions {
