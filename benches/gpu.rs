@@ -23,38 +23,29 @@ use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use zoovr::gpu::{AccumFormat, Backend, ClipMapper, Context, ExactVertex, GpuOptions};
+use zoovr::testdata::Rng;
 
 const CHUNK: usize = 1 << 16;
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 fn scene(count: usize, size: u32) -> Vec<ExactVertex> {
     let mut r = Rng(0x5eed_1234);
     let m = ClipMapper::new(size, size, false);
     let mut v = Vec::with_capacity(3 * count);
     for _ in 0..count {
-        let cx = r.next() * size as f64;
-        let cy = r.next() * size as f64;
-        let s = 1.0 + 5.0 * r.next();
-        let glow = [r.next() as f32, r.next() as f32, r.next() as f32];
-        let tau = (0.1 + r.next()) as f32;
+        let cx = r.f64() * size as f64;
+        let cy = r.f64() * size as f64;
+        let s = 1.0 + 5.0 * r.f64();
+        let glow = [r.f64() as f32, r.f64() as f32, r.f64() as f32];
+        let tau = (0.1 + r.f64()) as f32;
         for _ in 0..3 {
             let p = m
                 .clip(
-                    cx + s * (r.next() - 0.5),
-                    cy + s * (r.next() - 0.5),
-                    1.0 + r.next(),
+                    cx + s * (r.f64() - 0.5),
+                    cy + s * (r.f64() - 0.5),
+                    1.0 + r.f64(),
                 )
                 .unwrap_or([0.0, 0.0, 0.5, 1.0]);
-            v.push(ExactVertex::new(p, r.next() as f32, tau, glow));
+            v.push(ExactVertex::new(p, r.f64() as f32, tau, glow));
         }
     }
     v

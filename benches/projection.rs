@@ -9,19 +9,7 @@ use glam::{DMat3, DVec3};
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::{CellKind, Cells};
 use zoovr::projection::{Polyhedron, Projected, Projector};
-
-struct Rng(u64);
-impl Rng {
-    fn f64(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545F4914F6CDD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.f64()
-    }
-}
+use zoovr::testdata::Rng;
 
 /// 64 random pieces of `kind` with their cameras.
 fn pieces(kind: CellKind, ortho: bool, seed: u64) -> Vec<(Polyhedron, Camera)> {

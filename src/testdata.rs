@@ -1,6 +1,7 @@
 //! Locating test data: the shared real datasets (`../shared/data` next to the
 //! project root, or `$ZOOVR_DATA`) and the project's own `meshes/`. Used by
 //! tests and benchmarks, which skip cleanly when the shared data is absent.
+//! Also [`Rng`], the one seeded generator of the tests and benchmarks.
 
 use std::path::PathBuf;
 
@@ -73,4 +74,34 @@ pub fn read_options(rel: &str) -> crate::io::ReadOptions {
         o.q_file = shared_file("bluntfin/bluntfinq.bin");
     }
     o
+}
+
+/// xorshift64* (Vigna): the seeded generator of the tests and benchmarks
+/// (fixed seeds, reproducible runs, no dependency). The seed must not be 0.
+#[derive(Clone, Debug)]
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+
+    /// Uniform in `[0, 1)`.
+    pub fn f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in `[a, b)`.
+    pub fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.f64()
+    }
+
+    /// Uniform in `0..n` (0 when `n` is 0).
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n.max(1) as u64) as usize
+    }
 }

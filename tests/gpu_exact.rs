@@ -8,6 +8,7 @@ use zoovr::gpu::{
 };
 use zoovr::image::Image;
 use zoovr::numeric::tolerance::EXP_TABLE_MAX_ABS_ERROR;
+use zoovr::testdata::Rng;
 
 fn open(backend: Option<Backend>) -> Option<Context> {
     match Context::new(&GpuOptions {
@@ -27,18 +28,6 @@ fn open(backend: Option<Backend>) -> Option<Context> {
 }
 
 /// Small deterministic generator (xorshift64*).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.next()
-    }
-}
 
 fn render(
     ctx: &Context,
@@ -246,7 +235,7 @@ fn random_scene(seed: u64, count: usize, w: u32, h: u32) -> (Vec<ExactVertex>, V
         let cy = r.range(-0.2, 1.2) * h as f64;
         let s = r.range(2.0, 0.4 * w as f64);
         let tau = r.range(0.0, 3.0) as f32;
-        let glow = [r.next() as f32, r.next() as f32, r.next() as f32];
+        let glow = [r.f64() as f32, r.f64() as f32, r.f64() as f32];
         for _ in 0..3 {
             let p = m
                 .clip(cx + r.range(-s, s), cy + r.range(-s, s), r.range(0.5, 20.0))

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use zoovr::field::{ArrayData, DataArray};
 use zoovr::io::legacy::{read, read_bytes};
 use zoovr::mesh::{CellKind, Mesh};
-use zoovr::testdata::shared_file;
+use zoovr::testdata::{shared_file, Rng};
 
 fn load(rel: &str) -> Option<Mesh> {
     let p = shared_file(rel)?;
@@ -589,18 +589,6 @@ fn regex_like_location(msg: &str) -> bool {
 }
 
 /// xorshift64*: a tiny deterministic generator for the mutation test.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 fn mutate(rng: &mut Rng, base: &[u8]) -> Vec<u8> {
     let mut b = base.to_vec();
@@ -609,7 +597,7 @@ fn mutate(rng: &mut Rng, base: &[u8]) -> Vec<u8> {
         1 => {
             for _ in 0..1 + rng.below(4) {
                 let i = rng.below(b.len());
-                b[i] = rng.next() as u8;
+                b[i] = rng.next_u64() as u8;
             }
         }
         2 => {

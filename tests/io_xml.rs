@@ -20,7 +20,7 @@ use base64::Engine;
 use zoovr::field::ArrayData;
 use zoovr::io::{self, collection, xml, Format, ReadOptions};
 use zoovr::mesh::{CellKind, Mesh};
-use zoovr::testdata::shared_file;
+use zoovr::testdata::{shared_file, Rng};
 
 // ---------------------------------------------------------------- helpers
 
@@ -1013,18 +1013,6 @@ fn every_corrupt_xml_file_fails_naming_the_file() {
 }
 
 /// xorshift64*: a fixed-seed generator, so failures reproduce.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 #[test]
 fn mutations_never_panic() {

@@ -122,13 +122,8 @@ mod tests {
 
     #[test]
     fn plane3_agrees_with_orient3d() {
-        let mut x: u64 = 99;
-        let mut f = || {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((x >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut rng = crate::testdata::Rng(99);
+        let mut f = || rng.range(-1.0, 1.0);
         let mut exact_calls = 0;
         for i in 0..20000 {
             let a = DVec3::new(f(), f(), f()) * 100.0;

@@ -279,20 +279,15 @@ fn original_edge(p: Key, q: Key) -> (u32, u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testdata::Rng;
 
     /// A convex piece: the convex hull of `k` points on an ellipsoid
     /// (`crate::mesh::hull`; points off the hull are simply unused).
     fn piece(k: usize, seed: u64) -> Polyhedron {
-        let mut x = seed;
-        let mut f = || {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = Rng(seed);
         let pts: Vec<DVec3> = (0..k)
             .map(|_| {
-                let (u, v) = (f() * std::f64::consts::TAU, f() * 2.0 - 1.0);
+                let (u, v) = (rng.f64() * std::f64::consts::TAU, rng.f64() * 2.0 - 1.0);
                 let r = (1.0 - v * v).sqrt();
                 DVec3::new(2.0 * r * u.cos(), r * u.sin(), 0.7 * v + 3.0)
             })

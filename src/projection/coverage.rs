@@ -170,6 +170,7 @@ impl Projected {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testdata::Rng;
 
     /// Brute force: whether a pixel centre of the image lies within
     /// `margin` of the closed triangle (true Euclidean distance).
@@ -201,30 +202,19 @@ mod tests {
         false
     }
 
-    struct Lcg(u64);
-    impl Lcg {
-        fn f(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
-
     #[test]
     fn small_triangles_agree_with_brute_force() {
         let grid = PixelGrid::new(12, 9);
-        let mut rng = Lcg(7);
+        let mut rng = Rng(7);
         let (mut kept, mut dropped, mut spared) = (0, 0, 0);
         for _ in 0..20000 {
             // Sub-pixel to few-pixel triangles, some reaching off the image.
-            let o = DVec2::new(rng.f() * 14.0 - 1.0, rng.f() * 11.0 - 1.0);
-            let s = 0.05 + 2.0 * rng.f() * rng.f();
+            let o = DVec2::new(rng.f64() * 14.0 - 1.0, rng.f64() * 11.0 - 1.0);
+            let s = 0.05 + 2.0 * rng.f64() * rng.f64();
             let p = [
                 o,
-                o + DVec2::new(rng.f(), rng.f()) * s,
-                o + DVec2::new(rng.f(), rng.f()) * s,
+                o + DVec2::new(rng.f64(), rng.f64()) * s,
+                o + DVec2::new(rng.f64(), rng.f64()) * s,
             ];
             let fast = grid.triangle_reaches(p[0], p[1], p[2]);
             // Never drops a triangle that reaches a centre with the margin.
@@ -256,14 +246,14 @@ mod tests {
     #[test]
     fn polygons_agree_with_their_fans() {
         let grid = PixelGrid::new(10, 10);
-        let mut rng = Lcg(3);
+        let mut rng = Rng(3);
         let (mut yes, mut no) = (0, 0);
         for _ in 0..20000 {
             // A convex polygon: points on an ellipse at sorted angles.
-            let c = DVec2::new(rng.f() * 12.0 - 1.0, rng.f() * 12.0 - 1.0);
-            let (rx, ry) = (0.05 + rng.f() * 1.5, 0.05 + rng.f() * 1.5);
-            let n = 3 + (rng.f() * 6.0) as usize;
-            let mut ang: Vec<f64> = (0..n).map(|_| rng.f() * std::f64::consts::TAU).collect();
+            let c = DVec2::new(rng.f64() * 12.0 - 1.0, rng.f64() * 12.0 - 1.0);
+            let (rx, ry) = (0.05 + rng.f64() * 1.5, 0.05 + rng.f64() * 1.5);
+            let n = 3 + (rng.f64() * 6.0) as usize;
+            let mut ang: Vec<f64> = (0..n).map(|_| rng.f64() * std::f64::consts::TAU).collect();
             ang.sort_by(f64::total_cmp);
             let p: Vec<DVec2> = ang
                 .iter()

@@ -694,19 +694,7 @@ mod tests {
     use crate::camera::{Camera, CameraParams};
     use crate::mesh::{CellKind, Cells};
     use crate::projection::{Polyhedron, Projected, Projector};
-
-    struct Rng(u64);
-    impl Rng {
-        fn f64(&mut self) -> f64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545F4914F6CDD1D) >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn range(&mut self, a: f64, b: f64) -> f64 {
-            a + (b - a) * self.f64()
-        }
-    }
+    use crate::testdata::Rng;
 
     const KINDS: [CellKind; 6] = CellKind::FIXED;
 

@@ -6,24 +6,7 @@ use glam::{DMat3, DVec2, DVec3};
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::{CellKind, Cells};
 use zoovr::projection::{Polyhedron, Projected, ViewMap};
-
-/// xorshift64* (fixed seeds, no dependency).
-pub struct Rng(pub u64);
-
-impl Rng {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545F4914F6CDD1D)
-    }
-    pub fn f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.f64()
-    }
-}
+pub use zoovr::testdata::Rng;
 
 pub const KINDS: [CellKind; 6] = CellKind::FIXED;
 
