@@ -27,8 +27,6 @@ fn open(backend: Option<Backend>) -> Option<Context> {
     }
 }
 
-/// Small deterministic generator (xorshift64*).
-
 fn render(
     ctx: &Context,
     opts: &FrameOptions,

@@ -588,8 +588,6 @@ fn regex_like_location(msg: &str) -> bool {
     })
 }
 
-/// xorshift64*: a tiny deterministic generator for the mutation test.
-
 fn mutate(rng: &mut Rng, base: &[u8]) -> Vec<u8> {
     let mut b = base.to_vec();
     match rng.below(4) {

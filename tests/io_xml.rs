@@ -1012,8 +1012,6 @@ fn every_corrupt_xml_file_fails_naming_the_file() {
     assert!(n >= 8, "only {n} corrupt xml files");
 }
 
-/// xorshift64*: a fixed-seed generator, so failures reproduce.
-
 #[test]
 fn mutations_never_panic() {
     let seeds: Vec<Vec<u8>> = vec![
