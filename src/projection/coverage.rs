@@ -84,8 +84,7 @@ impl PixelGrid {
     /// grown by the margin (see module docs).
     #[inline]
     pub fn triangle_reaches(&self, a: DVec2, b: DVec2, c: DVec2) -> bool {
-        let p = [a, b, c];
-        self.polygon_reaches(3, |k| p[k])
+        self.points_reach(&[a, b, c])
     }
 
     /// Whether a pixel centre lies in the convex polygon of `n` points
@@ -99,10 +98,20 @@ impl PixelGrid {
             return true;
         }
         let mut p = [DVec2::ZERO; MAX_POLYGON];
-        p[0] = at(0);
-        let (mut min, mut max) = (p[0], p[0]);
-        for (k, q) in p.iter_mut().enumerate().take(n).skip(1) {
+        for (k, q) in p.iter_mut().enumerate().take(n) {
             *q = at(k);
+        }
+        self.points_reach(&p[..n])
+    }
+
+    /// [`Self::polygon_reaches`] of the (at least one) points `p`. Inlined
+    /// into [`Self::triangle_reaches`], the per-triangle test of the
+    /// renderers, where the three points' loops unroll.
+    #[inline(always)]
+    fn points_reach(&self, p: &[DVec2]) -> bool {
+        let n = p.len();
+        let (mut min, mut max) = (p[0], p[0]);
+        for q in &p[1..] {
             min = min.min(*q);
             max = max.max(*q);
         }
@@ -119,20 +128,16 @@ impl PixelGrid {
         // is cross(d, q - p) / |d| (positive on the left); compared squared,
         // `e < -m |d|` is `e < 0 && e^2 > m^2 |d|^2`.
         let m2 = COVERAGE_MARGIN_PX * COVERAGE_MARGIN_PX;
-        let mut d = [DVec2::ZERO; MAX_POLYGON];
-        let mut lim = [0.0; MAX_POLYGON];
-        for k in 0..n {
-            d[k] = p[(k + 1) % n] - p[k];
-            lim[k] = m2 * d[k].length_squared();
-        }
         for j in j0..=j1 {
             let y = j as f64 + 0.5;
             for i in i0..=i1 {
                 let q = DVec2::new(i as f64 + 0.5, y);
                 let (mut left, mut right) = (true, true);
                 for k in 0..n {
-                    let e = d[k].perp_dot(q - p[k]);
-                    let far = e * e > lim[k];
+                    let pk = p[k];
+                    let d = p[if k + 1 == n { 0 } else { k + 1 }] - pk;
+                    let e = d.perp_dot(q - pk);
+                    let far = e * e > m2 * d.length_squared();
                     left &= !(e < 0.0 && far);
                     right &= !(e > 0.0 && far);
                 }
