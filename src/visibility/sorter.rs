@@ -19,6 +19,7 @@
 use std::time::Instant;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::exact::orient_dir;
 use super::geometry::{Geometry, BOUNDARY, CONCAVE, FLIP, PLANAR};
@@ -451,60 +452,83 @@ impl Sorter {
             return Err(VisibilityError::TooManyPieces(pieces));
         }
         extra.pieces = pieces;
-        let mut edges: Vec<(u32, u32)> = Vec::new();
-        let p = &self.mesh.points;
         for &c in &self.pool.active {
-            let faces = self.topo.faces_of(c as usize);
-            for &f in faces {
-                let fu = f as usize;
-                self.face_target[fu] = NONE;
-                let [c0, c1] = self.topo.face_cells[fu];
-                if c1 == NONE {
-                    continue;
-                }
-                let other = if c0 == c { c1 } else { c0 };
-                // Handle a face between two split cells once (from c0).
-                if self.pool.get(other).is_some() && c != c0 {
-                    continue;
-                }
-                let flip = self.geom.face_flags[fu] & FLIP != 0;
-                for (k, t) in self.geom.tris(fu).enumerate() {
-                    let s = self.tri_sign[t];
-                    if s == 0 {
-                        continue;
-                    }
-                    let p0 = self.piece_on(&extra, c0, f, k);
-                    let p1 = self.piece_on(&extra, c1, f, k);
-                    // Eye on c1's side: c1's piece is drawn later.
-                    if (s > 0) != flip {
-                        edges.push((p0, p1));
-                    } else {
-                        edges.push((p1, p0));
-                    }
-                }
-            }
-            if let Some(sc) = self.pool.get(c) {
-                let b = n as u32 + extra.base_by_slot[self.pool.slot_of[c as usize] as usize];
-                for it in &sc.internal {
-                    let [a, bb, cc] = it.tri.map(|v| p[v as usize]);
-                    let se = view.side(a, bb, cc);
-                    if se == Side::On || it.side_i == Side::On {
-                        continue;
-                    }
-                    let (pi, pj) = (b + it.i, b + it.j);
-                    // Eye on tet i's side: i occludes j, j first.
-                    if se == it.side_i {
-                        edges.push((pj, pi));
-                    } else {
-                        edges.push((pi, pj));
-                    }
-                }
+            for &f in self.topo.faces_of(c as usize) {
+                self.face_target[f as usize] = NONE;
             }
         }
+        // The edges of each block of split cells on the thread pool, joined
+        // in cell order (the same list as one pass over the cells).
+        let this = &*self;
+        let blocks: Vec<Vec<(u32, u32)>> = this
+            .pool
+            .active
+            .par_chunks(EXTRA_BLOCK)
+            .map(|block| {
+                let mut edges = Vec::new();
+                for &c in block {
+                    this.split_cell_edges(&extra, view, c, &mut edges);
+                }
+                edges
+            })
+            .collect();
+        let edges = blocks.concat();
         extra.to = Vec::new();
         extra.off = Vec::new();
         self.set_edges(&mut extra, edges);
         Ok(extra)
+    }
+
+    /// Appends the edges of split cell `c` to `edges`: per triangle of its
+    /// faces shared with another cell (a face between two split cells from
+    /// its first cell only), and between its own tets.
+    fn split_cell_edges(&self, extra: &Extra, view: View, c: u32, edges: &mut Vec<(u32, u32)>) {
+        let n = self.mesh.cells.len();
+        let p = &self.mesh.points;
+        for &f in self.topo.faces_of(c as usize) {
+            let fu = f as usize;
+            let [c0, c1] = self.topo.face_cells[fu];
+            if c1 == NONE {
+                continue;
+            }
+            let other = if c0 == c { c1 } else { c0 };
+            // Handle a face between two split cells once (from c0).
+            if self.pool.get(other).is_some() && c != c0 {
+                continue;
+            }
+            let flip = self.geom.face_flags[fu] & FLIP != 0;
+            for (k, t) in self.geom.tris(fu).enumerate() {
+                let s = self.tri_sign[t];
+                if s == 0 {
+                    continue;
+                }
+                let p0 = self.piece_on(extra, c0, f, k);
+                let p1 = self.piece_on(extra, c1, f, k);
+                // Eye on c1's side: c1's piece is drawn later.
+                if (s > 0) != flip {
+                    edges.push((p0, p1));
+                } else {
+                    edges.push((p1, p0));
+                }
+            }
+        }
+        if let Some(sc) = self.pool.get(c) {
+            let b = n as u32 + extra.base_by_slot[self.pool.slot_of[c as usize] as usize];
+            for it in &sc.internal {
+                let [a, bb, cc] = it.tri.map(|v| p[v as usize]);
+                let se = view.side(a, bb, cc);
+                if se == Side::On || it.side_i == Side::On {
+                    continue;
+                }
+                let (pi, pj) = (b + it.i, b + it.j);
+                // Eye on tet i's side: i occludes j, j first.
+                if se == it.side_i {
+                    edges.push((pj, pi));
+                } else {
+                    edges.push((pi, pj));
+                }
+            }
+        }
     }
 
     /// Appends the non-convex constraints (mapped to pieces); returns their
@@ -693,8 +717,8 @@ impl Sorter {
         };
         levels.sort_by(f64::total_cmp);
         levels.dedup();
-        let mut out = Emit {
-            pieces: Vec::with_capacity(extra.pieces),
+        let emit = |capacity: usize| Emit {
+            pieces: Vec::with_capacity(capacity),
             levels: &levels,
             scalars: policy.point_scalars,
             points: &self.mesh.points,
@@ -703,8 +727,22 @@ impl Sorter {
             bands: Vec::new(),
             keyed: Vec::new(),
         };
-        for &v in &emitted {
-            out.push(self.piece(extra, v));
+        // The emitted pieces in blocks on the thread pool (slicing a tet
+        // into its ordered slabs is most of the work), joined in order.
+        let blocks: Vec<Emit> = emitted
+            .par_chunks(FINISH_BLOCK)
+            .map(|block| {
+                let mut out = emit(block.len() + block.len() / 2);
+                for &v in block {
+                    out.push(self.piece(extra, v));
+                }
+                out
+            })
+            .collect();
+        let mut out = emit(blocks.iter().map(|b| b.pieces.len()).sum::<usize>() + comps.len());
+        for b in blocks {
+            out.pieces.extend_from_slice(&b.pieces);
+            out.sliced += b.sliced;
         }
         let view = if camera.ortho {
             View::Dir(camera.forward)
@@ -809,6 +847,12 @@ impl Sorter {
         }
     }
 }
+
+/// Emitted pieces per block of [`Sorter::finish`]'s parallel pass.
+const FINISH_BLOCK: usize = 1 << 14;
+
+/// Split cells per block of [`Sorter::build_extra`]'s parallel pass.
+const EXTRA_BLOCK: usize = 1 << 12;
 
 /// Appends pieces to an order, a tet holding breakpoints as its slabs.
 struct Emit<'a> {

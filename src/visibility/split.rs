@@ -7,6 +7,8 @@
 //! triangulation of the topology's stored face), and the triangles shared by
 //! two tets inside the cell, with the side of the first tet's apex.
 
+use rayon::prelude::*;
+
 use crate::mesh::tetra::{tetrahedralize_cell, triangulate_face};
 use crate::mesh::topology::Topology;
 use crate::mesh::{Mesh, NONE};
@@ -164,15 +166,23 @@ impl SplitPool {
             }
         }
         self.active.clear();
+        let mut new_cells = Vec::new();
         for (c, &w) in want.iter().enumerate() {
             if w == 0 {
                 continue;
             }
             self.active.push(c as u32);
-            if self.slot_of[c] != NONE {
-                continue;
+            if self.slot_of[c] == NONE {
+                new_cells.push(c);
             }
-            let sc = SplitCell::build(mesh, topo, c);
+        }
+        // The splits are independent: built in parallel, stored in cell
+        // order (the same slots as a serial build).
+        let built: Vec<SplitCell> = new_cells
+            .par_iter()
+            .map(|&c| SplitCell::build(mesh, topo, c))
+            .collect();
+        for (&c, sc) in new_cells.iter().zip(built) {
             let s = match self.free.pop() {
                 Some(s) => {
                     self.slots[s as usize] = sc;
