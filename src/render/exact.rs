@@ -23,11 +23,12 @@
 //!    GPU evaluates `alpha = 1 - exp(-l tau)` per pixel from its
 //!    exponential table and composites back to front.
 //!
-//! Pieces are processed in parallel in windows of consecutive chunks; the
-//! chunks are pushed to the GPU in order, so memory stays bounded by the
-//! window, whatever the mesh size. Window k + 1 is projected (from a scoped
-//! thread driving the rayon pool) while this thread uploads and draws
-//! window k; chunk buffers are reused from window to window.
+//! Pieces are processed in chunks of consecutive pieces by worker threads
+//! (as many as the rayon pool has), which take chunks in order and run a
+//! bounded number of chunks ahead of this thread; this thread uploads and
+//! draws each chunk as soon as it and all before it are done, so memory
+//! stays bounded whatever the mesh size and no worker waits for another
+//! ([`pipeline`]); chunk buffers are reused.
 //!
 //! Interpolation: region vertices are sent with `w = 1` (positions already
 //! divided), so the GPU interpolates linearly in screen space, which is the
@@ -37,11 +38,10 @@
 //! composited per pixel on the CPU into one layer each, drawn at the group's
 //! place in the order ([`super::group`]).
 
-use std::sync::Mutex;
+use std::sync::{Condvar, Mutex};
 use std::time::Instant;
 
 use glam::{DVec2, DVec3};
-use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::gpu::{Context, ExactVertex, Frame, FrameOptions, FrameStats, PendingContext};
@@ -61,8 +61,13 @@ use super::group::composite_group;
 use super::scene::{ScalarsRef, Scene};
 use super::{RenderError, RenderOptions};
 
-/// Pieces processed per parallel chunk.
+/// Pieces processed per chunk (one worker's unit of work).
 const CHUNK: usize = 2048;
+
+/// Chunks a worker may run ahead of the GPU hand-over, per worker: bounds
+/// the memory in flight (about 0.4 MB per chunk on a fine mesh) while
+/// keeping every worker busy when chunk costs vary.
+const AHEAD_PER_WORKER: usize = 4;
 
 /// What the exact mode did, with times in seconds.
 #[derive(Clone, Debug, Default)]
@@ -640,6 +645,132 @@ fn push_out(frame: &mut Frame, out: &ChunkOut, stats: &mut ExactStats) -> Result
     Ok(())
 }
 
+/// Chunk buffers of drawn chunks, reused: fresh multi-megabyte vectors
+/// would be new pages for the kernel to fault in and zero, chunk after
+/// chunk.
+#[derive(Default)]
+struct BufferPool(Mutex<Vec<ChunkOut>>);
+
+impl BufferPool {
+    fn take(&self) -> ChunkOut {
+        self.0
+            .lock()
+            .ok()
+            .and_then(|mut p| p.pop())
+            .unwrap_or_default()
+    }
+
+    fn put(&self, mut out: ChunkOut) {
+        out.clear();
+        if let Ok(mut p) = self.0.lock() {
+            p.push(out);
+        }
+    }
+}
+
+/// Shared state of [`pipeline`].
+struct Flow {
+    /// Next chunk a worker takes.
+    next: usize,
+    /// Chunks handed to the sink so far.
+    handed: usize,
+    /// Finished chunks waiting for the hand-over (`slots[i % len]`).
+    slots: Vec<Option<ChunkOut>>,
+    /// Set when the sink failed or a worker panicked: everyone stops.
+    stop: bool,
+    panic: Option<Box<dyn std::any::Any + Send>>,
+}
+
+/// Projects `pieces` in chunks of `chunk` ([`CHUNK`]) on `workers` threads and hands
+/// each chunk's output to `sink` on this thread, in order, as soon as it
+/// and all before it are done. Workers take chunks in order and run at most
+/// [`AHEAD_PER_WORKER`] per worker ahead of the hand-over, so memory stays
+/// bounded; there is no barrier between groups of chunks, so no worker
+/// waits for another's slow chunk. The first error of `sink` stops the
+/// workers and is returned; a worker's panic is resumed here.
+fn pipeline(
+    ctx: &Ctx,
+    pieces: &[Piece],
+    chunk: usize,
+    workers: usize,
+    pool: &BufferPool,
+    mut sink: impl FnMut(ChunkOut) -> Result<(), RenderError>,
+) -> Result<(), RenderError> {
+    let chunks: Vec<&[Piece]> = pieces.chunks(chunk.max(1)).collect();
+    if chunks.is_empty() {
+        return Ok(());
+    }
+    let ahead = workers * AHEAD_PER_WORKER;
+    let flow = Mutex::new(Flow {
+        next: 0,
+        handed: 0,
+        slots: (0..ahead).map(|_| None).collect(),
+        stop: false,
+        panic: None,
+    });
+    let changed = Condvar::new();
+    let lock = || flow.lock().unwrap_or_else(|e| e.into_inner());
+    let result = std::thread::scope(|s| {
+        for _ in 0..workers.min(chunks.len()) {
+            s.spawn(|| loop {
+                let i = {
+                    let mut f = lock();
+                    while !f.stop && f.next < chunks.len() && f.next >= f.handed + ahead {
+                        f = changed.wait(f).unwrap_or_else(|e| e.into_inner());
+                    }
+                    if f.stop || f.next >= chunks.len() {
+                        return;
+                    }
+                    f.next += 1;
+                    f.next - 1
+                };
+                let done = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    process_chunk(ctx, chunks[i], pool.take())
+                }));
+                let mut f = lock();
+                match done {
+                    Ok(out) => f.slots[i % ahead] = Some(out),
+                    Err(p) => {
+                        f.stop = true;
+                        f.panic.get_or_insert(p);
+                    }
+                }
+                drop(f);
+                changed.notify_all();
+            });
+        }
+        for i in 0..chunks.len() {
+            let out = {
+                let mut f = lock();
+                loop {
+                    if f.stop {
+                        return Ok(());
+                    }
+                    if let Some(out) = f.slots[i % ahead].take() {
+                        break out;
+                    }
+                    f = changed.wait(f).unwrap_or_else(|e| e.into_inner());
+                }
+            };
+            let r = sink(out);
+            let mut f = lock();
+            f.handed += 1;
+            if r.is_err() {
+                f.stop = true;
+            }
+            drop(f);
+            changed.notify_all();
+            r?;
+        }
+        Ok(())
+    });
+    let panic = lock().panic.take();
+    if let Some(p) = panic {
+        std::panic::resume_unwind(p);
+    }
+    result
+}
+
 /// Renders the scene in the exact mode. The GPU context is `gpu`, or, when
 /// that is empty, `pending` (a context opening on another thread, waited
 /// for after the sort, which it overlaps) or a new one opened with
@@ -698,7 +829,6 @@ pub fn render_exact(
     fopts.length_unit = scene.unit_distance as f32;
     let t_gpu = Instant::now();
     let mut frame = gpu.begin_frame_with(&fopts)?;
-    let window = CHUNK * rayon::current_num_threads().max(1) * 2;
     let total = order.pieces.len();
     let mut done = 0;
     // Stretches of ordinary pieces, each followed by at most one group.
@@ -709,50 +839,20 @@ pub fn render_exact(
         start = g.end;
     }
     stretches.push((start..total, None));
-    // Window k + 1 is projected (on the rayon pool, from a scoped thread)
-    // while this thread hands window k to the GPU, so the pool never waits
-    // for uploads.
     let tp = Instant::now();
-    let mut ready: Vec<ChunkOut> = Vec::new();
-    // Buffers of drawn chunks, reused: fresh multi-megabyte vectors would
-    // be new pages for the kernel to fault in and zero, chunk after chunk.
-    let pool: Mutex<Vec<ChunkOut>> = Mutex::new(Vec::new());
-    let recycled = || {
-        pool.lock()
-            .ok()
-            .and_then(|mut p| p.pop())
-            .unwrap_or_default()
-    };
-    let recycle = |mut out: ChunkOut| {
-        out.clear();
-        if let Ok(mut p) = pool.lock() {
-            p.push(out);
-        }
-    };
+    let pool = BufferPool::default();
+    let workers = rayon::current_num_threads().max(1);
     for (plain, group) in stretches {
-        for win in order.pieces[plain].chunks(window) {
-            let projected = std::thread::scope(|s| {
-                let next = s.spawn(|| {
-                    win.par_chunks(CHUNK)
-                        .map(|c| process_chunk(&ctx, c, recycled()))
-                        .collect::<Vec<ChunkOut>>()
-                });
-                let pushed = ready.drain(..).try_for_each(|out| {
-                    push_out(&mut frame, &out, &mut stats)?;
-                    recycle(out);
-                    Ok::<(), RenderError>(())
-                });
-                let next = next.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
-                pushed.map(|()| next)
-            })?;
-            ready = projected;
-            done += win.len();
-            progress(done, total);
-        }
-        for out in ready.drain(..) {
+        let pieces = &order.pieces[plain];
+        let mut handed = 0;
+        pipeline(&ctx, pieces, CHUNK, workers, &pool, |out| {
             push_out(&mut frame, &out, &mut stats)?;
-            recycle(out);
-        }
+            pool.put(out);
+            handed += CHUNK;
+            progress(done + handed.min(pieces.len()), total);
+            Ok(())
+        })?;
+        done += pieces.len();
         if let Some(g) = group {
             let mut out = ChunkOut::default();
             stats.group_pixels += composite_group(&ctx, &order.pieces[g.clone()], &mut out);
@@ -850,5 +950,84 @@ mod tests {
         }
         // The view still makes the case this guards against.
         assert!(degenerate > 0, "no f32-degenerate sliver in this view");
+    }
+
+    /// The pipeline hands every chunk over in order, exactly as projecting
+    /// the chunks one after another gives them, with whatever number of
+    /// workers; an error of the hand-over stops it and is returned.
+    #[test]
+    fn pipeline_hands_chunks_over_in_order_and_stops_on_error() {
+        let mesh = warped_hex_grid(
+            12,
+            &Warp {
+                amplitude: 0.2,
+                seed: 3,
+            },
+        );
+        let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        let camera = Camera::fit(
+            scene.mesh.bounds(),
+            &CameraParams {
+                width: 64,
+                height: 64,
+                azimuth: 30.0,
+                elevation: 20.0,
+                ..Default::default()
+            },
+        );
+        let breakpoints = split_points(&scene.tf);
+        let policy = SplitPolicy {
+            all: true,
+            breakpoints: &breakpoints,
+            point_scalars: None,
+        };
+        let mut sorter = Sorter::new(&scene.mesh, &scene.topology);
+        let order = sorter.order(&camera, &policy).unwrap();
+        let ctx = Ctx {
+            mesh: &scene.mesh,
+            scalars: scene.scalars(),
+            tf: &scene.tf,
+            camera: &camera,
+            breakpoints: &breakpoints,
+            levels: &order.levels,
+            fragments: &order.fragments,
+            length_unit: scene.unit_distance,
+            cull: true,
+            grid: PixelGrid::new(camera.width, camera.height),
+        };
+        let chunk = 64;
+        let chunks = order.pieces.chunks(chunk).count();
+        assert!(chunks > 4 * 3 * AHEAD_PER_WORKER, "{chunks} chunks");
+        let serial: Vec<(Vec<ExactVertex>, Vec<u32>)> = order
+            .pieces
+            .chunks(chunk)
+            .map(|c| {
+                let out = process_chunk(&ctx, c, ChunkOut::default());
+                (out.vertices, out.indices)
+            })
+            .collect();
+        assert!(serial.iter().filter(|c| !c.1.is_empty()).count() > chunks / 2);
+        let pool = BufferPool::default();
+        for workers in [1, 2, 3] {
+            let mut got = Vec::new();
+            pipeline(&ctx, &order.pieces, chunk, workers, &pool, |out| {
+                got.push((out.vertices.clone(), out.indices.clone()));
+                pool.put(out);
+                Ok(())
+            })
+            .unwrap();
+            assert!(got == serial, "{workers} workers");
+            let mut calls = 0;
+            let r = pipeline(&ctx, &order.pieces, chunk, workers, &pool, |_| {
+                calls += 1;
+                if calls == 3 {
+                    Err(RenderError::Projection("stop".into()))
+                } else {
+                    Ok(())
+                }
+            });
+            assert!(matches!(r, Err(RenderError::Projection(_))));
+            assert_eq!(calls, 3);
+        }
     }
 }
