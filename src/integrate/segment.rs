@@ -180,48 +180,47 @@ const GLOW_LIMIT_DEPTH: f64 = 1e-200;
 ///   (a mode that needs `g` cannot represent it and must fall back).
 pub fn vertex_values(tf: &TransferFunction, l: f64, s_f: f64, s_b: f64) -> VertexValues {
     let seg = segment(tf, l, s_f, s_b);
-    // Interval averages (length 1 slicing; shares sum to 1).
-    let (sf, sb) = (
-        if s_f.is_nan() {
-            0.0
-        } else {
-            s_f.clamp(-MAX_SCALAR, MAX_SCALAR)
-        },
-        if s_b.is_nan() {
-            0.0
-        } else {
-            s_b.clamp(-MAX_SCALAR, MAX_SCALAR)
-        },
-    );
-    let mut tau_mean = 0.0;
+    let direct = seg.depth > GLOW_LIMIT_DEPTH;
+    let by_length = l > 0.0 && seg.depth > 0.0 && l.is_finite();
+    // Interval averages (length 1 slicing; shares sum to 1), needed only
+    // for the limits (most vertices skip this second pass).
+    let mut tau_avg = 0.0;
     let mut weighted = [0.0; 3];
     let mut plain = [0.0; 3];
-    for_each_piece(tf, 1.0, sf, sb, |share, t0, t1, c0, c1| {
-        tau_mean += share * 0.5 * (t0 + t1);
-        for k in 0..3 {
-            weighted[k] += share * (c0[k] * (2.0 * t0 + t1) + c1[k] * (t0 + 2.0 * t1)) / 6.0;
-            plain[k] += share * 0.5 * (c0[k] + c1[k]);
-        }
-    });
-    let glow = if seg.depth > GLOW_LIMIT_DEPTH {
+    if !(direct && by_length) {
+        let (sf, sb) = (
+            if s_f.is_nan() {
+                0.0
+            } else {
+                s_f.clamp(-MAX_SCALAR, MAX_SCALAR)
+            },
+            if s_b.is_nan() {
+                0.0
+            } else {
+                s_b.clamp(-MAX_SCALAR, MAX_SCALAR)
+            },
+        );
+        for_each_piece(tf, 1.0, sf, sb, |share, t0, t1, c0, c1| {
+            tau_avg += share * 0.5 * (t0 + t1);
+            for k in 0..3 {
+                weighted[k] += share * (c0[k] * (2.0 * t0 + t1) + c1[k] * (t0 + 2.0 * t1)) / 6.0;
+                plain[k] += share * 0.5 * (c0[k] + c1[k]);
+            }
+        });
+    }
+    let glow = if direct {
         std::array::from_fn(|k| seg.color[k] / seg.alpha)
     } else {
         match tf.model() {
-            EmissionModel::Glow if tau_mean > 0.0 => {
-                std::array::from_fn(|k| weighted[k] / tau_mean)
-            }
+            EmissionModel::Glow if tau_avg > 0.0 => std::array::from_fn(|k| weighted[k] / tau_avg),
             EmissionModel::Glow => plain,
-            EmissionModel::Independent if tau_mean > 0.0 => {
-                std::array::from_fn(|k| plain[k] / tau_mean)
+            EmissionModel::Independent if tau_avg > 0.0 => {
+                std::array::from_fn(|k| plain[k] / tau_avg)
             }
             EmissionModel::Independent => [0.0; 3],
         }
     };
-    let tau_mean = if l > 0.0 && seg.depth > 0.0 && l.is_finite() {
-        seg.depth / l
-    } else {
-        tau_mean
-    };
+    let tau_mean = if by_length { seg.depth / l } else { tau_avg };
     VertexValues {
         color: seg.color,
         alpha: seg.alpha,
