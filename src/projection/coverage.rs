@@ -53,38 +53,50 @@ impl PixelGrid {
         PixelGrid { width, height }
     }
 
-    /// Indices `i` of the centres `i + 0.5` in `[lo - m, hi + m]` within
-    /// `0..n` (`m` the margin), or `None` (also for NaN).
+    /// The centres a point can reach within the margin, per axis: indices
+    /// `i` of the centres `i + 0.5` in `[x - m, x + m]` (`m` the margin)
+    /// as `[i_lo, i_hi]` (empty when `i_lo > i_hi`), clamped to the image
+    /// (`i_lo <= n`, `i_hi >= -1`), and the same for `y`. A polygon's span
+    /// is the smallest `lo` and the largest `hi` of its points' spans
+    /// (rounding and `ceil`/`floor` are monotone, so this is exactly the
+    /// span of its grown bounding box). A NaN coordinate reaches nothing.
     #[inline]
-    fn span(lo: f64, hi: f64, n: u32) -> Option<(i64, i64)> {
-        let last = n as f64 - 1.0;
-        let a = lo - COVERAGE_MARGIN_PX - 0.5;
-        let b = hi + COVERAGE_MARGIN_PX - 0.5;
-        // NaN compares false: no span.
-        if !(a <= last && b >= 0.0) {
-            return None;
+    pub fn span(&self, p: DVec2) -> Span {
+        #[inline(always)]
+        fn axis(x: f64, n: u32) -> [i32; 2] {
+            if x.is_nan() {
+                return [n as i32, -1]; // reaches nothing
+            }
+            let top = n as f64;
+            // Clamped first: positions may be ~1e9 pixels away.
+            let a = (x - COVERAGE_MARGIN_PX - 0.5).clamp(-1.0, top);
+            let b = (x + COVERAGE_MARGIN_PX - 0.5).clamp(-1.0, top - 1.0);
+            // ceil(a) and floor(b) by truncation (`f64::ceil` and
+            // `f64::floor` are library calls on baseline x86-64).
+            let ia = a as i32;
+            let ia = ia + ((ia as f64) < a) as i32;
+            let ib = b as i32;
+            let ib = ib - ((ib as f64) > b) as i32;
+            [ia.max(0), ib]
         }
-        let (a, b) = (a.max(0.0), b.min(last));
-        // ceil(a) and floor(b) of values in [0, n - 1] by truncation
-        // (`f64::ceil` is a library call on baseline x86-64).
-        let ia = a as i64;
-        let ia = ia + ((ia as f64) < a) as i64;
-        let ib = b as i64;
-        (ia <= ib).then_some((ia, ib))
+        let [x0, x1] = axis(p.x, self.width);
+        let [y0, y1] = axis(p.y, self.height);
+        Span { x0, x1, y0, y1 }
     }
 
     /// Whether a pixel centre lies in the box `[min, max]` grown by the
     /// margin.
     pub fn box_reaches(&self, min: DVec2, max: DVec2) -> bool {
-        Self::span(min.x, max.x, self.width).is_some()
-            && Self::span(min.y, max.y, self.height).is_some()
+        let s = self.span(min).join(&self.span(max));
+        s.x0 <= s.x1 && s.y0 <= s.y1
     }
 
     /// Whether a pixel centre lies in triangle `a, b, c` (either winding)
     /// grown by the margin (see module docs).
     #[inline]
     pub fn triangle_reaches(&self, a: DVec2, b: DVec2, c: DVec2) -> bool {
-        self.points_reach(&[a, b, c])
+        let s = self.span(a).join(&self.span(b)).join(&self.span(c));
+        Self::centres_reach(&[a, b, c], s)
     }
 
     /// Whether a pixel centre lies in the convex polygon of `n` points
@@ -98,39 +110,36 @@ impl PixelGrid {
             return true;
         }
         let mut p = [DVec2::ZERO; MAX_POLYGON];
+        let mut s = self.span(at(0));
         for (k, q) in p.iter_mut().enumerate().take(n) {
             *q = at(k);
+            s = s.join(&self.span(*q));
         }
-        self.points_reach(&p[..n])
+        Self::centres_reach(&p[..n], s)
     }
 
-    /// [`Self::polygon_reaches`] of the (at least one) points `p`. Inlined
-    /// into [`Self::triangle_reaches`], the per-triangle test of the
-    /// renderers, where the three points' loops unroll.
+    /// Whether a centre of span `s` (the polygon's) lies in the convex
+    /// polygon `p` grown by the margin; polygons whose span holds more than
+    /// [`MAX_CANDIDATES`] centres are kept untested. Inlined into
+    /// [`Self::triangle_reaches`] and [`Projected::cull_to_pixels`], where
+    /// the three points' loops unroll.
     #[inline(always)]
-    fn points_reach(&self, p: &[DVec2]) -> bool {
-        let n = p.len();
-        let (mut min, mut max) = (p[0], p[0]);
-        for q in &p[1..] {
-            min = min.min(*q);
-            max = max.max(*q);
-        }
-        let (Some((i0, i1)), Some((j0, j1))) = (
-            Self::span(min.x, max.x, self.width),
-            Self::span(min.y, max.y, self.height),
-        ) else {
+    fn centres_reach(p: &[DVec2], s: Span) -> bool {
+        if s.x0 > s.x1 || s.y0 > s.y1 {
             return false;
-        };
-        if (i1 - i0 + 1) * (j1 - j0 + 1) > MAX_CANDIDATES {
+        }
+        let count = (s.x1 - s.x0 + 1) as i64 * (s.y1 - s.y0 + 1) as i64;
+        if count > MAX_CANDIDATES {
             return true;
         }
+        let n = p.len();
         // Edge k from p[k] to p[k + 1]: the signed distance of q to its line
         // is cross(d, q - p) / |d| (positive on the left); compared squared,
         // `e < -m |d|` is `e < 0 && e^2 > m^2 |d|^2`.
         let m2 = COVERAGE_MARGIN_PX * COVERAGE_MARGIN_PX;
-        for j in j0..=j1 {
+        for j in s.y0..=s.y1 {
             let y = j as f64 + 0.5;
-            for i in i0..=i1 {
+            for i in s.x0..=s.x1 {
                 let q = DVec2::new(i as f64 + 0.5, y);
                 let (mut left, mut right) = (true, true);
                 for k in 0..n {
@@ -150,17 +159,48 @@ impl PixelGrid {
     }
 }
 
+/// The pixel centres a point or polygon can reach ([`PixelGrid::span`]):
+/// column indices `x0..=x1`, row indices `y0..=y1`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Span {
+    pub x0: i32,
+    pub x1: i32,
+    pub y0: i32,
+    pub y1: i32,
+}
+
+impl Span {
+    /// The span of the union.
+    #[inline(always)]
+    pub fn join(&self, o: &Span) -> Span {
+        Span {
+            x0: self.x0.min(o.x0),
+            x1: self.x1.max(o.x1),
+            y0: self.y0.min(o.y0),
+            y1: self.y1.max(o.y1),
+        }
+    }
+}
+
 impl Projected {
     /// Drops the triangles that contain no pixel centre of `grid`
-    /// ([`PixelGrid::triangle_reaches`]); vertices and regions stay (a
-    /// vertex may now be used by no triangle). Returns how many were dropped.
+    /// ([`PixelGrid::triangle_reaches`]; each vertex's span is computed
+    /// once); vertices and regions stay (a vertex may now be used by no
+    /// triangle). Returns how many were dropped.
     pub fn cull_to_pixels(&mut self, grid: &PixelGrid) -> usize {
+        let mut spans = std::mem::take(&mut self.spans);
+        spans.clear();
+        spans.extend(self.vertices.iter().map(|v| grid.span(v.pos())));
         let before = self.triangles.len();
         let mut w = 0;
         for r in 0..before {
             let t = self.triangles[r];
-            let [a, b, c] = t.map(|i| self.vertices[i as usize].pos());
-            if grid.triangle_reaches(a, b, c) {
+            let [a, b, c] = t.map(|i| spans[i as usize]);
+            let s = a.join(&b).join(&c);
+            if s.x0 <= s.x1
+                && s.y0 <= s.y1
+                && PixelGrid::centres_reach(&t.map(|i| self.vertices[i as usize].pos()), s)
+            {
                 self.triangles[w] = t;
                 self.triangle_region[w] = self.triangle_region[r];
                 w += 1;
@@ -168,6 +208,7 @@ impl Projected {
         }
         self.triangles.truncate(w);
         self.triangle_region.truncate(w);
+        self.spans = spans;
         before - w
     }
 }
@@ -275,6 +316,45 @@ mod tests {
             }
         }
         assert!(yes > 1000 && no > 1000, "{yes} {no}");
+    }
+
+    /// The integer spans agree with the centres counted directly in the
+    /// grown box, including boxes on the margin's edges, off the image and
+    /// ~1e9 pixels away.
+    #[test]
+    fn spans_count_the_centres_of_the_grown_box() {
+        let grid = PixelGrid::new(7, 5);
+        let m = COVERAGE_MARGIN_PX;
+        let direct = |lo: f64, hi: f64, n: u32| -> usize {
+            (0..n)
+                .filter(|&i| {
+                    let c = i as f64 + 0.5;
+                    c >= lo - m && c <= hi + m
+                })
+                .count()
+        };
+        let mut rng = Rng(5);
+        let pick = |rng: &mut Rng| match rng.below(5) {
+            0 => rng.range(-3.0, 10.0),
+            1 => (rng.below(12) as f64 - 2.0) + 0.5 + m * [-1.0, 1.0][rng.below(2)],
+            2 => (rng.below(12) as f64 - 2.0) + 0.5 + m * [-1.0, 1.0][rng.below(2)] * (1.0 + 1e-9),
+            3 => rng.range(-1e9, 1e9),
+            _ => (rng.below(12) as f64 - 2.0) + 0.5,
+        };
+        for _ in 0..20000 {
+            let (a, b) = (pick(&mut rng), pick(&mut rng));
+            let (c, d) = (pick(&mut rng), pick(&mut rng));
+            let (lo, hi) = (
+                DVec2::new(a.min(b), c.min(d)),
+                DVec2::new(a.max(b), c.max(d)),
+            );
+            let s = grid.span(lo).join(&grid.span(hi));
+            let nx = (s.x1 - s.x0 + 1).max(0) as usize;
+            let ny = (s.y1 - s.y0 + 1).max(0) as usize;
+            assert_eq!(nx, direct(lo.x, hi.x, 7), "{lo} {hi}");
+            assert_eq!(ny, direct(lo.y, hi.y, 5), "{lo} {hi}");
+            assert_eq!(grid.box_reaches(lo, hi), nx * ny > 0);
+        }
     }
 
     #[test]

@@ -315,6 +315,9 @@ pub struct Projected {
     /// The camera mapping the values were computed for.
     pub view: ViewMap,
     spare: Vec<Vec<u32>>,
+    /// Scratch of [`Projected::cull_to_pixels`]: each vertex's
+    /// [`coverage::Span`].
+    spans: Vec<coverage::Span>,
 }
 
 impl Projected {
