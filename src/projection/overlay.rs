@@ -54,7 +54,7 @@ use glam::DVec2;
 
 use super::arrangement::segment_crossing;
 use super::subdivision::NIL;
-use super::Facing;
+use super::{Facing, VertexKind};
 use crate::numeric::predicates::{orient2d, Side};
 
 /// Pieces with more points take the general path (the edge table is
@@ -188,6 +188,8 @@ pub(super) struct Overlay {
     pub pos: Vec<DVec2>,
     /// Silhouette vertices.
     pub on_hull: Vec<bool>,
+    /// What the vertices are (the points, then the crossings).
+    pub kinds: Vec<VertexKind>,
     /// Vertices of region `r`: `region_verts[region_start[r]..region_start[r + 1]]`.
     pub region_verts: Vec<u32>,
     pub region_start: Vec<u32>,
@@ -473,6 +475,12 @@ impl Overlay {
             .resize(self.front_edges.len() * self.back_edges.len(), UNKNOWN);
         self.pos.clear();
         self.pos.extend_from_slice(pix);
+        self.kinds.clear();
+        self.kinds.extend(self.vkind.iter().map(|&k| match k {
+            1 => VertexKind::Front,
+            2 => VertexKind::Back,
+            _ => VertexKind::Silhouette,
+        }));
         // 4. Regions, from neighbour to neighbour, starting at a silhouette
         // edge `u -> v` of front triangle `f` and back triangle `b`: the
         // region `f ∩ b` has the corner `u`, left along that edge.
@@ -551,6 +559,7 @@ impl Overlay {
             visited,
             queue,
             pos,
+            kinds,
             region_verts,
             region_start,
             face_fb,
@@ -612,6 +621,10 @@ impl Overlay {
                                     pix[be.a as usize],
                                     pix[be.b as usize],
                                 ));
+                                kinds.push(VertexKind::Crossing {
+                                    fronts: fe.tris,
+                                    backs: be.tris,
+                                });
                                 cross[slot] = x;
                             }
                             exit = Some((x, j));
