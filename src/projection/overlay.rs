@@ -36,7 +36,8 @@
 //! Leaving a vertex along edge `g` of one triangle into the other, `T`: the
 //! line of `g` leaves `T` across the edge of `T` whose start lies strictly
 //! right of `g` and whose end strictly left (the sides of `T`'s corners,
-//! cached `orient2d` of original points; a corner on the line is a shared
+//! cached `orient2d` of original points, or known from an edge's own ends
+//! and its triangles' exact facings; a corner on the line is a shared
 //! endpoint or lies beyond `g`'s ends). If `g`'s end is outside that edge,
 //! `g` crosses it: the next vertex is the crossing, then follow the crossed
 //! edge. Otherwise the next vertex is `g`'s end, strictly inside `T`
@@ -201,24 +202,43 @@ pub(super) struct Overlay {
 /// point `v` and edge `a < b`, as a sign, computed on first use.
 #[derive(Clone, Debug, Default)]
 struct Sides {
-    /// Index `e * MAX_POINTS + v`; 2 while not computed.
+    /// Index `(e << shift) + v`; 2 while not computed.
     s: Vec<i8>,
+    /// Room for the points: `1 << shift` is at least their number.
+    shift: u32,
     /// Ends `a < b` of each edge.
     ends: Vec<[u32; 2]>,
 }
 
 impl Sides {
-    fn reset(&mut self, edges: &[Edge]) {
+    /// Starts over for `n` points, `edges` and the triangles along them
+    /// (corners `ccw`, edges `tri_edge`), with the sides known without an
+    /// `orient2d`: an edge's ends are on it, and the third corner of each
+    /// triangle along it is on that triangle's side (exactly: the triangle
+    /// is counter-clockwise by its exact facing).
+    fn reset(&mut self, n: usize, edges: &[Edge], ccw: &[[u32; 3]], tri_edge: &[[u32; 3]]) {
+        self.shift = n.next_power_of_two().trailing_zeros();
         self.ends.clear();
         self.ends.extend(edges.iter().map(|e| [e.a, e.b]));
         self.s.clear();
-        self.s.resize(edges.len() * MAX_POINTS, 2);
+        self.s.resize(edges.len() << self.shift, 2);
+        for (e, ed) in edges.iter().enumerate() {
+            self.s[(e << self.shift) + ed.a as usize] = 0;
+            self.s[(e << self.shift) + ed.b as usize] = 0;
+        }
+        for (c, te) in ccw.iter().zip(tri_edge) {
+            for k in 0..3 {
+                let e = te[k] as usize;
+                let third = c[NEXT[NEXT[k]]] as usize;
+                self.s[(e << self.shift) + third] = if c[k] == edges[e].a { 1 } else { -1 };
+            }
+        }
     }
 
     /// Side of point `v` of edge `e` (from its smaller end).
     #[inline(always)]
     fn get(&mut self, pix: &[DVec2], v: u32, e: u32) -> i8 {
-        let i = e as usize * MAX_POINTS + v as usize;
+        let i = (e as usize) << self.shift | v as usize;
         let s = self.s[i];
         if s != 2 {
             return s;
@@ -433,7 +453,7 @@ impl Overlay {
         // degenerate), nor a silhouette vertex (an extreme point of `S`)
         // inside any: only vertices of one kind against edges of the other
         // remain.
-        self.sides.reset(&self.edges);
+        self.sides.reset(n, &self.edges, &self.ccw, &self.tri_edge);
         self.vkind.clear();
         self.vkind.resize(n, 0);
         for (t, c) in self.ccw.iter().enumerate() {

@@ -596,13 +596,14 @@ fn emit(
     vmap.clear();
     vmap.resize(nv, NIL);
     let verts = |f: usize| &regions.verts[regions.start[f] as usize..regions.start[f + 1] as usize];
-    out.region_faces.clear();
-    out.region_faces.extend(
-        regions
-            .faces
-            .iter()
-            .map(|ft| [faces[ft[0] as usize], faces[ft[1] as usize]]),
-    );
+    // (Resized, then written in place: pushing 192-byte pairs goes
+    // through `memcpy`.)
+    out.region_faces
+        .resize(regions.faces.len(), [FaceTri::default(); 2]);
+    for (rf, ft) in out.region_faces.iter_mut().zip(regions.faces) {
+        rf[0] = faces[ft[0] as usize];
+        rf[1] = faces[ft[1] as usize];
+    }
     let fast = !regions.kinds.is_empty();
     if fast {
         widths.resize(faces.len(), f64::NAN);
