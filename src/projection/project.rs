@@ -551,8 +551,8 @@ struct EmitScratch {
     /// triangle (of a region around it) that is widest, and that width
     /// (general path).
     best: Vec<[(u32, f64); 2]>,
-    /// Per boundary triangle: its [`FaceTri`] and width (NaN until needed,
-    /// fast path).
+    /// Per boundary triangle: its [`FaceTri`] and width (in the fast path,
+    /// only when there are crossings).
     faces: Vec<FaceTri>,
     widths: Vec<f64>,
 }
@@ -606,7 +606,10 @@ fn emit(
     }
     let fast = !regions.kinds.is_empty();
     if fast {
-        widths.resize(faces.len(), f64::NAN);
+        // Crossings (after the points) choose by width.
+        if regions.kinds.len() > pix.len() {
+            widths.extend(faces.iter().map(FaceTri::width));
+        }
     } else {
         // Every region around a vertex holds it under its front and back
         // triangles, whose planes all give the vertex's values; take them
@@ -675,7 +678,7 @@ fn fast_vertex(
     poly: &Polyhedron,
     view: &ViewMap,
     faces: &[FaceTri],
-    widths: &mut [f64],
+    widths: &[f64],
     ft: [u32; 2],
     v: u32,
     q: DVec2,
@@ -689,14 +692,8 @@ fn fast_vertex(
         VertexKind::Back => (at(ft[0]), own()),
         VertexKind::Silhouette => (own(), own()),
         VertexKind::Crossing { fronts, backs } => {
-            let mut width = |t: u32| {
-                let w = &mut widths[t as usize];
-                if w.is_nan() {
-                    *w = faces[t as usize].width();
-                }
-                *w
-            };
-            let mut pick = |pair: [u32; 2], first: u32| {
+            let width = |t: u32| widths[t as usize];
+            let pick = |pair: [u32; 2], first: u32| {
                 let other = if pair[0] == first { pair[1] } else { pair[0] };
                 if width(other) > width(first) {
                     other
