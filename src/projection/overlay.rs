@@ -795,6 +795,53 @@ mod tests {
         0.5 * a
     }
 
+    /// Fast-path vertices get the same bits from their `VertexKind` as from
+    /// the search among the regions around them (the same front and back
+    /// triangles, ties included), in every output.
+    #[test]
+    fn vertex_kinds_match_search() {
+        let mut rng = Rng(0x5eed_f00d_fa57_0001);
+        let mut direct = Projector::new();
+        let mut search = Projector::new();
+        search.vertex_faces_by_search = true;
+        let (mut a, mut b) = (Projected::default(), Projected::default());
+        let bits = |o: &Projected| -> Vec<u64> {
+            o.vertices
+                .iter()
+                .flat_map(|v| {
+                    [v.px, v.py, v.z_front, v.z_back, v.l, v.s_front, v.s_back]
+                        .map(f64::to_bits)
+                        .into_iter()
+                        .chain([v.profile as u64])
+                })
+                .collect()
+        };
+        let mut fast = 0;
+        for kind in KINDS {
+            for i in 0..300 {
+                let (ortho, axis) = (i % 2 == 0, i % 7 == 0 || i % 7 == 3);
+                let tilt = if i % 7 == 3 {
+                    10f64.powf(-rng.range(3.0, 13.0))
+                } else {
+                    0.0
+                };
+                let (poly, cam) = piece(kind, &mut rng, ortho, axis, tilt);
+                for clip in [false, true] {
+                    direct.clip_to_image = clip;
+                    search.clip_to_image = clip;
+                    direct.project(&poly, &cam, &mut a).unwrap();
+                    search.project(&poly, &cam, &mut b).unwrap();
+                    fast += direct.took_fast_path as usize;
+                    assert_eq!(bits(&a), bits(&b), "{kind:?} {i}");
+                    assert_eq!(a.regions, b.regions, "{kind:?} {i}");
+                    assert_eq!(a.triangles, b.triangles, "{kind:?} {i}");
+                    assert_eq!(a.triangle_region, b.triangle_region, "{kind:?} {i}");
+                }
+            }
+        }
+        assert!(fast > 2000, "fast path taken {fast} times");
+    }
+
     /// The fast path gives the general path's regions: the same front and
     /// back triangles, areas and vertex values (crossings may round
     /// differently), and is taken for pieces in general position.

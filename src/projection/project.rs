@@ -96,6 +96,10 @@ pub struct Projector {
     pub fast_path: bool,
     /// Whether the last call took the fast path (tests).
     pub(crate) took_fast_path: bool,
+    /// Give fast-path vertices their values by the general path's search
+    /// among the regions around them, not by their [`VertexKind`] (tests:
+    /// both must give the same bits).
+    pub(crate) vertex_faces_by_search: bool,
     clipper: Clipper,
     clipped: Polyhedron,
     arr: Arrangement,
@@ -156,6 +160,7 @@ impl Default for Projector {
             cull_to_pixels: false,
             fast_path: true,
             took_fast_path: false,
+            vertex_faces_by_search: false,
             clipper: Clipper::default(),
             clipped: Polyhedron::default(),
             arr: Arrangement::default(),
@@ -290,7 +295,11 @@ impl Projector {
                 verts: &t.verts,
                 start: &t.start,
                 faces: &t.faces,
-                kinds: &t.kinds,
+                kinds: if self.vertex_faces_by_search {
+                    &[]
+                } else {
+                    &t.kinds
+                },
             };
             emit(poly, &self.pix, regions, &mut self.emit, out);
         } else if self.took_fast_path {
@@ -302,7 +311,11 @@ impl Projector {
                 verts: &o.region_verts,
                 start: &o.region_start,
                 faces: &o.face_fb,
-                kinds: &o.kinds,
+                kinds: if self.vertex_faces_by_search {
+                    &[]
+                } else {
+                    &o.kinds
+                },
             };
             emit(poly, &self.pix, regions, &mut self.emit, out);
         } else {
