@@ -33,8 +33,8 @@ use crate::numeric::predicates::{orient2d, Side};
 
 /// Regions of a tetrahedron, in the layout of the projector's region
 /// tables: positions (the four points, then the crossing in class 2),
-/// silhouette flags, region vertex lists and each region's front and back
-/// triangle.
+/// silhouette flags, region vertex lists, each region's front and back
+/// triangle, and what each vertex is ([`VertexKind`], for its values).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct TetRegions {
     pub pos: Vec<DVec2>,
