@@ -165,6 +165,23 @@ impl ViewMap {
 /// those widths.
 pub(crate) type WidestFaces = [(u32, f64); 2];
 
+/// What the fast path knows of a region vertex in general position (see
+/// `project`, step 6): which boundary triangles hold it, so that its values
+/// need no search among the regions around it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum VertexKind {
+    /// An original point used by front triangles only: a corner of every
+    /// front triangle around it, strictly inside one back triangle.
+    Front,
+    /// An original point used by back triangles only.
+    Back,
+    /// An original point used by both (a silhouette vertex).
+    Silhouette,
+    /// The proper crossing of an edge between front triangles `fronts` and
+    /// an edge between back triangles `backs`.
+    Crossing { fronts: [u32; 2], backs: [u32; 2] },
+}
+
 /// A boundary triangle as seen on screen: pixel positions of its corners
 /// with their depths and scalars.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -269,8 +286,20 @@ impl RegionVertex {
         q: DVec2,
         on_hull: bool,
     ) -> RegionVertex {
-        let (zf, sf) = front.eval(view, q);
-        let (mut zb, mut sb) = back.eval(view, q);
+        RegionVertex::from_values(view, front.eval(view, q), back.eval(view, q), q, on_hull)
+    }
+
+    /// The vertex at pixel position `q` with front and back depth and
+    /// scalar `(zf, sf)` and `(zb, sb)` (as [`RegionVertex::evaluate`] after
+    /// evaluating the triangles).
+    #[inline]
+    pub(crate) fn from_values(
+        view: &ViewMap,
+        (zf, sf): (f64, f64),
+        (mut zb, mut sb): (f64, f64),
+        q: DVec2,
+        on_hull: bool,
+    ) -> RegionVertex {
         let mut profile = false;
         if zb <= zf {
             zb = zf;

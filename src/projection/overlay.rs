@@ -36,7 +36,8 @@
 //! Leaving a vertex along edge `g` of one triangle into the other, `T`: the
 //! line of `g` leaves `T` across the edge of `T` whose start lies strictly
 //! right of `g` and whose end strictly left (the sides of `T`'s corners,
-//! cached `orient2d` of original points; a corner on the line is a shared
+//! cached `orient2d` of original points, or known from an edge's own ends
+//! and its triangles' exact facings; a corner on the line is a shared
 //! endpoint or lies beyond `g`'s ends). If `g`'s end is outside that edge,
 //! `g` crosses it: the next vertex is the crossing, then follow the crossed
 //! edge. Otherwise the next vertex is `g`'s end, strictly inside `T`
@@ -54,7 +55,7 @@ use glam::DVec2;
 
 use super::arrangement::segment_crossing;
 use super::subdivision::NIL;
-use super::Facing;
+use super::{Facing, VertexKind};
 use crate::numeric::predicates::{orient2d, Side};
 
 /// Pieces with more points take the general path (the edge table is
@@ -188,6 +189,8 @@ pub(super) struct Overlay {
     pub pos: Vec<DVec2>,
     /// Silhouette vertices.
     pub on_hull: Vec<bool>,
+    /// What the vertices are (the points, then the crossings).
+    pub kinds: Vec<VertexKind>,
     /// Vertices of region `r`: `region_verts[region_start[r]..region_start[r + 1]]`.
     pub region_verts: Vec<u32>,
     pub region_start: Vec<u32>,
@@ -199,24 +202,43 @@ pub(super) struct Overlay {
 /// point `v` and edge `a < b`, as a sign, computed on first use.
 #[derive(Clone, Debug, Default)]
 struct Sides {
-    /// Index `e * MAX_POINTS + v`; 2 while not computed.
+    /// Index `(e << shift) + v`; 2 while not computed.
     s: Vec<i8>,
+    /// Room for the points: `1 << shift` is at least their number.
+    shift: u32,
     /// Ends `a < b` of each edge.
     ends: Vec<[u32; 2]>,
 }
 
 impl Sides {
-    fn reset(&mut self, edges: &[Edge]) {
+    /// Starts over for `n` points, `edges` and the triangles along them
+    /// (corners `ccw`, edges `tri_edge`), with the sides known without an
+    /// `orient2d`: an edge's ends are on it, and the third corner of each
+    /// triangle along it is on that triangle's side (exactly: the triangle
+    /// is counter-clockwise by its exact facing).
+    fn reset(&mut self, n: usize, edges: &[Edge], ccw: &[[u32; 3]], tri_edge: &[[u32; 3]]) {
+        self.shift = n.next_power_of_two().trailing_zeros();
         self.ends.clear();
         self.ends.extend(edges.iter().map(|e| [e.a, e.b]));
         self.s.clear();
-        self.s.resize(edges.len() * MAX_POINTS, 2);
+        self.s.resize(edges.len() << self.shift, 2);
+        for (e, ed) in edges.iter().enumerate() {
+            self.s[(e << self.shift) + ed.a as usize] = 0;
+            self.s[(e << self.shift) + ed.b as usize] = 0;
+        }
+        for (c, te) in ccw.iter().zip(tri_edge) {
+            for k in 0..3 {
+                let e = te[k] as usize;
+                let third = c[NEXT[NEXT[k]]] as usize;
+                self.s[(e << self.shift) + third] = if c[k] == edges[e].a { 1 } else { -1 };
+            }
+        }
     }
 
     /// Side of point `v` of edge `e` (from its smaller end).
     #[inline(always)]
     fn get(&mut self, pix: &[DVec2], v: u32, e: u32) -> i8 {
-        let i = e as usize * MAX_POINTS + v as usize;
+        let i = (e as usize) << self.shift | v as usize;
         let s = self.s[i];
         if s != 2 {
             return s;
@@ -431,7 +453,7 @@ impl Overlay {
         // degenerate), nor a silhouette vertex (an extreme point of `S`)
         // inside any: only vertices of one kind against edges of the other
         // remain.
-        self.sides.reset(&self.edges);
+        self.sides.reset(n, &self.edges, &self.ccw, &self.tri_edge);
         self.vkind.clear();
         self.vkind.resize(n, 0);
         for (t, c) in self.ccw.iter().enumerate() {
@@ -473,6 +495,12 @@ impl Overlay {
             .resize(self.front_edges.len() * self.back_edges.len(), UNKNOWN);
         self.pos.clear();
         self.pos.extend_from_slice(pix);
+        self.kinds.clear();
+        self.kinds.extend(self.vkind.iter().map(|&k| match k {
+            1 => VertexKind::Front,
+            2 => VertexKind::Back,
+            _ => VertexKind::Silhouette,
+        }));
         // 4. Regions, from neighbour to neighbour, starting at a silhouette
         // edge `u -> v` of front triangle `f` and back triangle `b`: the
         // region `f ∩ b` has the corner `u`, left along that edge.
@@ -551,6 +579,7 @@ impl Overlay {
             visited,
             queue,
             pos,
+            kinds,
             region_verts,
             region_start,
             face_fb,
@@ -612,6 +641,10 @@ impl Overlay {
                                     pix[be.a as usize],
                                     pix[be.b as usize],
                                 ));
+                                kinds.push(VertexKind::Crossing {
+                                    fronts: fe.tris,
+                                    backs: be.tris,
+                                });
                                 cross[slot] = x;
                             }
                             exit = Some((x, j));
@@ -760,6 +793,53 @@ mod tests {
             a += p.perp_dot(q);
         }
         0.5 * a
+    }
+
+    /// Fast-path vertices get the same bits from their `VertexKind` as from
+    /// the search among the regions around them (the same front and back
+    /// triangles, ties included), in every output.
+    #[test]
+    fn vertex_kinds_match_search() {
+        let mut rng = Rng(0x5eed_f00d_fa57_0001);
+        let mut direct = Projector::new();
+        let mut search = Projector::new();
+        search.vertex_faces_by_search = true;
+        let (mut a, mut b) = (Projected::default(), Projected::default());
+        let bits = |o: &Projected| -> Vec<u64> {
+            o.vertices
+                .iter()
+                .flat_map(|v| {
+                    [v.px, v.py, v.z_front, v.z_back, v.l, v.s_front, v.s_back]
+                        .map(f64::to_bits)
+                        .into_iter()
+                        .chain([v.profile as u64])
+                })
+                .collect()
+        };
+        let mut fast = 0;
+        for kind in KINDS {
+            for i in 0..300 {
+                let (ortho, axis) = (i % 2 == 0, i % 7 == 0 || i % 7 == 3);
+                let tilt = if i % 7 == 3 {
+                    10f64.powf(-rng.range(3.0, 13.0))
+                } else {
+                    0.0
+                };
+                let (poly, cam) = piece(kind, &mut rng, ortho, axis, tilt);
+                for clip in [false, true] {
+                    direct.clip_to_image = clip;
+                    search.clip_to_image = clip;
+                    direct.project(&poly, &cam, &mut a).unwrap();
+                    search.project(&poly, &cam, &mut b).unwrap();
+                    fast += direct.took_fast_path as usize;
+                    assert_eq!(bits(&a), bits(&b), "{kind:?} {i}");
+                    assert_eq!(a.regions, b.regions, "{kind:?} {i}");
+                    assert_eq!(a.triangles, b.triangles, "{kind:?} {i}");
+                    assert_eq!(a.triangle_region, b.triangle_region, "{kind:?} {i}");
+                }
+            }
+        }
+        assert!(fast > 2000, "fast path taken {fast} times");
     }
 
     /// The fast path gives the general path's regions: the same front and

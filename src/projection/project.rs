@@ -31,7 +31,12 @@
 //!    rounded positions, gives meaningless depths; every region around the
 //!    vertex holds it, so any of them gives the same exact value) -- the
 //!    corner's own data when the vertex is that corner, so profile vertices
-//!    get `l = 0` exactly; regions are fan-triangulated, skipping triangles
+//!    get `l = 0` exactly. The fast path finds those triangles without the
+//!    search, from what it knows of each vertex ([`VertexKind`]: an original
+//!    point is a corner of every triangle of its own facing around it and
+//!    lies strictly inside one of the other facing; a crossing has the two
+//!    triangles on each side of its two edges), and so picks the same ones
+//!    (ties included); regions are fan-triangulated, skipping triangles
 //!    whose exact orientation is not positive (zero area); with
 //!    [`Projector::clip_to_image`] the regions are then clipped to the image
 //!    rectangle plus a margin (near-plane caps project ~1e9 pixels away);
@@ -53,7 +58,9 @@ use super::overlay::Overlay;
 use super::polyhedron::Polyhedron;
 use super::subdivision::NIL;
 use super::tet::TetRegions;
-use super::{FaceTri, Facing, Projected, ProjectionError, RegionVertex, ViewMap, WidestFaces};
+use super::{
+    FaceTri, Facing, Projected, ProjectionError, RegionVertex, VertexKind, ViewMap, WidestFaces,
+};
 use crate::camera::Camera;
 use crate::numeric::predicates::{orient2d, Side};
 use crate::numeric::tolerance::{IMAGE_CLIP_MARGIN_PX, NEAR_CLIP_SCALE};
@@ -89,6 +96,10 @@ pub struct Projector {
     pub fast_path: bool,
     /// Whether the last call took the fast path (tests).
     pub(crate) took_fast_path: bool,
+    /// Give fast-path vertices their values by the general path's search
+    /// among the regions around them, not by their [`VertexKind`] (tests:
+    /// both must give the same bits).
+    pub(crate) vertex_faces_by_search: bool,
     clipper: Clipper,
     clipped: Polyhedron,
     arr: Arrangement,
@@ -149,6 +160,7 @@ impl Default for Projector {
             cull_to_pixels: false,
             fast_path: true,
             took_fast_path: false,
+            vertex_faces_by_search: false,
             clipper: Clipper::default(),
             clipped: Polyhedron::default(),
             arr: Arrangement::default(),
@@ -283,6 +295,11 @@ impl Projector {
                 verts: &t.verts,
                 start: &t.start,
                 faces: &t.faces,
+                kinds: if self.vertex_faces_by_search {
+                    &[]
+                } else {
+                    &t.kinds
+                },
             };
             emit(poly, &self.pix, regions, &mut self.emit, out);
         } else if self.took_fast_path {
@@ -294,6 +311,11 @@ impl Projector {
                 verts: &o.region_verts,
                 start: &o.region_start,
                 faces: &o.face_fb,
+                kinds: if self.vertex_faces_by_search {
+                    &[]
+                } else {
+                    &o.kinds
+                },
             };
             emit(poly, &self.pix, regions, &mut self.emit, out);
         } else {
@@ -429,6 +451,7 @@ impl Projector {
             verts: &self.region_verts,
             start: &self.region_start,
             faces: &self.face_fb,
+            kinds: &[],
         };
         emit(poly, &self.pix, regions, &mut self.emit, out);
         Ok(())
@@ -538,9 +561,11 @@ impl Projector {
 struct EmitScratch {
     vmap: Vec<u32>,
     /// Per subdivision vertex, for its front and back values: the boundary
-    /// triangle (of a region around it) that is widest, and that width.
+    /// triangle (of a region around it) that is widest, and that width
+    /// (general path).
     best: Vec<[(u32, f64); 2]>,
-    /// Per boundary triangle: its [`FaceTri`] and width.
+    /// Per boundary triangle: its [`FaceTri`] and width (in the fast path,
+    /// only when there are crossings).
     faces: Vec<FaceTri>,
     widths: Vec<f64>,
 }
@@ -557,6 +582,9 @@ struct Regions<'a> {
     start: &'a [u32],
     /// Front and back triangle of each region.
     faces: &'a [[u32; 2]],
+    /// What the fast path knows of each vertex (empty: the general path,
+    /// search the regions around each vertex).
+    kinds: &'a [VertexKind],
 }
 
 /// Writes vertices, regions and fan triangles (step 6 of the module docs).
@@ -573,63 +601,124 @@ fn emit(
         faces,
         widths,
     } = scratch;
-    // Each boundary triangle as seen on screen, with its width, once.
+    // Each boundary triangle as seen on screen, once.
     faces.clear();
+    faces.extend((0..poly.triangles.len() as u32).map(|t| FaceTri::new(poly, pix, t)));
     widths.clear();
-    for t in 0..poly.triangles.len() {
-        let f = FaceTri::new(poly, pix, t as u32);
-        faces.push(f);
-        widths.push(f.width());
-    }
     let nv = regions.pos.len();
     vmap.clear();
     vmap.resize(nv, NIL);
-    // Every region around a vertex holds it under its front and back
-    // triangles, whose planes all give the vertex's values; take them
-    // from the widest ones (best conditioned, `FaceTri::width`), never
-    // from a sliver left by a face seen (nearly) edge-on. (Regions are
-    // visited in order and only a strictly wider triangle replaces one:
-    // ties go to the first region's.)
-    best.clear();
-    best.resize(nv, [(NIL, -1.0); 2]);
     let verts = |f: usize| &regions.verts[regions.start[f] as usize..regions.start[f + 1] as usize];
+    // (Resized, then written in place: pushing 192-byte pairs goes
+    // through `memcpy`.)
     out.region_faces
         .resize(regions.faces.len(), [FaceTri::default(); 2]);
-    for (f, &ft) in regions.faces.iter().enumerate() {
-        let w = ft.map(|t| widths[t as usize]);
-        let rf = &mut out.region_faces[f];
+    for (rf, ft) in out.region_faces.iter_mut().zip(regions.faces) {
         rf[0] = faces[ft[0] as usize];
         rf[1] = faces[ft[1] as usize];
-        for &v in verts(f) {
-            let best = &mut best[v as usize];
-            for s in 0..2 {
-                if w[s] > best[s].1 {
-                    best[s] = (ft[s], w[s]);
+    }
+    let fast = !regions.kinds.is_empty();
+    if fast {
+        // Crossings (after the points) choose by width.
+        if regions.kinds.len() > pix.len() {
+            widths.extend(faces.iter().map(FaceTri::width));
+        }
+    } else {
+        // Every region around a vertex holds it under its front and back
+        // triangles, whose planes all give the vertex's values; take them
+        // from the widest ones (best conditioned, `FaceTri::width`), never
+        // from a sliver left by a face seen (nearly) edge-on. (Regions are
+        // visited in order and only a strictly wider triangle replaces one:
+        // ties go to the first region's.)
+        widths.extend(faces.iter().map(FaceTri::width));
+        best.clear();
+        best.resize(nv, [(NIL, -1.0); 2]);
+        for (f, &ft) in regions.faces.iter().enumerate() {
+            let w = ft.map(|t| widths[t as usize]);
+            for &v in verts(f) {
+                let best = &mut best[v as usize];
+                for s in 0..2 {
+                    if w[s] > best[s].1 {
+                        best[s] = (ft[s], w[s]);
+                    }
                 }
             }
         }
     }
-    for f in 0..regions.faces.len() {
+    let view = out.view;
+    for (f, &ft) in regions.faces.iter().enumerate() {
         let r = out.push_region();
-        let region = &mut out.regions[r];
         for &v in verts(f) {
             let mut id = vmap[v as usize];
             if id == NIL {
                 id = out.vertices.len() as u32;
                 vmap[v as usize] = id;
-                let [(tf, _), (tb, _)] = best[v as usize];
-                out.vertices.push(RegionVertex::evaluate(
-                    &out.view,
-                    &faces[tf as usize],
-                    &faces[tb as usize],
-                    regions.pos[v as usize],
-                    regions.on_hull.get(v as usize).copied().unwrap_or(false),
-                ));
+                let q = regions.pos[v as usize];
+                let on_hull = regions.on_hull.get(v as usize).copied().unwrap_or(false);
+                out.vertices.push(if fast {
+                    fast_vertex(poly, &view, faces, widths, ft, v, q, on_hull, regions.kinds)
+                } else {
+                    let [(tf, _), (tb, _)] = best[v as usize];
+                    RegionVertex::evaluate(
+                        &view,
+                        &faces[tf as usize],
+                        &faces[tb as usize],
+                        q,
+                        on_hull,
+                    )
+                });
             }
-            region.push(id);
+            out.regions[r].push(id);
         }
     }
     out.triangulate_regions();
+}
+
+/// The values of fast-path vertex `v` at `q`, first met in a region with
+/// front and back triangles `ft`: the same triangles, and so the same bits,
+/// as the general search of [`emit`] picks (the widest front and back
+/// triangle among the regions around `v`, ties to the first region's), found
+/// from `v`'s [`VertexKind`]. An original point is a corner of every
+/// triangle around it of its own facing (no point lies inside an edge it
+/// does not end), where any of them gives the point's own data; a point of
+/// one facing only lies strictly inside one triangle of the other facing,
+/// the one of every region around it. A crossing has the two triangles on
+/// each side of its two edges: the first region's, unless the other one is
+/// strictly wider.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn fast_vertex(
+    poly: &Polyhedron,
+    view: &ViewMap,
+    faces: &[FaceTri],
+    widths: &[f64],
+    ft: [u32; 2],
+    v: u32,
+    q: DVec2,
+    on_hull: bool,
+    kinds: &[VertexKind],
+) -> RegionVertex {
+    let own = || (poly.points[v as usize].z, poly.scalars[v as usize]);
+    let at = |t: u32| faces[t as usize].eval(view, q);
+    let (front, back) = match kinds[v as usize] {
+        VertexKind::Front => (own(), at(ft[1])),
+        VertexKind::Back => (at(ft[0]), own()),
+        VertexKind::Silhouette => (own(), own()),
+        VertexKind::Crossing { fronts, backs } => {
+            let width = |t: u32| widths[t as usize];
+            let pick = |pair: [u32; 2], first: u32| {
+                let other = if pair[0] == first { pair[1] } else { pair[0] };
+                if width(other) > width(first) {
+                    other
+                } else {
+                    first
+                }
+            };
+            let (tf, tb) = (pick(fronts, ft[0]), pick(backs, ft[1]));
+            (at(tf), at(tb))
+        }
+    };
+    RegionVertex::from_values(view, front, back, q, on_hull)
 }
 
 /// A point of a region polygon being clipped to the image window.

@@ -28,13 +28,13 @@
 use glam::DVec2;
 
 use super::arrangement::segment_crossing;
-use super::Facing;
+use super::{Facing, VertexKind};
 use crate::numeric::predicates::{orient2d, Side};
 
 /// Regions of a tetrahedron, in the layout of the projector's region
 /// tables: positions (the four points, then the crossing in class 2),
-/// silhouette flags, region vertex lists and each region's front and back
-/// triangle.
+/// silhouette flags, region vertex lists, each region's front and back
+/// triangle, and what each vertex is ([`VertexKind`], for its values).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct TetRegions {
     pub pos: Vec<DVec2>,
@@ -42,6 +42,7 @@ pub(crate) struct TetRegions {
     pub verts: Vec<u32>,
     pub start: Vec<u32>,
     pub faces: Vec<[u32; 2]>,
+    pub kinds: Vec<VertexKind>,
 }
 
 impl TetRegions {
@@ -56,6 +57,7 @@ impl TetRegions {
         self.verts.clear();
         self.start.clear();
         self.faces.clear();
+        self.kinds.clear();
         if pix.len() != 4 || tris.len() != 4 || facing.len() != 4 {
             return false;
         }
@@ -93,6 +95,20 @@ impl TetRegions {
                 let lone = (0..4u32).find(|&t| front(t) == (nf == 1)).unwrap_or(0);
                 let d = opposite[lone as usize];
                 self.on_hull.extend((0..4).map(|i| i != d));
+                // d lies strictly inside the lone face, under the three
+                // others, of the other facing.
+                let inner = if front(lone) {
+                    VertexKind::Back
+                } else {
+                    VertexKind::Front
+                };
+                self.kinds.extend((0..4).map(|i| {
+                    if i == d {
+                        inner
+                    } else {
+                        VertexKind::Silhouette
+                    }
+                }));
                 let [a, b, c] = tris[lone as usize];
                 for (u, v, w) in [(a, b, c), (b, c, a), (c, a, b)] {
                     // The face through u, v and d leaves out w.
@@ -125,6 +141,11 @@ impl TetRegions {
                 let (r, s) = (opposite[fr[0] as usize], opposite[fr[1] as usize]);
                 self.on_hull.extend([true; 4]);
                 self.on_hull.push(false);
+                self.kinds.extend([VertexKind::Silhouette; 4]);
+                self.kinds.push(VertexKind::Crossing {
+                    fronts: fr,
+                    backs: bk,
+                });
                 self.pos.push(segment_crossing(
                     pix[p as usize],
                     pix[q as usize],
