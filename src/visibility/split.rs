@@ -46,7 +46,9 @@ fn sorted3(mut t: [u32; 3]) -> [u32; 3] {
 impl SplitCell {
     /// Splits cell `c` into its consistent tets and records their faces.
     pub fn build(mesh: &Mesh, topo: &Topology, c: usize) -> SplitCell {
-        let mut tets = Vec::new();
+        // Sized up front: most of a split's cost was growing these (a
+        // hexahedron has 5 or 6 tets, 12 face triangles, up to 7 inner ones).
+        let mut tets = Vec::with_capacity(6);
         tetrahedralize_cell(&mesh.cells, c, &mut tets);
         // (sorted triangle, tet, apex) for every tet face.
         let mut keyed: Vec<([u32; 3], u32, u32)> = Vec::with_capacity(tets.len() * 4);
@@ -65,7 +67,7 @@ impl SplitCell {
         }
         keyed.sort_unstable();
         let p = &mesh.points;
-        let mut internal = Vec::new();
+        let mut internal = Vec::with_capacity(2 * tets.len());
         let mut i = 0;
         while i < keyed.len() {
             let mut j = i + 1;
@@ -92,10 +94,17 @@ impl SplitCell {
             }
             i = j;
         }
-        let mut owner_off = vec![0u32];
-        let mut owner = Vec::new();
+        let faces = topo.faces_of(c);
+        let mut owner_off = Vec::with_capacity(faces.len() + 1);
+        owner_off.push(0u32);
+        let mut owner = Vec::with_capacity(
+            faces
+                .iter()
+                .map(|&f| topo.face(f as usize).len().saturating_sub(2))
+                .sum(),
+        );
         let mut unmatched = 0;
-        for &f in topo.faces_of(c) {
+        for &f in faces {
             triangulate_face(topo.face(f as usize), |t| {
                 let key = sorted3(t);
                 match keyed.binary_search_by(|e| e.0.cmp(&key).then(std::cmp::Ordering::Greater)) {
