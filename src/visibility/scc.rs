@@ -21,9 +21,11 @@ pub fn tarjan(
     let mut stack: Vec<u32> = Vec::new();
     let mut comps: Vec<Vec<u32>> = Vec::new();
     let mut next = 0u32;
-    // Call stack frames: (node, successors, position in successors).
-    let mut frames: Vec<(u32, Vec<u32>, usize)> = Vec::new();
-    let mut buf = Vec::new();
+    // Call stack frames: (node, where its successors start in `succs`,
+    // position of the next one to follow). The successors of every frame
+    // live on one stack, popped with the frame (no vector per node).
+    let mut frames: Vec<(u32, usize, usize)> = Vec::new();
+    let mut succs: Vec<u32> = Vec::new();
     macro_rules! visit {
         ($v:expr) => {{
             let v: u32 = $v;
@@ -32,9 +34,9 @@ pub fn tarjan(
             next += 1;
             stack.push(v);
             on_stack[v as usize] = true;
-            buf.clear();
-            succ(v, &mut buf);
-            frames.push((v, buf.clone(), 0));
+            let begin = succs.len();
+            succ(v, &mut succs);
+            frames.push((v, begin, begin));
         }};
     }
     for root in 0..n as u32 {
@@ -44,8 +46,10 @@ pub fn tarjan(
         visit!(root);
         while let Some(frame) = frames.last_mut() {
             let v = frame.0;
-            if frame.2 < frame.1.len() {
-                let w = frame.1[frame.2];
+            // A frame's successors end where the next frame's begin (or at
+            // the top of the stack for the last frame).
+            if frame.2 < succs.len() {
+                let w = succs[frame.2];
                 frame.2 += 1;
                 if w as usize >= n || !alive(w) {
                     continue;
@@ -57,7 +61,9 @@ pub fn tarjan(
                 }
                 continue;
             }
-            frames.pop();
+            if let Some((_, begin, _)) = frames.pop() {
+                succs.truncate(begin);
+            }
             if let Some(parent) = frames.last() {
                 let p = parent.0 as usize;
                 low[p] = low[p].min(low[v as usize]);

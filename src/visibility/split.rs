@@ -191,6 +191,8 @@ impl SplitPool {
             .par_iter()
             .map(|&c| SplitCell::build(mesh, topo, c))
             .collect();
+        self.slots
+            .reserve(new_cells.len().saturating_sub(self.free.len()));
         for (&c, sc) in new_cells.iter().zip(built) {
             let s = match self.free.pop() {
                 Some(s) => {
