@@ -11,13 +11,16 @@
 //! Run: `cargo bench --bench render` (`-- bluntfin` to filter).
 //!
 //! Measured 2026-12-02 (Mesa 22.3.6, 2 idle cores), frame after the first
-//! (Vulkan / GL): bluntfin 0.27 / 0.27 s at 512^2, 0.49 / 0.49 s at
-//! 1024^2; hex_shell 3.32 / 3.29 s at 512^2 (2.95M triangles), 4.64 / 4.48
-//! s at 1024^2 (5.53M); grid_1m 5.28 / 5.36 s at 512^2 (9.69M), 7.37 /
-//! 7.42 s at 1024^2 (15.8M). Projection and integrals dominate (the draw
-//! calls overlap them; GL's uploads take 0.6-3.5 s of that overlapped
-//! time). Before coverage culling (2026-12-01): bluntfin 0.57 s, hex_shell
-//! 5.9 s (12.0M triangles), grid_1m 6.7 s (20.5M).
+//! (Vulkan / GL): bluntfin 0.22 / 0.22 s at 512^2 (criterion), 0.39 / 0.39
+//! s at 1024^2; hex_shell 2.24 / 2.31 s at 512^2 (2.95M triangles), 3.29 /
+//! 3.34 s at 1024^2 (5.53M); grid_1m 4.15 / 4.15 s at 512^2 (9.69M), 6.12
+//! / 6.32 s at 1024^2 (15.8M). Projection and integrals dominate (the draw
+//! calls overlap them; GL's uploads take 0.7-4 s of that overlapped time).
+//! Earlier the same day (before the chunk pipeline, the faster coverage
+//! test and projection, the parallel sort stages): bluntfin 0.27 s,
+//! hex_shell 3.32 s, grid_1m 5.28 s at 512^2. Before coverage culling
+//! (2026-12-01): bluntfin 0.57 s, hex_shell 5.9 s (12.0M triangles),
+//! grid_1m 6.7 s (20.5M).
 
 use std::time::Duration;
 
