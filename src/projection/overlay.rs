@@ -731,6 +731,21 @@ mod tests {
 
     const KINDS: [CellKind; 6] = CellKind::FIXED;
 
+    /// Case `i` of the tests' mix: ortho every other case, the reference
+    /// cell axis-aligned every 7th and nearly axis-aligned (slivers of faces
+    /// seen nearly edge-on) every 7th + 3; and whether the view is exactly
+    /// axis-aligned and orthographic.
+    fn case(kind: CellKind, rng: &mut Rng, i: usize) -> (Polyhedron, Camera, bool) {
+        let (ortho, axis) = (i % 2 == 0, i % 7 == 0 || i % 7 == 3);
+        let tilt = if i % 7 == 3 {
+            10f64.powf(-rng.range(3.0, 13.0))
+        } else {
+            0.0
+        };
+        let (poly, cam) = piece(kind, rng, ortho, axis, tilt);
+        (poly, cam, axis && ortho && tilt == 0.0)
+    }
+
     /// A random affine image of `kind`'s reference cell (or the reference
     /// itself, axis-aligned views then see faces edge-on, or nearly: tilted
     /// by `tilt` degrees) and a camera.
@@ -819,13 +834,7 @@ mod tests {
         let mut fast = 0;
         for kind in KINDS {
             for i in 0..300 {
-                let (ortho, axis) = (i % 2 == 0, i % 7 == 0 || i % 7 == 3);
-                let tilt = if i % 7 == 3 {
-                    10f64.powf(-rng.range(3.0, 13.0))
-                } else {
-                    0.0
-                };
-                let (poly, cam) = piece(kind, &mut rng, ortho, axis, tilt);
+                let (poly, cam, _) = case(kind, &mut rng, i);
                 for clip in [false, true] {
                     direct.clip_to_image = clip;
                     search.clip_to_image = clip;
@@ -855,20 +864,13 @@ mod tests {
         let (mut taken, mut total, mut axis_fast, mut axis_total) = (0, 0, 0, 0);
         for kind in KINDS {
             for i in 0..400 {
-                let (ortho, axis) = (i % 2 == 0, i % 7 == 0 || i % 7 == 3);
-                // Nearly axis-aligned: slivers of faces seen nearly edge-on.
-                let tilt = if i % 7 == 3 {
-                    10f64.powf(-rng.range(3.0, 13.0))
-                } else {
-                    0.0
-                };
-                let (poly, cam) = piece(kind, &mut rng, ortho, axis, tilt);
+                let (poly, cam, axis_ortho) = case(kind, &mut rng, i);
                 fast.project(&poly, &cam, &mut a).unwrap();
                 general.project(&poly, &cam, &mut b).unwrap();
                 total += 1;
                 taken += fast.took_fast_path as usize;
                 assert!(!general.took_fast_path);
-                if axis && ortho && tilt == 0.0 {
+                if axis_ortho {
                     axis_fast += fast.took_fast_path as usize;
                     axis_total += 1;
                 }

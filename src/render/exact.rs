@@ -876,6 +876,29 @@ mod tests {
     use crate::generate::{warped_hex_grid, Warp};
     use crate::render::SceneSpec;
     use crate::tf::EmissionModel;
+    use crate::visibility::Order;
+
+    /// The context of `order` for `scene` seen by `camera`.
+    fn test_ctx<'a>(
+        scene: &'a Scene,
+        camera: &'a Camera,
+        breakpoints: &'a [f64],
+        order: &'a Order,
+        cull: bool,
+    ) -> Ctx<'a> {
+        Ctx {
+            mesh: &scene.mesh,
+            scalars: scene.scalars(),
+            tf: &scene.tf,
+            camera,
+            breakpoints,
+            levels: &order.levels,
+            fragments: &order.fragments,
+            length_unit: scene.unit_distance,
+            cull,
+            grid: PixelGrid::new(camera.width, camera.height),
+        }
+    }
 
     /// An unwarped grid seen in perspective straight down an axis, every
     /// cell split into tets: the diagonal faces of the tets in the planes
@@ -921,18 +944,7 @@ mod tests {
         };
         let mut sorter = Sorter::new(&scene.mesh, &scene.topology);
         let order = sorter.order(&camera, &policy).unwrap();
-        let ctx = Ctx {
-            mesh: &scene.mesh,
-            scalars: scene.scalars(),
-            tf: &scene.tf,
-            camera: &camera,
-            breakpoints: &breakpoints,
-            levels: &order.levels,
-            fragments: &order.fragments,
-            length_unit: scene.unit_distance,
-            cull: false,
-            grid: PixelGrid::new(camera.width, camera.height),
-        };
+        let ctx = test_ctx(&scene, &camera, &breakpoints, &order, false);
         // Piece by piece, up to the first one that makes such a sliver (the
         // whole view refines into ~1e5 triangles).
         let mut degenerate = 0;
@@ -983,18 +995,7 @@ mod tests {
         };
         let mut sorter = Sorter::new(&scene.mesh, &scene.topology);
         let order = sorter.order(&camera, &policy).unwrap();
-        let ctx = Ctx {
-            mesh: &scene.mesh,
-            scalars: scene.scalars(),
-            tf: &scene.tf,
-            camera: &camera,
-            breakpoints: &breakpoints,
-            levels: &order.levels,
-            fragments: &order.fragments,
-            length_unit: scene.unit_distance,
-            cull: true,
-            grid: PixelGrid::new(camera.width, camera.height),
-        };
+        let ctx = test_ctx(&scene, &camera, &breakpoints, &order, true);
         let chunk = 64;
         let chunks = order.pieces.chunks(chunk).count();
         assert!(chunks > 4 * 3 * AHEAD_PER_WORKER, "{chunks} chunks");
