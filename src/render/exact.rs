@@ -82,8 +82,9 @@ pub struct ExactStats {
     pub sort_s: f64,
     /// Time spent opening (or waiting for) the GPU context.
     pub gpu_open_s: f64,
-    /// Projection, integrals and the draw calls, which overlap (window
-    /// k + 1 is projected while window k is uploaded and drawn).
+    /// Projection, integrals and the draw calls, which overlap (workers
+    /// project later chunks while this thread uploads and draws finished
+    /// ones, [`pipeline`]).
     pub project_s: f64,
     pub gpu: FrameStats,
     /// What the GPU had left after the last draw call: finishing and
