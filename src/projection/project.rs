@@ -286,37 +286,17 @@ impl Projector {
         let tet = fast && n == 4 && self.tet.build(&self.pix, &poly.triangles, &self.facing);
         self.took_fast_path =
             tet || (fast && self.overlay.build(&self.pix, &poly.triangles, &self.facing));
-        if tet {
-            // 4. Regions of a tetrahedron in general position (`tet`).
-            let t = &self.tet;
-            let regions = Regions {
-                pos: &t.pos,
-                on_hull: &t.on_hull,
-                verts: &t.verts,
-                start: &t.start,
-                faces: &t.faces,
-                kinds: if self.vertex_faces_by_search {
-                    &[]
-                } else {
-                    &t.kinds
-                },
+        if self.took_fast_path {
+            // 4. Regions of a tetrahedron (`tet`) or another piece
+            // (`overlay`) in general position.
+            let mut regions = if tet {
+                Regions::of_tet(&self.tet)
+            } else {
+                Regions::of_overlay(&self.overlay)
             };
-            emit(poly, &self.pix, regions, &mut self.emit, out);
-        } else if self.took_fast_path {
-            // 4. Regions of a piece in general position (`overlay`).
-            let o = &self.overlay;
-            let regions = Regions {
-                pos: &o.pos,
-                on_hull: &o.on_hull,
-                verts: &o.region_verts,
-                start: &o.region_start,
-                faces: &o.face_fb,
-                kinds: if self.vertex_faces_by_search {
-                    &[]
-                } else {
-                    &o.kinds
-                },
-            };
+            if self.vertex_faces_by_search {
+                regions.kinds = &[];
+            }
             emit(poly, &self.pix, regions, &mut self.emit, out);
         } else {
             self.general_regions(poly, out)?;
@@ -585,6 +565,32 @@ struct Regions<'a> {
     /// What the fast path knows of each vertex (empty: the general path,
     /// search the regions around each vertex).
     kinds: &'a [VertexKind],
+}
+
+impl<'a> Regions<'a> {
+    /// The regions of a tetrahedron in general position.
+    fn of_tet(t: &'a TetRegions) -> Regions<'a> {
+        Regions {
+            pos: &t.pos,
+            on_hull: &t.on_hull,
+            verts: &t.verts,
+            start: &t.start,
+            faces: &t.faces,
+            kinds: &t.kinds,
+        }
+    }
+
+    /// The regions the overlay traced.
+    fn of_overlay(o: &'a Overlay) -> Regions<'a> {
+        Regions {
+            pos: &o.pos,
+            on_hull: &o.on_hull,
+            verts: &o.region_verts,
+            start: &o.region_start,
+            faces: &o.face_fb,
+            kinds: &o.kinds,
+        }
+    }
 }
 
 /// Writes vertices, regions and fan triangles (step 6 of the module docs).

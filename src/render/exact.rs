@@ -682,9 +682,9 @@ struct Flow {
     panic: Option<Box<dyn std::any::Any + Send>>,
 }
 
-/// Projects `pieces` in chunks of `chunk` ([`CHUNK`]) on `workers` threads and hands
-/// each chunk's output to `sink` on this thread, in order, as soon as it
-/// and all before it are done. Workers take chunks in order and run at most
+/// Projects `pieces` in chunks of `chunk` pieces ([`CHUNK`]) on `workers`
+/// threads and hands each chunk's output to `sink` on this thread, in
+/// order, as soon as it and all before it are done. Workers take chunks in order and run at most
 /// [`AHEAD_PER_WORKER`] per worker ahead of the hand-over, so memory stays
 /// bounded; there is no barrier between groups of chunks, so no worker
 /// waits for another's slow chunk. The first error of `sink` stops the
