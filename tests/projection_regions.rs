@@ -390,3 +390,53 @@ fn fuzz_pentagonal_prism_edge_on_perspective() {
     check_area(&out, &poly, &cam);
     assert!(out.vertices.iter().all(|v| v.l.is_finite() && v.l >= 0.0));
 }
+
+/// Region vertices carry exact values (evaluated, never interpolated), in
+/// orthographic and perspective views, through the fast path (which values
+/// crossings along their front and back edges) and the general path alike:
+/// each equals a direct ray-polyhedron intersection through its position.
+#[test]
+fn vertex_values_equal_ray_hits() {
+    let mut rng = Rng(0x7e57_ed9e_0000_0001);
+    let mut out = Projected::default();
+    let mut checked = 0;
+    for general in [false, true] {
+        let mut pr = Projector::new();
+        pr.fast_path = !general;
+        pr.perspective_refine = false;
+        for ortho in [true, false] {
+            for kind in KINDS {
+                for _ in 0..30 {
+                    let (pts, cells, sc) = random_cell(kind, &mut rng);
+                    let cam = random_camera(&mut rng, bounds(&pts), ortho);
+                    let poly =
+                        Polyhedron::from_cell(&cells, 0, &pts, |i| sc[i as usize], &cam).unwrap();
+                    pr.project(&poly, &cam, &mut out).unwrap();
+                    let diameter = poly
+                        .points
+                        .iter()
+                        .flat_map(|p| poly.points.iter().map(move |q| (*p - *q).length()))
+                        .fold(0.0, f64::max);
+                    let zscale = poly.points.iter().map(|p| p.z.abs()).fold(0.0, f64::max);
+                    for v in &out.vertices {
+                        // Rays grazing the silhouette may miss by rounding.
+                        if v.l < 1e-3 * diameter {
+                            continue;
+                        }
+                        let (l, zin, zout, sin, sout) = ray_hit(&poly, &out.view, v.pos())
+                            .unwrap_or_else(|| panic!("{kind:?}: vertex {v:?} misses"));
+                        let tol = 1e-9 * (diameter + zscale);
+                        assert!((v.l - l).abs() <= tol, "{kind:?} {ortho}: l {} {l}", v.l);
+                        assert!((v.z_front - zin).abs() <= tol, "{kind:?} {ortho}: zf");
+                        assert!((v.z_back - zout).abs() <= tol, "{kind:?} {ortho}: zb");
+                        // (Scalars are in [0, 1].)
+                        assert!((v.s_front - sin).abs() <= 1e-9, "{kind:?} {ortho}: sf");
+                        assert!((v.s_back - sout).abs() <= 1e-9, "{kind:?} {ortho}: sb");
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 2000, "{checked} vertices checked");
+}

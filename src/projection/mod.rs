@@ -177,9 +177,11 @@ pub(crate) enum VertexKind {
     Back,
     /// An original point used by both (a silhouette vertex).
     Silhouette,
-    /// The proper crossing of an edge between front triangles `fronts` and
-    /// an edge between back triangles `backs`.
-    Crossing { fronts: [u32; 2], backs: [u32; 2] },
+    /// The proper crossing of the edge between two front triangles with
+    /// ends (original points) `front`, and the edge between two back
+    /// triangles with ends `back`: its front values lie on the front edge,
+    /// its back values on the back edge.
+    Crossing { front: [u32; 2], back: [u32; 2] },
 }
 
 /// A boundary triangle as seen on screen: pixel positions of its corners

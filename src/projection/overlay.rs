@@ -642,8 +642,8 @@ impl Overlay {
                                     pix[be.b as usize],
                                 ));
                                 kinds.push(VertexKind::Crossing {
-                                    fronts: fe.tris,
-                                    backs: be.tris,
+                                    front: [fe.a, fe.b],
+                                    back: [be.a, be.b],
                                 });
                                 cross[slot] = x;
                             }

@@ -31,12 +31,14 @@
 //!    rounded positions, gives meaningless depths; every region around the
 //!    vertex holds it, so any of them gives the same exact value) -- the
 //!    corner's own data when the vertex is that corner, so profile vertices
-//!    get `l = 0` exactly. The fast path finds those triangles without the
-//!    search, from what it knows of each vertex ([`VertexKind`]: an original
-//!    point is a corner of every triangle of its own facing around it and
-//!    lies strictly inside one of the other facing; a crossing has the two
-//!    triangles on each side of its two edges), and so picks the same ones
-//!    (ties included); regions are fan-triangulated, skipping triangles
+//!    get `l = 0` exactly. The fast path finds an original point's
+//!    triangles without the search, from what it knows of the vertex
+//!    ([`VertexKind`]: a corner of every triangle of its own facing around
+//!    it, strictly inside one of the other facing), and so picks the same
+//!    ones; a crossing of a front and a back edge takes its front (back)
+//!    values along the front (back) edge, between the edge's ends, which is
+//!    exact and well conditioned even when a triangle beside the edge is a
+//!    sliver; regions are fan-triangulated, skipping triangles
 //!    whose exact orientation is not positive (zero area); with
 //!    [`Projector::clip_to_image`] the regions are then clipped to the image
 //!    rectangle plus a margin (near-plane caps project ~1e9 pixels away);
@@ -96,9 +98,10 @@ pub struct Projector {
     pub fast_path: bool,
     /// Whether the last call took the fast path (tests).
     pub(crate) took_fast_path: bool,
-    /// Give fast-path vertices their values by the general path's search
-    /// among the regions around them, not by their [`VertexKind`] (tests:
-    /// both must give the same bits).
+    /// Give fast-path vertices that are original points their values by the
+    /// general path's search among the regions around them, not by their
+    /// [`VertexKind`] (tests: both must give the same bits; crossings are
+    /// valued along their edges either way).
     pub(crate) vertex_faces_by_search: bool,
     clipper: Clipper,
     clipped: Polyhedron,
@@ -294,9 +297,7 @@ impl Projector {
             } else {
                 Regions::of_overlay(&self.overlay)
             };
-            if self.vertex_faces_by_search {
-                regions.kinds = &[];
-            }
+            regions.search = self.vertex_faces_by_search;
             emit(poly, &self.pix, regions, &mut self.emit, out);
         } else {
             self.general_regions(poly, out)?;
@@ -432,6 +433,7 @@ impl Projector {
             start: &self.region_start,
             faces: &self.face_fb,
             kinds: &[],
+            search: true,
         };
         emit(poly, &self.pix, regions, &mut self.emit, out);
         Ok(())
@@ -565,6 +567,9 @@ struct Regions<'a> {
     /// What the fast path knows of each vertex (empty: the general path,
     /// search the regions around each vertex).
     kinds: &'a [VertexKind],
+    /// Whether original points take the search (the general path; the
+    /// fast path's own check in tests) even with `kinds`.
+    search: bool,
 }
 
 impl<'a> Regions<'a> {
@@ -577,6 +582,7 @@ impl<'a> Regions<'a> {
             start: &t.start,
             faces: &t.faces,
             kinds: &t.kinds,
+            search: false,
         }
     }
 
@@ -589,6 +595,7 @@ impl<'a> Regions<'a> {
             start: &o.region_start,
             faces: &o.face_fb,
             kinds: &o.kinds,
+            search: false,
         }
     }
 }
@@ -623,13 +630,7 @@ fn emit(
         rf[0] = faces[ft[0] as usize];
         rf[1] = faces[ft[1] as usize];
     }
-    let fast = !regions.kinds.is_empty();
-    if fast {
-        // Crossings (after the points) choose by width.
-        if regions.kinds.len() > pix.len() {
-            widths.extend(faces.iter().map(FaceTri::width));
-        }
-    } else {
+    if regions.search {
         // Every region around a vertex holds it under its front and back
         // triangles, whose planes all give the vertex's values; take them
         // from the widest ones (best conditioned, `FaceTri::width`), never
@@ -661,8 +662,12 @@ fn emit(
                 vmap[v as usize] = id;
                 let q = regions.pos[v as usize];
                 let on_hull = regions.on_hull.get(v as usize).copied().unwrap_or(false);
-                out.vertices.push(if fast {
-                    fast_vertex(poly, &view, faces, widths, ft, v, q, on_hull, regions.kinds)
+                let by_kind = regions
+                    .kinds
+                    .get(v as usize)
+                    .is_some_and(|k| !regions.search || matches!(k, VertexKind::Crossing { .. }));
+                out.vertices.push(if by_kind {
+                    fast_vertex(poly, pix, &view, faces, ft, v, q, on_hull, regions.kinds)
                 } else {
                     let [(tf, _), (tb, _)] = best[v as usize];
                     RegionVertex::evaluate(
@@ -681,23 +686,23 @@ fn emit(
 }
 
 /// The values of fast-path vertex `v` at `q`, first met in a region with
-/// front and back triangles `ft`: the same triangles, and so the same bits,
-/// as the general search of [`emit`] picks (the widest front and back
-/// triangle among the regions around `v`, ties to the first region's), found
-/// from `v`'s [`VertexKind`]. An original point is a corner of every
-/// triangle around it of its own facing (no point lies inside an edge it
-/// does not end), where any of them gives the point's own data; a point of
-/// one facing only lies strictly inside one triangle of the other facing,
-/// the one of every region around it. A crossing has the two triangles on
-/// each side of its two edges: the first region's, unless the other one is
-/// strictly wider.
+/// front and back triangles `ft`, from `v`'s [`VertexKind`] (no search among
+/// the regions around it). An original point is a corner of every triangle
+/// around it of its own facing (no point lies inside an edge it does not
+/// end), where any of them gives the point's own data; a point of one
+/// facing only lies strictly inside one triangle of the other facing, the
+/// one of every region around it, and so the general path's search picks
+/// the same triangles and gets the same bits. A crossing lies on a front
+/// and a back edge, along which the front (back) surface is the segment
+/// between the edge's ends ([`along_edge`]): exact whatever the widths of
+/// the triangles on either side, one of which may be a sliver.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn fast_vertex(
     poly: &Polyhedron,
+    pix: &[DVec2],
     view: &ViewMap,
     faces: &[FaceTri],
-    widths: &[f64],
     ft: [u32; 2],
     v: u32,
     q: DVec2,
@@ -710,21 +715,40 @@ fn fast_vertex(
         VertexKind::Front => (own(), at(ft[1])),
         VertexKind::Back => (at(ft[0]), own()),
         VertexKind::Silhouette => (own(), own()),
-        VertexKind::Crossing { fronts, backs } => {
-            let width = |t: u32| widths[t as usize];
-            let pick = |pair: [u32; 2], first: u32| {
-                let other = if pair[0] == first { pair[1] } else { pair[0] };
-                if width(other) > width(first) {
-                    other
-                } else {
-                    first
-                }
-            };
-            let (tf, tb) = (pick(fronts, ft[0]), pick(backs, ft[1]));
-            (at(tf), at(tb))
-        }
+        VertexKind::Crossing { front, back } => (
+            along_edge(poly, pix, view.ortho, front, q),
+            along_edge(poly, pix, view.ortho, back, q),
+        ),
     };
     RegionVertex::from_values(view, front, back, q, on_hull)
+}
+
+/// Depth and scalar of the piece's boundary along its edge between points
+/// `[a, b]`, on the ray through pixel position `q` (a point of the edge up
+/// to rounding). The edge's parameter is that of `q`'s orthogonal
+/// projection onto it, clamped to the edge: well conditioned however the
+/// edge crosses others. Orthographic: linear interpolation;
+/// perspective: `1 / z` and `s / z` are linear along a projected segment.
+#[inline]
+fn along_edge(
+    poly: &Polyhedron,
+    pix: &[DVec2],
+    ortho: bool,
+    [a, b]: [u32; 2],
+    q: DVec2,
+) -> (f64, f64) {
+    let (pa, pb) = (pix[a as usize], pix[b as usize]);
+    let d = pb - pa;
+    let t = ((q - pa).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+    let (za, zb) = (poly.points[a as usize].z, poly.points[b as usize].z);
+    let (sa, sb) = (poly.scalars[a as usize], poly.scalars[b as usize]);
+    if ortho {
+        (za + t * (zb - za), sa + t * (sb - sa))
+    } else {
+        let (wa, wb) = ((1.0 - t) / za, t / zb);
+        let w = wa + wb;
+        (1.0 / w, (wa * sa + wb * sb) / w)
+    }
 }
 
 /// A point of a region polygon being clipped to the image window.

@@ -143,8 +143,8 @@ impl TetRegions {
                 self.on_hull.push(false);
                 self.kinds.extend([VertexKind::Silhouette; 4]);
                 self.kinds.push(VertexKind::Crossing {
-                    fronts: fr,
-                    backs: bk,
+                    front: [p, q],
+                    back: [r, s],
                 });
                 self.pos.push(segment_crossing(
                     pix[p as usize],
