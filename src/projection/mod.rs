@@ -341,8 +341,11 @@ pub struct Projected {
     pub triangles: Vec<[u32; 3]>,
     /// Region of each triangle.
     pub triangle_region: Vec<u32>,
-    /// Front and back triangle of each region.
-    pub region_faces: Vec<[FaceTri; 2]>,
+    /// The piece's boundary triangles as seen on screen (in the piece's
+    /// triangle order).
+    pub faces: Vec<FaceTri>,
+    /// Front and back triangle of each region (indices into `faces`).
+    pub region_faces: Vec<[u32; 2]>,
     /// The camera mapping the values were computed for.
     pub view: ViewMap,
     spare: Vec<Vec<u32>>,
@@ -361,7 +364,14 @@ impl Projected {
         }
         self.triangles.clear();
         self.triangle_region.clear();
+        self.faces.clear();
         self.region_faces.clear();
+    }
+
+    /// The front (`side` 0) or back (1) triangle of region `r`.
+    #[inline]
+    pub fn region_face(&self, r: usize, side: usize) -> &FaceTri {
+        &self.faces[self.region_faces[r][side] as usize]
     }
 
     fn push_region(&mut self) -> usize {

@@ -137,22 +137,84 @@ enum EdgeKind {
     Silhouette,
 }
 
+/// What an edge is in this view.
 #[derive(Clone, Copy, Debug)]
 struct Edge {
-    a: u32,
-    b: u32,
-    front: u8,
-    back: u8,
-    /// Uses in the input winding as `a -> b` and `b -> a`.
-    fwd: u8,
-    bwd: u8,
     kind: EdgeKind,
     /// Index among the edges of its kind (front or back).
     class: u32,
-    /// Start of the edge in its front triangle's counter-clockwise order.
-    front_from: u32,
-    /// The two triangles on its sides.
-    tris: [u32; 2],
+}
+
+/// Which of its edges `ccw[t][k] -> ccw[t][k + 1]` stands for which input
+/// edge `tris[t][k] -> tris[t][k + 1]` (reversed) once a front triangle
+/// `t` is turned counter-clockwise as `[t0, t2, t1]`: edge `k` is input
+/// edge `REVERSED[k]` (an involution).
+const REVERSED: [usize; 3] = [2, 1, 0];
+
+/// The piece's boundary topology: what depends on its triangle list alone,
+/// not on the view. It is kept for the last list, which the next piece
+/// usually has too (pieces of one cell kind whose faces were split along
+/// the same diagonals).
+#[derive(Clone, Debug, Default)]
+struct Topology {
+    /// The triangle list and point count it was built for.
+    tris: Vec<[u32; 3]>,
+    n: usize,
+    /// Every edge used once in each direction (a closed surface).
+    closed: bool,
+    /// Ends `a < b` of each edge.
+    ends: Vec<[u32; 2]>,
+    /// The two triangles along each edge, with the edge's index among
+    /// each one's input edges.
+    sides: Vec<[(u32, u8); 2]>,
+    /// Edge id of each triangle's input edge `t[k] -> t[k + 1]`.
+    tri_edge: Vec<[u32; 3]>,
+    /// Edge ids by ends (`a * n + b`), and uses of each edge from its
+    /// smaller and its larger end (scratch).
+    edge_id: Vec<u32>,
+    uses: Vec<[u8; 2]>,
+}
+
+impl Topology {
+    /// Makes this the topology of `tris` over `n` points (nothing to do
+    /// when it already is).
+    fn update(&mut self, n: usize, tris: &[[u32; 3]]) {
+        if self.n == n && self.tris == tris {
+            return;
+        }
+        self.n = n;
+        self.tris.clear();
+        self.tris.extend_from_slice(tris);
+        self.edge_id.clear();
+        self.edge_id.resize(n * n, NIL);
+        self.ends.clear();
+        self.sides.clear();
+        self.tri_edge.clear();
+        self.uses.clear();
+        for (ti, t) in tris.iter().enumerate() {
+            let mut te = [NIL; 3];
+            for k in 0..3 {
+                let (u, v) = (t[k], t[NEXT[k]]);
+                let (a, b) = (u.min(v), u.max(v));
+                let key = a as usize * n + b as usize;
+                let mut id = self.edge_id[key];
+                if id == NIL {
+                    id = self.ends.len() as u32;
+                    self.edge_id[key] = id;
+                    self.ends.push([a, b]);
+                    self.sides.push([(NIL, 0); 2]);
+                    self.uses.push([0; 2]);
+                }
+                let used = &mut self.uses[id as usize][(u > v) as usize];
+                *used = used.saturating_add(1);
+                let sd = &mut self.sides[id as usize];
+                sd[(sd[0].0 != NIL) as usize] = (ti as u32, k as u8);
+                te[k] = id;
+            }
+            self.tri_edge.push(te);
+        }
+        self.closed = self.uses.iter().all(|&u| u == [1, 1]);
+    }
 }
 
 /// Regions of a piece in general position (see module docs). Outputs are
@@ -162,11 +224,12 @@ pub(super) struct Overlay {
     /// Corners of each triangle, counter-clockwise (front ones reversed).
     ccw: Vec<[u32; 3]>,
     is_front: Vec<bool>,
+    /// The boundary's topology (view-independent, cached).
+    topo: Topology,
     /// Edge id of each triangle's edge `ccw[k] -> ccw[k + 1]`.
     tri_edge: Vec<[u32; 3]>,
     /// The same edges with what the walk needs.
     te: Vec<[TriEdge; 3]>,
-    edge_id: Vec<u32>,
     edges: Vec<Edge>,
     front_edges: Vec<u32>,
     back_edges: Vec<u32>,
@@ -206,50 +269,46 @@ struct Sides {
     s: Vec<i8>,
     /// Room for the points: `1 << shift` is at least their number.
     shift: u32,
-    /// Ends `a < b` of each edge.
-    ends: Vec<[u32; 2]>,
 }
 
 impl Sides {
-    /// Starts over for `n` points, `edges` and the triangles along them
-    /// (corners `ccw`, edges `tri_edge`), with the sides known without an
-    /// `orient2d`: an edge's ends are on it, and the third corner of each
-    /// triangle along it is on that triangle's side (exactly: the triangle
-    /// is counter-clockwise by its exact facing).
-    fn reset(&mut self, n: usize, edges: &[Edge], ccw: &[[u32; 3]], tri_edge: &[[u32; 3]]) {
+    /// Starts over for `n` points, edges with `ends` and the triangles
+    /// along them (corners `ccw`, edges `tri_edge`), with the sides known
+    /// without an `orient2d`: an edge's ends are on it, and the third corner
+    /// of each triangle along it is on that triangle's side (exactly: the
+    /// triangle is counter-clockwise by its exact facing).
+    fn reset(&mut self, n: usize, ends: &[[u32; 2]], ccw: &[[u32; 3]], tri_edge: &[[u32; 3]]) {
         self.shift = n.next_power_of_two().trailing_zeros();
-        self.ends.clear();
-        self.ends.extend(edges.iter().map(|e| [e.a, e.b]));
         self.s.clear();
-        self.s.resize(edges.len() << self.shift, 2);
-        for (e, ed) in edges.iter().enumerate() {
-            self.s[(e << self.shift) + ed.a as usize] = 0;
-            self.s[(e << self.shift) + ed.b as usize] = 0;
+        self.s.resize(ends.len() << self.shift, 2);
+        for (e, &[a, b]) in ends.iter().enumerate() {
+            self.s[(e << self.shift) + a as usize] = 0;
+            self.s[(e << self.shift) + b as usize] = 0;
         }
         for (c, te) in ccw.iter().zip(tri_edge) {
             for k in 0..3 {
                 let e = te[k] as usize;
                 let third = c[NEXT[NEXT[k]]] as usize;
-                self.s[(e << self.shift) + third] = if c[k] == edges[e].a { 1 } else { -1 };
+                self.s[(e << self.shift) + third] = if c[k] == ends[e][0] { 1 } else { -1 };
             }
         }
     }
 
-    /// Side of point `v` of edge `e` (from its smaller end).
+    /// Side of point `v` of edge `e` (with `ends`, from its smaller end).
     #[inline(always)]
-    fn get(&mut self, pix: &[DVec2], v: u32, e: u32) -> i8 {
+    fn get(&mut self, pix: &[DVec2], ends: &[[u32; 2]], v: u32, e: u32) -> i8 {
         let i = (e as usize) << self.shift | v as usize;
         let s = self.s[i];
         if s != 2 {
             return s;
         }
-        self.compute(pix, v, e, i)
+        self.compute(pix, ends, v, e, i)
     }
 
     #[cold]
     #[inline(never)]
-    fn compute(&mut self, pix: &[DVec2], v: u32, e: u32, i: usize) -> i8 {
-        let [a, b] = self.ends[e as usize];
+    fn compute(&mut self, pix: &[DVec2], ends: &[[u32; 2]], v: u32, e: u32, i: usize) -> i8 {
+        let [a, b] = ends[e as usize];
         let s = sign(orient2d(pix[a as usize], pix[b as usize], pix[v as usize]));
         self.s[i] = s;
         s
@@ -258,8 +317,8 @@ impl Sides {
     /// Side of point `v` of a triangle's edge `h` (counter-clockwise:
     /// positive is the triangle's side).
     #[inline(always)]
-    fn tri(&mut self, pix: &[DVec2], v: u32, h: TriEdge) -> i8 {
-        let s = self.get(pix, v, h.e);
+    fn tri(&mut self, pix: &[DVec2], ends: &[[u32; 2]], v: u32, h: TriEdge) -> i8 {
+        let s = self.get(pix, ends, v, h.e);
         if h.fwd {
             s
         } else {
@@ -309,89 +368,52 @@ impl Overlay {
             self.ccw.push(c);
             self.is_front.push(*f == Facing::Front);
         }
-        self.edge_id.clear();
-        self.edge_id.resize(n * n, NIL);
-        self.edges.clear();
-        self.tri_edge.clear();
-        for (ti, c) in self.ccw.iter().enumerate() {
-            let front = self.is_front[ti];
-            let mut te = [NIL; 3];
-            for k in 0..3 {
-                let (u, v) = (c[k], c[(k + 1) % 3]);
-                let (a, b) = (u.min(v), u.max(v));
-                let key = a as usize * n + b as usize;
-                let mut id = self.edge_id[key];
-                if id == NIL {
-                    id = self.edges.len() as u32;
-                    self.edge_id[key] = id;
-                    self.edges.push(Edge {
-                        a,
-                        b,
-                        front: 0,
-                        back: 0,
-                        fwd: 0,
-                        bwd: 0,
-                        kind: EdgeKind::Silhouette,
-                        class: NIL,
-                        front_from: NIL,
-                        tris: [NIL; 2],
-                    });
-                }
-                let e = &mut self.edges[id as usize];
-                // The input winding (front triangles were reversed).
-                let forward = if front { v < u } else { u < v };
-                if forward {
-                    e.fwd += 1;
-                } else {
-                    e.bwd += 1;
-                }
-                if front {
-                    e.front += 1;
-                    e.front_from = u;
-                } else {
-                    e.back += 1;
-                }
-                if e.tris[0] == NIL {
-                    e.tris[0] = ti as u32;
-                } else {
-                    e.tris[1] = ti as u32;
-                }
-                te[k] = id;
-            }
-            self.tri_edge.push(te);
+        self.topo.update(n, tris);
+        if !self.topo.closed {
+            return false; // not a closed surface
         }
+        let topo = &self.topo;
         self.front_edges.clear();
         self.back_edges.clear();
+        self.edges.clear();
         self.succ.clear();
         self.succ.resize(n, NIL);
         let mut n_sil = 0;
         let mut first = NIL;
-        for (id, e) in self.edges.iter_mut().enumerate() {
-            if e.fwd != 1 || e.bwd != 1 {
-                return false; // not a closed surface
-            }
-            match (e.front, e.back) {
-                (2, 0) => {
-                    e.kind = EdgeKind::Front;
-                    e.class = self.front_edges.len() as u32;
-                    self.front_edges.push(id as u32);
+        for (id, sd) in topo.sides.iter().enumerate() {
+            let (f0, f1) = (
+                self.is_front[sd[0].0 as usize],
+                self.is_front[sd[1].0 as usize],
+            );
+            self.edges.push(if f0 && f1 {
+                self.front_edges.push(id as u32);
+                Edge {
+                    kind: EdgeKind::Front,
+                    class: self.front_edges.len() as u32 - 1,
                 }
-                (0, 2) => {
-                    e.kind = EdgeKind::Back;
-                    e.class = self.back_edges.len() as u32;
-                    self.back_edges.push(id as u32);
+            } else if !f0 && !f1 {
+                self.back_edges.push(id as u32);
+                Edge {
+                    kind: EdgeKind::Back,
+                    class: self.back_edges.len() as u32 - 1,
                 }
-                _ => {
-                    let from = e.front_from;
-                    let to = if from == e.a { e.b } else { e.a };
-                    if self.succ[from as usize] != NIL {
-                        return false;
-                    }
-                    self.succ[from as usize] = to;
-                    n_sil += 1;
-                    first = from;
+            } else {
+                // The front triangle runs along it (counter-clockwise)
+                // from its input edge's end.
+                let (t, k) = if f0 { sd[0] } else { sd[1] };
+                let t = &topo.tris[t as usize];
+                let (from, to) = (t[NEXT[k as usize]], t[k as usize]);
+                if self.succ[from as usize] != NIL {
+                    return false;
                 }
-            }
+                self.succ[from as usize] = to;
+                n_sil += 1;
+                first = from;
+                Edge {
+                    kind: EdgeKind::Silhouette,
+                    class: NIL,
+                }
+            });
         }
         // 2. The silhouette: one strictly convex cycle, winding once.
         if n_sil < 3 {
@@ -421,39 +443,39 @@ impl Overlay {
             return false;
         }
         self.te.clear();
+        self.tri_edge.clear();
         for t in 0..self.ccw.len() {
+            let front = self.is_front[t];
             let mut row = [TriEdge::default(); 3];
+            let mut ids = [NIL; 3];
             for (k, r) in row.iter_mut().enumerate() {
-                let id = self.tri_edge[t][k];
-                let e = &self.edges[id as usize];
-                let nbr = if e.tris[0] as usize == t {
-                    e.tris[1]
+                let j = if front { REVERSED[k] } else { k };
+                let id = topo.tri_edge[t][j];
+                let sd = topo.sides[id as usize];
+                let (nbr, nj) = if sd[0].0 as usize == t { sd[1] } else { sd[0] };
+                let nbr_k = if self.is_front[nbr as usize] {
+                    REVERSED[nj as usize]
                 } else {
-                    e.tris[0]
+                    nj as usize
                 };
-                let Some(nbr_k) = (0..3).find(|&j| self.tri_edge[nbr as usize][j] == id) else {
-                    return false;
-                };
+                ids[k] = id;
                 *r = TriEdge {
                     e: id,
-                    class: if e.kind == EdgeKind::Silhouette {
-                        NIL
-                    } else {
-                        e.class
-                    },
-                    fwd: self.ccw[t][k] == e.a,
+                    class: self.edges[id as usize].class,
+                    fwd: self.ccw[t][k] == topo.ends[id as usize][0],
                     nbr,
                     nbr_k: nbr_k as u8,
                 };
             }
             self.te.push(row);
+            self.tri_edge.push(ids);
         }
         // 3. No point on an edge it does not end. A front vertex cannot lie
         // inside a front edge (the front triangles tile `S` and are not
         // degenerate), nor a silhouette vertex (an extreme point of `S`)
         // inside any: only vertices of one kind against edges of the other
         // remain.
-        self.sides.reset(n, &self.edges, &self.ccw, &self.tri_edge);
+        self.sides.reset(n, &topo.ends, &self.ccw, &self.tri_edge);
         self.vkind.clear();
         self.vkind.resize(n, 0);
         for (t, c) in self.ccw.iter().enumerate() {
@@ -475,7 +497,7 @@ impl Overlay {
                 } else {
                     self.front_edges[i]
                 };
-                let Edge { a, b, .. } = self.edges[e as usize];
+                let [a, b] = topo.ends[e as usize];
                 let (pa, pb) = (pix[a as usize], pix[b as usize]);
                 if q.x < pa.x.min(pb.x)
                     || q.x > pa.x.max(pb.x)
@@ -484,7 +506,7 @@ impl Overlay {
                 {
                     continue;
                 }
-                if self.sides.get(pix, v as u32, e) == 0 {
+                if self.sides.get(pix, &topo.ends, v as u32, e) == 0 {
                     return false;
                 }
             }
@@ -519,7 +541,7 @@ impl Overlay {
         else {
             return false;
         };
-        let [t0, t1] = self.edges[seed].tris;
+        let [(t0, _), (t1, _)] = self.topo.sides[seed];
         let (f, b) = if self.is_front[t0 as usize] {
             (t0, t1)
         } else {
@@ -570,7 +592,7 @@ impl Overlay {
             ccw,
             is_front,
             te,
-            edges,
+            topo,
             back_edges,
             backs,
             class,
@@ -586,6 +608,7 @@ impl Overlay {
             ..
         } = self;
         let (ccw, is_front, te, class) = (&ccw[..], &is_front[..], &te[..], &class[..]);
+        let ends = &topo.ends[..];
         let (n_back_edges, n_backs) = (back_edges.len(), backs.len());
         let Start { v: v0, t1, k, t2 } = st;
         let (mut t1, mut k, mut t2) = (t1 as usize, k as usize, t2 as usize);
@@ -609,9 +632,9 @@ impl Overlay {
             let mut inside = false;
             if g.class != NIL {
                 let o = [
-                    sides.tri(pix, c[0], g),
-                    sides.tri(pix, c[1], g),
-                    sides.tri(pix, c[2], g),
+                    sides.tri(pix, ends, c[0], g),
+                    sides.tri(pix, ends, c[1], g),
+                    sides.tri(pix, ends, c[2], g),
                 ];
                 let j = if o[0] < 0 && o[1] > 0 {
                     0
@@ -624,7 +647,7 @@ impl Overlay {
                 };
                 if j < 3 {
                     let h = te[t2][j];
-                    match sides.tri(pix, e, h) {
+                    match sides.tri(pix, ends, e, h) {
                         -1 => {
                             // g crosses h: the crossing vertex, computed
                             // once from the front edge's ends and the back
@@ -633,17 +656,17 @@ impl Overlay {
                             let slot = fe.class as usize * n_back_edges + be.class as usize;
                             let mut x = cross[slot];
                             if x == UNKNOWN {
-                                let (fe, be) = (&edges[fe.e as usize], &edges[be.e as usize]);
+                                let (fe, be) = (ends[fe.e as usize], ends[be.e as usize]);
                                 x = pos.len() as u32;
                                 pos.push(segment_crossing(
-                                    pix[fe.a as usize],
-                                    pix[fe.b as usize],
-                                    pix[be.a as usize],
-                                    pix[be.b as usize],
+                                    pix[fe[0] as usize],
+                                    pix[fe[1] as usize],
+                                    pix[be[0] as usize],
+                                    pix[be[1] as usize],
                                 ));
                                 kinds.push(VertexKind::Crossing {
-                                    front: [fe.a, fe.b],
-                                    back: [be.a, be.b],
+                                    front: fe,
+                                    back: be,
                                 });
                                 cross[slot] = x;
                             }
@@ -677,7 +700,7 @@ impl Overlay {
                     Side::On => return false,
                 }
                 e
-            } else if inside || te[t2].iter().all(|&h| sides.tri(pix, e, h) > 0) {
+            } else if inside || te[t2].iter().all(|&h| sides.tri(pix, ends, e, h) > 0) {
                 k = NEXT[k];
                 e
             } else {
@@ -851,6 +874,65 @@ mod tests {
         assert!(fast > 2000, "fast path taken {fast} times");
     }
 
+    /// The cached topology follows the triangle list: pieces of every kind,
+    /// with their faces split along varying diagonals (the corners' global
+    /// ids shuffled) and repeated or alternating, project with one
+    /// projector exactly as with a fresh one each.
+    #[test]
+    fn topology_cache_follows_the_triangles() {
+        let mut rng = Rng(0x70b0_1099_cace_0001);
+        let mut shared = Projector::new();
+        let (mut a, mut b) = (Projected::default(), Projected::default());
+        let mut fast = 0;
+        let mut last: Option<(Polyhedron, Camera)> = None;
+        for i in 0..600 {
+            let kind = KINDS[rng.below(KINDS.len())];
+            let (poly, cam) = if i % 3 == 2 && last.is_some() {
+                // The same triangles again, in another view.
+                let (p, _) = last.clone().unwrap();
+                let (_, cam) = piece(kind, &mut rng, i % 2 == 0, false, 0.0);
+                (p, cam)
+            } else {
+                let r = kind.reference_corners();
+                let mut ids: Vec<u32> = (0..r.len() as u32).collect();
+                for k in (1..ids.len()).rev() {
+                    ids.swap(k, rng.below(k + 1));
+                }
+                let (_, cam) = piece(kind, &mut rng, i % 2 == 0, false, 0.0);
+                let m = loop {
+                    let m = DMat3::from_cols_array(&std::array::from_fn(|_| rng.range(-1.0, 1.0)));
+                    if m.determinant().abs() > 0.15 {
+                        break m;
+                    }
+                };
+                // Corner k of the cell is world point ids[k].
+                let mut world = vec![DVec3::ZERO; r.len()];
+                for (k, &id) in ids.iter().enumerate() {
+                    world[id as usize] = m * r[k];
+                }
+                let mut cells = Cells::default();
+                cells.push(kind, &ids);
+                let s: Vec<f64> = (0..r.len()).map(|_| rng.f64()).collect();
+                let p = Polyhedron::from_cell(&cells, 0, &world, |i| s[i as usize], &cam);
+                match p {
+                    Ok(p) => (p, cam),
+                    Err(_) => continue,
+                }
+            };
+            let _ = shared.project(&poly, &cam, &mut a);
+            let mut fresh = Projector::new();
+            let _ = fresh.project(&poly, &cam, &mut b);
+            fast += shared.took_fast_path as usize;
+            assert_eq!(shared.took_fast_path, fresh.took_fast_path, "{kind:?} {i}");
+            assert_eq!(a.vertices, b.vertices, "{kind:?} {i}");
+            assert_eq!(a.regions, b.regions, "{kind:?} {i}");
+            assert_eq!(a.triangles, b.triangles, "{kind:?} {i}");
+            assert_eq!(a.region_faces, b.region_faces, "{kind:?} {i}");
+            last = Some((poly, cam));
+        }
+        assert!(fast > 300, "fast path taken {fast} times");
+    }
+
     /// The fast path gives the general path's regions: the same front and
     /// back triangles, areas and vertex values (crossings may round
     /// differently), and is taken for pieces in general position.
@@ -884,7 +966,7 @@ mod tests {
                 let well_conditioned = a
                     .region_faces
                     .iter()
-                    .all(|f| f[0].width() > 0.5 && f[1].width() > 0.5);
+                    .all(|f| f.iter().all(|&t| a.faces[t as usize].width() > 0.5));
                 for ra in 0..a.regions.len() {
                     // (Rounded crossings may leave slivers of zero area.)
                     assert!(area(&a, ra) >= -tol, "{kind:?} {i}");

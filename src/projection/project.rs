@@ -622,14 +622,7 @@ fn emit(
     vmap.clear();
     vmap.resize(nv, NIL);
     let verts = |f: usize| &regions.verts[regions.start[f] as usize..regions.start[f + 1] as usize];
-    // (Resized, then written in place: pushing 192-byte pairs goes
-    // through `memcpy`.)
-    out.region_faces
-        .resize(regions.faces.len(), [FaceTri::default(); 2]);
-    for (rf, ft) in out.region_faces.iter_mut().zip(regions.faces) {
-        rf[0] = faces[ft[0] as usize];
-        rf[1] = faces[ft[1] as usize];
-    }
+    out.region_faces.extend_from_slice(regions.faces);
     if regions.search {
         // Every region around a vertex holds it under its front and back
         // triangles, whose planes all give the vertex's values; take them
@@ -682,6 +675,8 @@ fn emit(
             out.regions[r].push(id);
         }
     }
+    // The triangles go out (the old ones are the next call's scratch).
+    std::mem::swap(faces, &mut out.faces);
     out.triangulate_regions();
 }
 
@@ -907,7 +902,8 @@ impl WindowScratch {
                 std::mem::swap(&mut self.poly, &mut self.tmp);
             }
             // Write the clipped polygon back with new vertex ids.
-            let [front, back] = out.region_faces[r];
+            let (front, back) = (out.region_face(r, 0), out.region_face(r, 1));
+            let wr = [front.width(), back.width()];
             out.regions[r].clear();
             if self.poly.len() < 3 {
                 continue;
@@ -926,7 +922,6 @@ impl WindowScratch {
                         // an edge (or around a corner) takes its front
                         // (back) values from the widest front (back)
                         // triangle among them (`FaceTri::width`).
-                        let wr = [front.width(), back.width()];
                         let found = self.keys.iter().position(|e| e.0 == key);
                         let (id, best, fresh) = match found {
                             Some(e) => {
@@ -952,8 +947,8 @@ impl WindowScratch {
                         if fresh {
                             let mut v = RegionVertex::evaluate(
                                 &out.view,
-                                &out.region_faces[best[0].0 as usize][0],
-                                &out.region_faces[best[1].0 as usize][1],
+                                out.region_face(best[0].0 as usize, 0),
+                                out.region_face(best[1].0 as usize, 1),
                                 w.p,
                                 false,
                             );

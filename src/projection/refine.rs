@@ -194,7 +194,7 @@ pub(crate) fn refine_with(
             s.widths.extend(
                 out.region_faces
                     .iter()
-                    .map(|f| [f[0].width(), f[1].width()]),
+                    .map(|f| f.map(|t| out.faces[t as usize].width())),
             );
         }
         s.mids.clear();
@@ -261,9 +261,11 @@ fn is_sliver(a: DVec2, b: DVec2, c: DVec2) -> bool {
 fn midpoint(out: &mut Projected, r: [u32; 2], a: u32, b: u32) -> u32 {
     let (va, vb) = (out.vertices[a as usize], out.vertices[b as usize]);
     let q = (DVec2::new(va.px, va.py) + DVec2::new(vb.px, vb.py)) * 0.5;
-    let front = out.region_faces[r[0] as usize][0];
-    let back = out.region_faces[r[1] as usize][1];
-    let mut v = RegionVertex::evaluate(&out.view, &front, &back, q, false);
+    let (front, back) = (
+        out.region_face(r[0] as usize, 0),
+        out.region_face(r[1] as usize, 1),
+    );
+    let mut v = RegionVertex::evaluate(&out.view, front, back, q, false);
     if va.profile && vb.profile {
         v.z_back = v.z_front;
         v.s_back = v.s_front;
