@@ -329,13 +329,92 @@ impl RegionVertex {
     }
 }
 
+/// Vertex lists (ids) of convex regions, stored one after the other.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RegionList {
+    verts: Vec<u32>,
+    /// Region `r` is `verts[start[r]..start[r + 1]]` (`start[0] = 0`).
+    start: Vec<u32>,
+}
+
+impl Default for RegionList {
+    fn default() -> Self {
+        RegionList {
+            verts: Vec::new(),
+            start: vec![0],
+        }
+    }
+}
+
+impl RegionList {
+    /// Number of regions.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The regions' vertex lists, in order.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = &[u32]> + '_ {
+        self.start
+            .windows(2)
+            .map(|w| &self.verts[w[0] as usize..w[1] as usize])
+    }
+
+    /// Empties the list, keeping allocations.
+    pub fn clear(&mut self) {
+        self.verts.clear();
+        self.start.clear();
+        self.start.push(0);
+    }
+
+    /// Adds vertex `v` to the region being built (the one after the last
+    /// [`Self::close`]).
+    #[inline]
+    pub fn push_vertex(&mut self, v: u32) {
+        self.verts.push(v);
+    }
+
+    /// The vertices pushed since the last [`Self::close`].
+    #[inline]
+    pub fn open(&self) -> &[u32] {
+        &self.verts[*self.start.last().unwrap_or(&0) as usize..]
+    }
+
+    /// Ends the region being built (empty when nothing was pushed); it
+    /// gets the next index.
+    #[inline]
+    pub fn close(&mut self) {
+        self.start.push(self.verts.len() as u32);
+    }
+
+    /// Empties the region being built.
+    pub fn discard_open(&mut self) {
+        let s = *self.start.last().unwrap_or(&0) as usize;
+        self.verts.truncate(s);
+    }
+}
+
+impl std::ops::Index<usize> for RegionList {
+    type Output = [u32];
+
+    #[inline]
+    fn index(&self, r: usize) -> &[u32] {
+        &self.verts[self.start[r] as usize..self.start[r + 1] as usize]
+    }
+}
+
 /// The projection of one piece (reused between calls).
 #[derive(Clone, Debug, Default)]
 pub struct Projected {
     /// Region vertices (shared between the regions and triangles).
     pub vertices: Vec<RegionVertex>,
     /// Convex regions, CCW (see module docs), indices into `vertices`.
-    pub regions: Vec<Vec<u32>>,
+    pub regions: RegionList,
     /// Triangles for the rasteriser: a fan of each region, refined where
     /// needed (perspective, [`refine`]); CCW, positive area.
     pub triangles: Vec<[u32; 3]>,
@@ -348,7 +427,6 @@ pub struct Projected {
     pub region_faces: Vec<[u32; 2]>,
     /// The camera mapping the values were computed for.
     pub view: ViewMap,
-    spare: Vec<Vec<u32>>,
     /// Scratch of [`Projected::cull_to_pixels`]: each vertex's
     /// [`coverage::Span`].
     spans: Vec<coverage::Span>,
@@ -358,10 +436,7 @@ impl Projected {
     /// Empties everything, keeping allocations.
     pub fn clear(&mut self) {
         self.vertices.clear();
-        while let Some(mut r) = self.regions.pop() {
-            r.clear();
-            self.spare.push(r);
-        }
+        self.regions.clear();
         self.triangles.clear();
         self.triangle_region.clear();
         self.faces.clear();
@@ -372,12 +447,6 @@ impl Projected {
     #[inline]
     pub fn region_face(&self, r: usize, side: usize) -> &FaceTri {
         &self.faces[self.region_faces[r][side] as usize]
-    }
-
-    fn push_region(&mut self) -> usize {
-        let r = self.spare.pop().unwrap_or_default();
-        self.regions.push(r);
-        self.regions.len() - 1
     }
 
     /// Fan-triangulates every region, skipping triangles whose exact

@@ -647,7 +647,6 @@ fn emit(
     }
     let view = out.view;
     for (f, &ft) in regions.faces.iter().enumerate() {
-        let r = out.push_region();
         for &v in verts(f) {
             let mut id = vmap[v as usize];
             if id == NIL {
@@ -672,8 +671,9 @@ fn emit(
                     )
                 });
             }
-            out.regions[r].push(id);
+            out.regions.push_vertex(id);
         }
+        out.regions.close();
     }
     // The triangles go out (the old ones are the next call's scratch).
     std::mem::swap(faces, &mut out.faces);
@@ -778,6 +778,8 @@ struct WindowScratch {
     /// whose front and back triangles gave its values.
     keys: Vec<(WinKey, u32, WidestFaces)>,
     verts: Vec<RegionVertex>,
+    /// The clipped regions.
+    regions: super::RegionList,
     own: u32,
 }
 
@@ -820,6 +822,7 @@ impl WindowScratch {
         self.map.resize(out.vertices.len(), NIL);
         self.keys.clear();
         self.verts.clear();
+        self.regions.clear();
         self.own = 0;
         for r in 0..out.regions.len() {
             self.poly.clear();
@@ -904,8 +907,8 @@ impl WindowScratch {
             // Write the clipped polygon back with new vertex ids.
             let (front, back) = (out.region_face(r, 0), out.region_face(r, 1));
             let wr = [front.width(), back.width()];
-            out.regions[r].clear();
             if self.poly.len() < 3 {
+                self.regions.close();
                 continue;
             }
             for w in &self.poly {
@@ -967,15 +970,18 @@ impl WindowScratch {
                         id
                     }
                 };
-                if out.regions[r].last() != Some(&id) && out.regions[r].first() != Some(&id) {
-                    out.regions[r].push(id);
+                let open = self.regions.open();
+                if open.last() != Some(&id) && open.first() != Some(&id) {
+                    self.regions.push_vertex(id);
                 }
             }
-            if out.regions[r].len() < 3 {
-                out.regions[r].clear();
+            if self.regions.open().len() < 3 {
+                self.regions.discard_open();
             }
+            self.regions.close();
         }
         std::mem::swap(&mut out.vertices, &mut self.verts);
+        std::mem::swap(&mut out.regions, &mut self.regions);
         out.triangulate_regions();
     }
 }
