@@ -42,7 +42,7 @@
 //! `g` crosses it: the next vertex is the crossing, then follow the crossed
 //! edge. Otherwise the next vertex is `g`'s end, strictly inside `T`
 //! (continue along the same triangle) or a shared corner (continue along the
-//! more counter-clockwise of the two triangles' next edges, `orient2d`).
+//! more counter-clockwise of the two triangles' next edges: a cached side).
 //! Each piece of boundary followed along a non-silhouette
 //! edge is also a piece of the boundary of the region across it (the
 //! triangle across the edge, intersected with the same other triangle),
@@ -684,20 +684,22 @@ impl Overlay {
                 x
             } else if let Some(j) = (0..3).find(|&j| c[j] == e) {
                 // A shared corner: the region's wedge there starts at the
-                // more counter-clockwise of the two next edges.
+                // more counter-clockwise of the two next edges, `e -> a`
+                // (t1's edge after g) and `e -> c` (t2's): the side of `c`
+                // of t1's edge `e -> a` (cached).
                 let (a, c) = (ccw[t1][NEXT[NEXT[k]]], c[NEXT[j]]);
                 let turn = if a == c {
-                    Side::Negative
+                    -1
                 } else {
-                    orient2d(pix[e as usize], pix[a as usize], pix[c as usize])
+                    sides.tri(pix, ends, c, te[t1][NEXT[k]])
                 };
                 match turn {
-                    Side::Negative => k = NEXT[k],
-                    Side::Positive => {
+                    -1 => k = NEXT[k],
+                    1 => {
                         (t1, t2, k) = (t2, t1, j);
                         t1_front = !t1_front;
                     }
-                    Side::On => return false,
+                    _ => return false,
                 }
                 e
             } else if inside || te[t2].iter().all(|&h| sides.tri(pix, ends, e, h) > 0) {

@@ -724,7 +724,7 @@ fn fast_vertex(
 /// projection onto it, clamped to the edge: well conditioned however the
 /// edge crosses others. Orthographic: linear interpolation;
 /// perspective: `1 / z` and `s / z` are linear along a projected segment.
-#[inline]
+#[inline(always)]
 fn along_edge(
     poly: &Polyhedron,
     pix: &[DVec2],
