@@ -118,6 +118,9 @@ struct TriEdge {
     /// The triangle across it, and the edge's index there.
     nbr: u32,
     nbr_k: u8,
+    /// The neighbour's part of a region's index in `visited` (see
+    /// `Overlay::slot`).
+    nbr_slot: u32,
 }
 
 /// The next corner (edge) of a triangle.
@@ -245,6 +248,10 @@ pub(super) struct Overlay {
     vkind: Vec<u8>,
     /// Index of each triangle among the front (back) triangles.
     class: Vec<u32>,
+    /// Each triangle's part of the index in `visited` of the regions under
+    /// it: its class times the number of back triangles for a front one,
+    /// its class for a back one (the two parts of a region add up).
+    slot: Vec<u32>,
     /// Regions found (front index * backs + back index).
     visited: Vec<bool>,
     queue: Vec<Packed>,
@@ -442,6 +449,15 @@ impl Overlay {
         if prev != first || wraps != 1 {
             return false;
         }
+        let n_backs = self.backs.len() as u32;
+        self.slot.clear();
+        self.slot.extend(self.is_front.iter().zip(&self.class).map(|(&f, &c)| {
+            if f {
+                c * n_backs
+            } else {
+                c
+            }
+        }));
         self.te.clear();
         self.tri_edge.clear();
         for t in 0..self.ccw.len() {
@@ -465,6 +481,7 @@ impl Overlay {
                     fwd: self.ccw[t][k] == topo.ends[id as usize][0],
                     nbr,
                     nbr_k: nbr_k as u8,
+                    nbr_slot: self.slot[nbr as usize],
                 };
             }
             self.te.push(row);
@@ -594,8 +611,7 @@ impl Overlay {
             te,
             topo,
             back_edges,
-            backs,
-            class,
+            slot,
             sides,
             cross,
             visited,
@@ -607,9 +623,9 @@ impl Overlay {
             face_fb,
             ..
         } = self;
-        let (ccw, is_front, te, class) = (&ccw[..], &is_front[..], &te[..], &class[..]);
+        let (ccw, is_front, te, slot) = (&ccw[..], &is_front[..], &te[..], &slot[..]);
         let ends = &topo.ends[..];
-        let (n_back_edges, n_backs) = (back_edges.len(), backs.len());
+        let n_back_edges = back_edges.len();
         let Start { v: v0, t1, k, t2 } = st;
         let (mut t1, mut k, mut t2) = (t1 as usize, k as usize, t2 as usize);
         let mut t1_front = is_front[t1];
@@ -711,12 +727,7 @@ impl Overlay {
             // The neighbour across the edge just followed shares this piece
             // of it, reversed: its walk can start at `v`.
             if g.class != NIL {
-                let (nf, nb) = if is_front[g.nbr as usize] {
-                    (g.nbr as usize, other)
-                } else {
-                    (other, g.nbr as usize)
-                };
-                let i = class[nf] as usize * n_backs + class[nb] as usize;
+                let i = (g.nbr_slot + slot[other]) as usize;
                 if !std::mem::replace(&mut visited[i], true) {
                     queue.push(
                         Start {
