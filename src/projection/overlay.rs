@@ -47,7 +47,10 @@
 //! edge is also a piece of the boundary of the region across it (the
 //! triangle across the edge, intersected with the same other triangle),
 //! which is queued with its walk's start (the piece's end, along the edge
-//! reversed) unless already found. Every decision is an exact predicate on
+//! reversed) unless already found; that walk's first step, back along the
+//! piece, and where it turns at the piece's start are known from this walk
+//! when it reached the piece's start by a crossing or strictly inside a
+//! triangle, and are not traced again. Every decision is an exact predicate on
 //! original points; anything unexpected (a zero orientation, a walk that
 //! does not close) declines to the general path.
 
@@ -103,6 +106,50 @@ impl Start {
             t2: (w >> 47) as u32 & 0x7fff,
             k: (w >> 62) as u8,
         }
+    }
+}
+
+/// How a walk arrived at the start of its current step (along edge `k` of
+/// `t1`, inside `t2`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Arrival {
+    /// Not recorded (the walk's first step, or after a shared corner).
+    Unknown,
+    /// By crossing edge `k` of the current `t2`: its previous step went
+    /// along that edge, inside the current `t1`.
+    Crossing(u8),
+    /// At the end of `t1`'s previous edge, strictly inside `t2`.
+    Inside,
+}
+
+/// The first step of a queued walk, when the walk that queued it knows it
+/// (see [`Overlay::region`]): the vertex it reaches and how, packed into
+/// one word (`v` in bits 0-31, the arrival in 32-34: 0-2 a crossing of
+/// that edge, 3 inside, 4 none).
+#[derive(Clone, Copy, Debug)]
+struct Known(u64);
+
+impl Known {
+    const NONE: Known = Known(4 << 32);
+
+    #[inline]
+    fn new(v: u32, how: Arrival) -> Known {
+        let a = match how {
+            Arrival::Crossing(k) => k as u64,
+            Arrival::Inside => 3,
+            Arrival::Unknown => 4,
+        };
+        Known(v as u64 | a << 32)
+    }
+
+    #[inline]
+    fn get(self) -> (u32, Arrival) {
+        let how = match (self.0 >> 32) as u8 {
+            k @ 0..=2 => Arrival::Crossing(k),
+            3 => Arrival::Inside,
+            _ => Arrival::Unknown,
+        };
+        (self.0 as u32, how)
     }
 }
 
@@ -254,7 +301,10 @@ pub(super) struct Overlay {
     slot: Vec<u32>,
     /// Regions found (front index * backs + back index).
     visited: Vec<bool>,
-    queue: Vec<Packed>,
+    queue: Vec<(Packed, Known)>,
+    /// Trace every step of every region (tests: the steps that are known
+    /// from the neighbour's walk must come out the same).
+    pub retrace: bool,
     /// Positions of the vertices: the points, then the crossings.
     pub pos: Vec<DVec2>,
     /// Silhouette vertices.
@@ -451,13 +501,16 @@ impl Overlay {
         }
         let n_backs = self.backs.len() as u32;
         self.slot.clear();
-        self.slot.extend(self.is_front.iter().zip(&self.class).map(|(&f, &c)| {
-            if f {
-                c * n_backs
-            } else {
-                c
-            }
-        }));
+        self.slot
+            .extend(self.is_front.iter().zip(&self.class).map(
+                |(&f, &c)| {
+                    if f {
+                        c * n_backs
+                    } else {
+                        c
+                    }
+                },
+            ));
         self.te.clear();
         self.tri_edge.clear();
         for t in 0..self.ccw.len() {
@@ -569,7 +622,7 @@ impl Overlay {
         };
         let u = self.ccw[f as usize][k];
         self.visit(f, b);
-        self.queue.push(
+        self.queue.push((
             Start {
                 v: u,
                 t1: f,
@@ -577,9 +630,10 @@ impl Overlay {
                 t2: b,
             }
             .pack(),
-        );
-        while let Some(st) = self.queue.pop() {
-            if !self.region(pix, Start::unpack(st)) {
+            Known::NONE,
+        ));
+        while let Some((st, known)) = self.queue.pop() {
+            if !self.region(pix, Start::unpack(st), known) {
                 return false;
             }
         }
@@ -604,7 +658,16 @@ impl Overlay {
     /// neighbours not found yet; `false` when something unexpected declines
     /// the fast path. (The fields are borrowed one by one, so that the
     /// walk's tables stay in registers.)
-    fn region(&mut self, pix: &[DVec2], st: Start) -> bool {
+    ///
+    /// A walk that followed a piece `u -> v` of edge `g` (of `t1`, inside
+    /// `t2`) queues the region across `g` (`t1' ∩ t2`, `t1'` across `g`)
+    /// to start at `v` along `g` reversed: its first step ends at `u`, and
+    /// where it goes on from there is known (`known`) when this walk
+    /// arrived at `u` by crossing edge `h` of `t2` (it crosses `h` there
+    /// too, and follows `h` inside `t1'`) or at `g`'s start strictly inside
+    /// `t2` (it follows the edge of `t1'` after `g`). Only at a shared
+    /// corner is its turn left to the walk.
+    fn region(&mut self, pix: &[DVec2], st: Start, known: Known) -> bool {
         let Overlay {
             ccw,
             is_front,
@@ -621,6 +684,7 @@ impl Overlay {
             region_verts,
             region_start,
             face_fb,
+            retrace,
             ..
         } = self;
         let (ccw, is_front, te, slot) = (&ccw[..], &is_front[..], &te[..], &slot[..]);
@@ -632,6 +696,23 @@ impl Overlay {
         let (f, b) = if t1_front { (t1, t2) } else { (t2, t1) };
         let begin = region_verts.len();
         region_verts.push(v0);
+        // The current step's start, and how the walk got there.
+        let (mut cur, mut arrived) = (v0, Arrival::Unknown);
+        match known.get() {
+            (u, Arrival::Crossing(j)) if !*retrace => {
+                // Along edge j of t2 (crossed at u), inside t1.
+                region_verts.push(u);
+                (t1, t2, k) = (t2, t1, j as usize);
+                t1_front = !t1_front;
+                (cur, arrived) = (u, Arrival::Crossing(st.k));
+            }
+            (u, Arrival::Inside) if !*retrace => {
+                region_verts.push(u);
+                k = NEXT[k];
+                (cur, arrived) = (u, Arrival::Inside);
+            }
+            _ => {}
+        }
         let mut closed = false;
         for _ in 0..MAX_WALK {
             // Along edge g = k of t1 (s -> e), inside t2.
@@ -694,11 +775,14 @@ impl Overlay {
                     }
                 }
             }
+            let from = (cur, arrived);
             let v = if let Some((x, j)) = exit {
+                arrived = Arrival::Crossing(k as u8);
                 (t1, t2, k) = (t2, t1, j);
                 t1_front = !t1_front;
                 x
             } else if let Some(j) = (0..3).find(|&j| c[j] == e) {
+                arrived = Arrival::Unknown;
                 // A shared corner: the region's wedge there starts at the
                 // more counter-clockwise of the two next edges, `e -> a`
                 // (t1's edge after g) and `e -> c` (t2's): the side of `c`
@@ -719,6 +803,7 @@ impl Overlay {
                 }
                 e
             } else if inside || te[t2].iter().all(|&h| sides.tri(pix, ends, e, h) > 0) {
+                arrived = Arrival::Inside;
                 k = NEXT[k];
                 e
             } else {
@@ -729,7 +814,7 @@ impl Overlay {
             if g.class != NIL {
                 let i = (g.nbr_slot + slot[other]) as usize;
                 if !std::mem::replace(&mut visited[i], true) {
-                    queue.push(
+                    queue.push((
                         Start {
                             v,
                             t1: g.nbr,
@@ -737,7 +822,8 @@ impl Overlay {
                             t2: other as u32,
                         }
                         .pack(),
-                    );
+                        Known::new(from.0, from.1),
+                    ));
                 }
             }
             if v == v0 {
@@ -745,6 +831,7 @@ impl Overlay {
                 break;
             }
             region_verts.push(v);
+            cur = v;
         }
         let len = region_verts.len() - begin;
         if !closed || len < 3 {
@@ -885,6 +972,33 @@ mod tests {
             }
         }
         assert!(fast > 2000, "fast path taken {fast} times");
+    }
+
+    /// The first steps a walk takes over from the walk that queued it are
+    /// the steps it would trace: the same regions, vertices and triangles,
+    /// bit for bit, as when every step is traced.
+    #[test]
+    fn known_first_steps_match_tracing() {
+        let mut rng = Rng(0x5ca1_ab1e_0000_0007);
+        let mut fast = Projector::new();
+        let mut traced = Projector::new();
+        traced.overlay.retrace = true;
+        let (mut a, mut b) = (Projected::default(), Projected::default());
+        let mut taken = 0;
+        for kind in KINDS {
+            for i in 0..400 {
+                let (poly, cam, _) = case(kind, &mut rng, i);
+                fast.project(&poly, &cam, &mut a).unwrap();
+                traced.project(&poly, &cam, &mut b).unwrap();
+                assert_eq!(fast.took_fast_path, traced.took_fast_path, "{kind:?} {i}");
+                taken += fast.took_fast_path as usize;
+                assert_eq!(a.vertices, b.vertices, "{kind:?} {i}");
+                assert_eq!(a.regions, b.regions, "{kind:?} {i}");
+                assert_eq!(a.triangles, b.triangles, "{kind:?} {i}");
+                assert_eq!(a.region_faces, b.region_faces, "{kind:?} {i}");
+            }
+        }
+        assert!(taken > 1500, "fast path taken {taken} times");
     }
 
     /// The cached topology follows the triangle list: pieces of every kind,

@@ -106,7 +106,7 @@ pub struct Projector {
     clipper: Clipper,
     clipped: Polyhedron,
     arr: Arrangement,
-    overlay: Overlay,
+    pub(super) overlay: Overlay,
     tet: TetRegions,
     pix: Vec<DVec2>,
     canon: Vec<u32>,
