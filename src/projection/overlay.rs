@@ -219,10 +219,24 @@ struct Topology {
     sides: Vec<[(u32, u8); 2]>,
     /// Edge id of each triangle's input edge `t[k] -> t[k + 1]`.
     tri_edge: Vec<[u32; 3]>,
+    /// The same edges with their neighbours, as [`Overlay::build`] needs
+    /// them.
+    adj: Vec<[Adj; 3]>,
     /// Edge ids by ends (`a * n + b`), and uses of each edge from its
     /// smaller and its larger end (scratch).
     edge_id: Vec<u32>,
     uses: Vec<[u8; 2]>,
+}
+
+/// Input edge `k` of a triangle `t`: its id, whether `t[k]` is its
+/// smaller end, and the triangle across it with the edge's input index
+/// there.
+#[derive(Clone, Copy, Debug, Default)]
+struct Adj {
+    e: u32,
+    fwd: bool,
+    nbr: u32,
+    nbr_j: u8,
 }
 
 impl Topology {
@@ -264,6 +278,24 @@ impl Topology {
             self.tri_edge.push(te);
         }
         self.closed = self.uses.iter().all(|&u| u == [1, 1]);
+        self.adj.clear();
+        if self.closed {
+            for (t, (te, c)) in self.tri_edge.iter().zip(tris).enumerate() {
+                let mut row = [Adj::default(); 3];
+                for (j, r) in row.iter_mut().enumerate() {
+                    let e = te[j];
+                    let sd = self.sides[e as usize];
+                    let (nbr, nbr_j) = if sd[0].0 as usize == t { sd[1] } else { sd[0] };
+                    *r = Adj {
+                        e,
+                        fwd: c[j] == self.ends[e as usize][0],
+                        nbr,
+                        nbr_j,
+                    };
+                }
+                self.adj.push(row);
+            }
+        }
     }
 }
 
@@ -515,26 +547,25 @@ impl Overlay {
         self.tri_edge.clear();
         for t in 0..self.ccw.len() {
             let front = self.is_front[t];
+            let adj = &topo.adj[t];
             let mut row = [TriEdge::default(); 3];
             let mut ids = [NIL; 3];
             for (k, r) in row.iter_mut().enumerate() {
-                let j = if front { REVERSED[k] } else { k };
-                let id = topo.tri_edge[t][j];
-                let sd = topo.sides[id as usize];
-                let (nbr, nj) = if sd[0].0 as usize == t { sd[1] } else { sd[0] };
-                let nbr_k = if self.is_front[nbr as usize] {
-                    REVERSED[nj as usize]
+                // A front triangle runs along its input edges reversed.
+                let a = adj[if front { REVERSED[k] } else { k }];
+                let nbr_k = if self.is_front[a.nbr as usize] {
+                    REVERSED[a.nbr_j as usize]
                 } else {
-                    nj as usize
+                    a.nbr_j as usize
                 };
-                ids[k] = id;
+                ids[k] = a.e;
                 *r = TriEdge {
-                    e: id,
-                    class: self.edges[id as usize].class,
-                    fwd: self.ccw[t][k] == topo.ends[id as usize][0],
-                    nbr,
+                    e: a.e,
+                    class: self.edges[a.e as usize].class,
+                    fwd: a.fwd != front,
+                    nbr: a.nbr,
                     nbr_k: nbr_k as u8,
-                    nbr_slot: self.slot[nbr as usize],
+                    nbr_slot: self.slot[a.nbr as usize],
                 };
             }
             self.te.push(row);
