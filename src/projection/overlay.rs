@@ -964,16 +964,8 @@ mod tests {
         0.5 * a
     }
 
-    /// Fast-path vertices get the same bits from their `VertexKind` as from
-    /// the search among the regions around them (the same front and back
-    /// triangles, ties included), in every output.
-    #[test]
-    fn vertex_kinds_match_search() {
-        let mut rng = Rng(0x5eed_f00d_fa57_0001);
-        let mut direct = Projector::new();
-        let mut search = Projector::new();
-        search.vertex_faces_by_search = true;
-        let (mut a, mut b) = (Projected::default(), Projected::default());
+    /// Asserts that two projections are the same, bit for bit.
+    fn assert_same(a: &Projected, b: &Projected, what: &str) {
         let bits = |o: &Projected| -> Vec<u64> {
             o.vertices
                 .iter()
@@ -985,6 +977,23 @@ mod tests {
                 })
                 .collect()
         };
+        assert_eq!(bits(a), bits(b), "{what}");
+        assert_eq!(a.regions, b.regions, "{what}");
+        assert_eq!(a.triangles, b.triangles, "{what}");
+        assert_eq!(a.triangle_region, b.triangle_region, "{what}");
+        assert_eq!(a.region_faces, b.region_faces, "{what}");
+    }
+
+    /// Fast-path vertices get the same bits from their `VertexKind` as from
+    /// the search among the regions around them (the same front and back
+    /// triangles, ties included), in every output.
+    #[test]
+    fn vertex_kinds_match_search() {
+        let mut rng = Rng(0x5eed_f00d_fa57_0001);
+        let mut direct = Projector::new();
+        let mut search = Projector::new();
+        search.vertex_faces_by_search = true;
+        let (mut a, mut b) = (Projected::default(), Projected::default());
         let mut fast = 0;
         for kind in KINDS {
             for i in 0..300 {
@@ -995,10 +1004,7 @@ mod tests {
                     direct.project(&poly, &cam, &mut a).unwrap();
                     search.project(&poly, &cam, &mut b).unwrap();
                     fast += direct.took_fast_path as usize;
-                    assert_eq!(bits(&a), bits(&b), "{kind:?} {i}");
-                    assert_eq!(a.regions, b.regions, "{kind:?} {i}");
-                    assert_eq!(a.triangles, b.triangles, "{kind:?} {i}");
-                    assert_eq!(a.triangle_region, b.triangle_region, "{kind:?} {i}");
+                    assert_same(&a, &b, &format!("{kind:?} {i}"));
                 }
             }
         }
@@ -1023,10 +1029,7 @@ mod tests {
                 traced.project(&poly, &cam, &mut b).unwrap();
                 assert_eq!(fast.took_fast_path, traced.took_fast_path, "{kind:?} {i}");
                 taken += fast.took_fast_path as usize;
-                assert_eq!(a.vertices, b.vertices, "{kind:?} {i}");
-                assert_eq!(a.regions, b.regions, "{kind:?} {i}");
-                assert_eq!(a.triangles, b.triangles, "{kind:?} {i}");
-                assert_eq!(a.region_faces, b.region_faces, "{kind:?} {i}");
+                assert_same(&a, &b, &format!("{kind:?} {i}"));
             }
         }
         assert!(taken > 1500, "fast path taken {taken} times");
@@ -1082,10 +1085,7 @@ mod tests {
             let _ = fresh.project(&poly, &cam, &mut b);
             fast += shared.took_fast_path as usize;
             assert_eq!(shared.took_fast_path, fresh.took_fast_path, "{kind:?} {i}");
-            assert_eq!(a.vertices, b.vertices, "{kind:?} {i}");
-            assert_eq!(a.regions, b.regions, "{kind:?} {i}");
-            assert_eq!(a.triangles, b.triangles, "{kind:?} {i}");
-            assert_eq!(a.region_faces, b.region_faces, "{kind:?} {i}");
+            assert_same(&a, &b, &format!("{kind:?} {i}"));
             last = Some((poly, cam));
         }
         assert!(fast > 300, "fast path taken {fast} times");
