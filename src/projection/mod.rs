@@ -375,25 +375,25 @@ impl RegionList {
     /// Adds vertex `v` to the region being built (the one after the last
     /// [`Self::close`]).
     #[inline]
-    pub fn push_vertex(&mut self, v: u32) {
+    pub(crate) fn push_vertex(&mut self, v: u32) {
         self.verts.push(v);
     }
 
     /// The vertices pushed since the last [`Self::close`].
     #[inline]
-    pub fn open(&self) -> &[u32] {
+    pub(crate) fn open(&self) -> &[u32] {
         &self.verts[*self.start.last().unwrap_or(&0) as usize..]
     }
 
     /// Ends the region being built (empty when nothing was pushed); it
     /// gets the next index.
     #[inline]
-    pub fn close(&mut self) {
+    pub(crate) fn close(&mut self) {
         self.start.push(self.verts.len() as u32);
     }
 
     /// Empties the region being built.
-    pub fn discard_open(&mut self) {
+    pub(crate) fn discard_open(&mut self) {
         let s = *self.start.last().unwrap_or(&0) as usize;
         self.verts.truncate(s);
     }

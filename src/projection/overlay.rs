@@ -315,8 +315,6 @@ pub(super) struct Overlay {
     edges: Vec<Edge>,
     front_edges: Vec<u32>,
     back_edges: Vec<u32>,
-    fronts: Vec<u32>,
-    backs: Vec<u32>,
     succ: Vec<u32>,
     /// `orient2d(a, b, v)` of point `v` and edge `a < b`, cached.
     sides: Sides,
@@ -437,19 +435,18 @@ impl Overlay {
         // 1. Triangles counter-clockwise, edges and their kinds.
         self.ccw.clear();
         self.is_front.clear();
-        self.fronts.clear();
-        self.backs.clear();
         self.class.clear();
-        for (ti, (t, f)) in tris.iter().zip(facing).enumerate() {
+        let (mut n_fronts, mut n_backs) = (0u32, 0u32);
+        for (t, f) in tris.iter().zip(facing) {
             let c = match f {
                 Facing::Front => {
-                    self.class.push(self.fronts.len() as u32);
-                    self.fronts.push(ti as u32);
+                    self.class.push(n_fronts);
+                    n_fronts += 1;
                     [t[0], t[2], t[1]]
                 }
                 Facing::Back => {
-                    self.class.push(self.backs.len() as u32);
-                    self.backs.push(ti as u32);
+                    self.class.push(n_backs);
+                    n_backs += 1;
                     *t
                 }
                 Facing::EdgeOn => return false,
@@ -531,7 +528,6 @@ impl Overlay {
         if prev != first || wraps != 1 {
             return false;
         }
-        let n_backs = self.backs.len() as u32;
         self.slot.clear();
         self.slot
             .extend(self.is_front.iter().zip(&self.class).map(
@@ -632,8 +628,7 @@ impl Overlay {
         self.region_start.push(0);
         self.face_fb.clear();
         self.visited.clear();
-        self.visited
-            .resize(self.fronts.len() * self.backs.len(), false);
+        self.visited.resize((n_fronts * n_backs) as usize, false);
         self.queue.clear();
         let Some(seed) = self
             .edges
@@ -652,7 +647,7 @@ impl Overlay {
             return false;
         };
         let u = self.ccw[f as usize][k];
-        self.visit(f, b);
+        self.visited[(self.slot[f as usize] + self.slot[b as usize]) as usize] = true;
         self.queue.push((
             Start {
                 v: u,
@@ -669,20 +664,6 @@ impl Overlay {
             }
         }
         true
-    }
-
-    /// Marks region `t1 ∩ t2` (a front and a back triangle, either order)
-    /// as found; `false` when it was already.
-    #[inline]
-    fn visit(&mut self, t1: u32, t2: u32) -> bool {
-        let (f, b) = if self.is_front[t1 as usize] {
-            (t1, t2)
-        } else {
-            (t2, t1)
-        };
-        let i =
-            self.class[f as usize] as usize * self.backs.len() + self.class[b as usize] as usize;
-        !std::mem::replace(&mut self.visited[i], true)
     }
 
     /// Traces region `t1 ∩ t2` counter-clockwise from `st` and queues its
@@ -989,25 +970,10 @@ mod tests {
     /// triangles, ties included), in every output.
     #[test]
     fn vertex_kinds_match_search() {
-        let mut rng = Rng(0x5eed_f00d_fa57_0001);
         let mut direct = Projector::new();
         let mut search = Projector::new();
         search.vertex_faces_by_search = true;
-        let (mut a, mut b) = (Projected::default(), Projected::default());
-        let mut fast = 0;
-        for kind in KINDS {
-            for i in 0..300 {
-                let (poly, cam, _) = case(kind, &mut rng, i);
-                for clip in [false, true] {
-                    direct.clip_to_image = clip;
-                    search.clip_to_image = clip;
-                    direct.project(&poly, &cam, &mut a).unwrap();
-                    search.project(&poly, &cam, &mut b).unwrap();
-                    fast += direct.took_fast_path as usize;
-                    assert_same(&a, &b, &format!("{kind:?} {i}"));
-                }
-            }
-        }
+        let fast = agree(&mut direct, &mut search, 0x5eed_f00d_fa57_0001, 300, true);
         assert!(fast > 2000, "fast path taken {fast} times");
     }
 
@@ -1016,23 +982,36 @@ mod tests {
     /// bit for bit, as when every step is traced.
     #[test]
     fn known_first_steps_match_tracing() {
-        let mut rng = Rng(0x5ca1_ab1e_0000_0007);
         let mut fast = Projector::new();
         let mut traced = Projector::new();
         traced.overlay.retrace = true;
+        let taken = agree(&mut fast, &mut traced, 0x5ca1_ab1e_0000_0007, 400, false);
+        assert!(taken > 1500, "fast path taken {taken} times");
+    }
+
+    /// Projects `n` cases of every kind (seeded by `seed`; each also clipped
+    /// to the image with `clip`) with both projectors, asserts that they take
+    /// the same path to the same output, bit for bit, and returns how often
+    /// `a` took the fast path.
+    fn agree(a_pr: &mut Projector, b_pr: &mut Projector, seed: u64, n: usize, clip: bool) -> usize {
+        let mut rng = Rng(seed);
         let (mut a, mut b) = (Projected::default(), Projected::default());
-        let mut taken = 0;
+        let mut fast = 0;
         for kind in KINDS {
-            for i in 0..400 {
+            for i in 0..n {
                 let (poly, cam, _) = case(kind, &mut rng, i);
-                fast.project(&poly, &cam, &mut a).unwrap();
-                traced.project(&poly, &cam, &mut b).unwrap();
-                assert_eq!(fast.took_fast_path, traced.took_fast_path, "{kind:?} {i}");
-                taken += fast.took_fast_path as usize;
-                assert_same(&a, &b, &format!("{kind:?} {i}"));
+                for clip in [false, true].into_iter().take(1 + clip as usize) {
+                    a_pr.clip_to_image = clip;
+                    b_pr.clip_to_image = clip;
+                    a_pr.project(&poly, &cam, &mut a).unwrap();
+                    b_pr.project(&poly, &cam, &mut b).unwrap();
+                    fast += a_pr.took_fast_path as usize;
+                    assert_eq!(a_pr.took_fast_path, b_pr.took_fast_path, "{kind:?} {i}");
+                    assert_same(&a, &b, &format!("{kind:?} {i}"));
+                }
             }
         }
-        assert!(taken > 1500, "fast path taken {taken} times");
+        fast
     }
 
     /// The cached topology follows the triangle list: pieces of every kind,
