@@ -1,10 +1,15 @@
 // Exact (Max-Williams-Silva) compositing stage of zoovr.
 //
-// Per vertex: clip position, thickness l, mean extinction tau, glow C / alpha.
+// Per vertex: clip position, thickness l, mean extinction tau, glow C / alpha,
+// and the number of the piece (convex polyhedron) the triangle belongs to.
 // Per fragment: alpha = 1 - exp(-l tau) from the 2D exponential table
 // (src/gpu/exptable.rs documents range, warp and clamping; its `sample` is the
 // CPU twin of `alpha_of` below), colour = glow * alpha, premultiplied. The
-// pipeline blends with src + (1 - src.a) * dst on all channels.
+// pipeline blends with src + (1 - src.a) * dst on all channels, and tests
+// depth (less, write) against the piece's key: a pixel centre that two
+// triangles of one piece both cover (a sliver folded over by the rounding of
+// its corners to f32 and to the rasteriser's sub-pixel grid) is coloured
+// once, by the first.
 //
 // Varyings use the default perspective-correct interpolation; never
 // @interpolate(linear) (Mesa gives NaN with it on triangles crossing the
@@ -35,6 +40,7 @@ struct VertexIn {
     @location(1) thickness: f32,
     @location(2) tau: f32,
     @location(3) glow: vec3<f32>,
+    @location(4) piece: u32,
 }
 
 struct VertexOut {
@@ -42,6 +48,25 @@ struct VertexOut {
     @location(0) thickness: f32,
     @location(1) tau: f32,
     @location(2) glow: vec3<f32>,
+    @location(3) @interpolate(flat) piece: u32,
+}
+
+// What a fragment writes: its colour, and as its depth the piece's key (see
+// `piece_depth`), so that the depth test (less, with write) lets each piece
+// colour a pixel at most once.
+struct FragOut {
+    @location(0) color: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+}
+
+// The depth key of piece number `piece` in drawing order (twin:
+// gpu::vertex::piece_depth): the f32 just below 1.0 for piece 0, and one
+// representable value lower for each later piece, so later pieces pass a
+// strict less-than test against earlier ones while a second fragment of the
+// same piece at the same pixel fails it. Flat and written per fragment, the
+// key is exact (an interpolated position z need not be).
+fn piece_depth(piece: u32) -> f32 {
+    return bitcast<f32>(0x3F7FFFFFu - piece);
 }
 
 @vertex
@@ -51,6 +76,7 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.thickness = v.thickness * params.inv_unit;
     out.tau = v.tau * params.unit;
     out.glow = v.glow;
+    out.piece = v.piece;
     return out;
 }
 
@@ -94,16 +120,31 @@ fn finite(x: f32) -> bool {
 }
 
 @fragment
-fn fs_main(f: VertexOut) -> @location(0) vec4<f32> {
+fn fs_main(f: VertexOut) -> FragOut {
     // Every vertex the CPU sends is finite, but a rasteriser may still
     // interpolate garbage on a sliver of almost zero area (its attribute
     // planes divide by the area: Mesa gives NaN). Such a fragment has no
-    // meaningful value; it contributes nothing rather than poisoning every
-    // layer blended over it.
+    // meaningful value; it is discarded rather than poisoning every layer
+    // blended over it, and (writing no depth) leaves the pixel to the
+    // piece's other triangle there.
     if !(finite(f.thickness) && finite(f.tau) && finite(f.glow.x) && finite(f.glow.y)
         && finite(f.glow.z)) {
-        return vec4<f32>(0.0);
+        discard;
     }
     let alpha = alpha_of(f.thickness, f.tau);
-    return vec4<f32>(f.glow * alpha, alpha);
+    var out: FragOut;
+    out.color = vec4<f32>(f.glow * alpha, alpha);
+    out.depth = piece_depth(f.piece);
+    return out;
+}
+
+// Coverage counting (tests and diagnostics): every fragment adds 1 to red.
+// With the depth test on, red counts the pieces covering a pixel centre;
+// without it, their triangles.
+@fragment
+fn fs_count(f: VertexOut) -> FragOut {
+    var out: FragOut;
+    out.color = vec4<f32>(1.0, 0.0, 0.0, 0.0);
+    out.depth = piece_depth(f.piece);
+    return out;
 }

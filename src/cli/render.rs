@@ -118,7 +118,7 @@ impl ViewArgs {
                 cpu_adapter: self.cpu_adapter,
             },
             accum: AccumFormat::Auto,
-            cull_to_pixels: true,
+            ..Default::default()
         }
     }
 

@@ -17,6 +17,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
 use super::exptable::{ExpTable, TABLE_N};
+use super::frame::{DrawKind, PIECE_DEPTH_FORMAT};
 use super::vertex::ExactVertex;
 use super::{AccumFormat, GpuError, GpuOptions};
 
@@ -56,8 +57,8 @@ pub struct Context {
     pub(crate) bind_layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     shader: wgpu::ShaderModule,
-    pipeline_f16: OnceLock<wgpu::RenderPipeline>,
-    pipeline_f32: OnceLock<wgpu::RenderPipeline>,
+    /// Pipelines by accumulation format (f16, f32) and [`DrawKind`].
+    pipelines: [[OnceLock<wgpu::RenderPipeline>; 3]; 2],
     errors: Arc<Mutex<Vec<String>>>,
     lost: Arc<Mutex<Option<String>>>,
 }
@@ -224,8 +225,7 @@ impl Context {
             bind_layout,
             pipeline_layout,
             shader,
-            pipeline_f16: OnceLock::new(),
-            pipeline_f32: OnceLock::new(),
+            pipelines: Default::default(),
             errors,
             lost,
         };
@@ -256,22 +256,33 @@ impl Context {
         }
     }
 
-    /// The exact pipeline for a resolved format (built on first use).
-    pub(crate) fn pipeline(&self, format: AccumFormat) -> &wgpu::RenderPipeline {
-        let (cell, tf) = match format {
-            AccumFormat::F32 => (&self.pipeline_f32, wgpu::TextureFormat::Rgba32Float),
-            _ => (&self.pipeline_f16, wgpu::TextureFormat::Rgba16Float),
+    /// The exact pipeline for a resolved format and draw kind (built on
+    /// first use).
+    pub(crate) fn pipeline(&self, format: AccumFormat, kind: DrawKind) -> &wgpu::RenderPipeline {
+        let (row, tf) = match format {
+            AccumFormat::F32 => (1, wgpu::TextureFormat::Rgba32Float),
+            _ => (0, wgpu::TextureFormat::Rgba16Float),
         };
-        cell.get_or_init(|| self.build_pipeline(tf))
+        self.pipelines[row][kind as usize].get_or_init(|| self.build_pipeline(tf, kind))
     }
 
-    fn build_pipeline(&self, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
-        // Premultiplied "over", back to front: dst = src + (1 - src.a) dst.
-        let over = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-            operation: wgpu::BlendOperation::Add,
+    fn build_pipeline(&self, format: wgpu::TextureFormat, kind: DrawKind) -> wgpu::RenderPipeline {
+        // Premultiplied "over", back to front: dst = src + (1 - src.a) dst;
+        // counting adds.
+        let (blend, entry) = match kind {
+            DrawKind::Composite => (wgpu::BlendComponent::OVER, "fs_main"),
+            DrawKind::CountPieces | DrawKind::CountTriangles => (
+                wgpu::BlendComponent {
+                    src_factor: wgpu::BlendFactor::One,
+                    dst_factor: wgpu::BlendFactor::One,
+                    operation: wgpu::BlendOperation::Add,
+                },
+                "fs_count",
+            ),
         };
+        // One colouring per piece and pixel: the fragment's depth is its
+        // piece's key, decreasing in drawing order (`piece_depth`).
+        let once_per_piece = kind != DrawKind::CountTriangles;
         self.device
             .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("exact"),
@@ -287,17 +298,27 @@ impl Context {
                     cull_mode: None,
                     ..Default::default()
                 },
-                depth_stencil: None,
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: PIECE_DEPTH_FORMAT,
+                    depth_write_enabled: Some(once_per_piece),
+                    depth_compare: Some(if once_per_piece {
+                        wgpu::CompareFunction::Less
+                    } else {
+                        wgpu::CompareFunction::Always
+                    }),
+                    stencil: wgpu::StencilState::default(),
+                    bias: wgpu::DepthBiasState::default(),
+                }),
                 multisample: wgpu::MultisampleState::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &self.shader,
-                    entry_point: Some("fs_main"),
+                    entry_point: Some(entry),
                     compilation_options: Default::default(),
                     targets: &[Some(wgpu::ColorTargetState {
                         format,
                         blend: Some(wgpu::BlendState {
-                            color: over,
-                            alpha: over,
+                            color: blend,
+                            alpha: blend,
                         }),
                         write_mask: wgpu::ColorWrites::ALL,
                     })],

@@ -11,6 +11,21 @@
 //! submitting batch k+1 the frame waits for batch k-1, so at most two batches
 //! (and their staging copies) are alive. The first batch clears the target to
 //! transparent black.
+//!
+//! **Each piece colours a pixel at most once.** Every vertex carries the
+//! number of its piece (convex polyhedron) in drawing order, and the frame
+//! keeps a depth target whose test (less, with write) compares each
+//! fragment's piece key ([`super::vertex::piece_depth`]): a later piece
+//! always passes, a second fragment of a piece at the same pixel centre
+//! never does. A piece's region triangles tile its silhouette exactly in
+//! `f64`, but their corners are rounded to `f32` and then to the
+//! rasteriser's sub-pixel grid; a sliver whose corners cross over on the
+//! way folds over its neighbours, and a pixel centre in the fold would be
+//! coloured twice. Since the rounded triangles still wind once around every
+//! point of the rounded silhouette, each centre there is covered at least
+//! once (inverted triangles are drawn, no culling); the depth test makes
+//! it exactly once. [`DrawKind`] selects counting instead of compositing,
+//! for the coverage tests.
 
 use std::time::Instant;
 
@@ -20,7 +35,7 @@ use wgpu::util::DeviceExt;
 use super::context::Context;
 use super::exptable::{shader_params, TABLE_N};
 use super::readback::read_image;
-use super::vertex::ExactVertex;
+use super::vertex::{raster_side, ExactVertex};
 use super::{AccumFormat, GpuError};
 use crate::image::Image;
 
@@ -44,6 +59,24 @@ struct FrameUniforms {
     _pad: [u32; 3],
 }
 
+/// The depth format holding the piece keys.
+pub(crate) const PIECE_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// What a frame's fragments do.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DrawKind {
+    /// Composite the exact integrals back to front ("over"), each piece at
+    /// most once per pixel.
+    #[default]
+    Composite = 0,
+    /// Add 1 to red per piece covering a pixel centre (at most once per
+    /// piece, as when compositing).
+    CountPieces = 1,
+    /// Add 1 to red per triangle covering a pixel centre (no depth test):
+    /// the raw coverage of the triangulation.
+    CountTriangles = 2,
+}
+
 /// Options of one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameOptions {
@@ -60,6 +93,8 @@ pub struct FrameOptions {
     pub batch_vertices: usize,
     /// Maximum indices per batch (at least 3).
     pub batch_indices: usize,
+    /// Compositing, or coverage counting.
+    pub draw: DrawKind,
 }
 
 impl FrameOptions {
@@ -72,6 +107,7 @@ impl FrameOptions {
             length_unit: 1.0,
             batch_vertices: DEFAULT_BATCH_VERTICES,
             batch_indices: 3 * DEFAULT_BATCH_VERTICES,
+            draw: DrawKind::Composite,
         }
     }
 }
@@ -97,6 +133,8 @@ pub struct Frame<'c> {
     format: AccumFormat,
     target: wgpu::Texture,
     view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    draw: DrawKind,
     bind_group: wgpu::BindGroup,
     cap_vertices: usize,
     cap_indices: usize,
@@ -152,11 +190,22 @@ impl Context {
             ));
         }
 
+        // The square power-of-two viewport that makes sub-pixel positions
+        // exact (`raster_side`); the image is its top-left corner, and the
+        // scissor keeps fragments there.
+        let side = raster_side(opts.width, opts.height);
+        if side > max {
+            return Err(GpuError::BadSize {
+                width: opts.width,
+                height: opts.height,
+                max: max.checked_next_power_of_two().map_or(max, |p| p / 2),
+            });
+        }
         let target = self.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("accumulation"),
             size: wgpu::Extent3d {
-                width: opts.width,
-                height: opts.height,
+                width: side,
+                height: side,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -169,6 +218,21 @@ impl Context {
             view_formats: &[],
         });
         let view = target.create_view(&wgpu::TextureViewDescriptor::default());
+        let depth = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("piece keys"),
+            size: wgpu::Extent3d {
+                width: side,
+                height: side,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: PIECE_DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let depth_view = depth.create_view(&wgpu::TextureViewDescriptor::default());
         let (scale, inv_log_range) = shader_params();
         let uniforms = FrameUniforms {
             inv_unit: 1.0 / opts.length_unit,
@@ -207,6 +271,8 @@ impl Context {
             format,
             target,
             view,
+            depth_view,
+            draw: opts.draw,
             bind_group,
             cap_vertices,
             cap_indices,
@@ -335,7 +401,8 @@ impl Frame<'_> {
             });
         {
             let mut pass = self.begin_pass(&mut encoder);
-            pass.set_pipeline(self.ctx.pipeline(self.format));
+            pass.set_pipeline(self.ctx.pipeline(self.format, self.draw));
+            pass.set_scissor_rect(0, 0, self.width, self.height);
             pass.set_bind_group(0, &self.bind_group, &[]);
             pass.set_vertex_buffer(0, vbuf.slice(..vbytes.len() as u64));
             pass.set_index_buffer(ibuf.slice(..ibytes.len() as u64), wgpu::IndexFormat::Uint32);
@@ -357,10 +424,13 @@ impl Frame<'_> {
     }
 
     fn begin_pass<'e>(&self, encoder: &'e mut wgpu::CommandEncoder) -> wgpu::RenderPass<'e> {
-        let load = if self.cleared {
-            wgpu::LoadOp::Load
+        let (load, depth_load) = if self.cleared {
+            (wgpu::LoadOp::Load, wgpu::LoadOp::Load)
         } else {
-            wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+            (
+                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                wgpu::LoadOp::Clear(1.0),
+            )
         };
         encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("exact"),
@@ -373,7 +443,14 @@ impl Frame<'_> {
                     store: wgpu::StoreOp::Store,
                 },
             })],
-            depth_stencil_attachment: None,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: depth_load,
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,

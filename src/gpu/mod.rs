@@ -37,6 +37,7 @@
 //! Errors never panic: wgpu's uncaptured-error and device-lost callbacks are
 //! captured and turned into [`GpuError`] at the next check.
 
+pub mod cpu;
 mod context;
 pub mod exptable;
 mod frame;
@@ -44,8 +45,8 @@ mod readback;
 mod vertex;
 
 pub use context::{Context, ContextInfo, PendingContext};
-pub use frame::{Frame, FrameOptions, FrameStats};
-pub use vertex::{ClipMapper, ExactVertex};
+pub use frame::{DrawKind, Frame, FrameOptions, FrameStats};
+pub use vertex::{piece_depth, ClipMapper, ExactVertex, MAX_PIECES};
 
 use thiserror::Error;
 

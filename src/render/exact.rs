@@ -41,14 +41,16 @@
 use std::sync::{Condvar, Mutex};
 use std::time::Instant;
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
 use crate::camera::Camera;
-use crate::gpu::{Context, ExactVertex, Frame, FrameOptions, FrameStats, PendingContext};
+use crate::gpu::cpu::CpuFrame;
+use crate::gpu::{
+    ClipMapper, Context, ExactVertex, Frame, FrameOptions, FrameStats, GpuError, PendingContext, MAX_PIECES,
+};
 use crate::image::Image;
 use crate::integrate::{vertex_values, VertexValues};
 use crate::mesh::Mesh;
-use crate::numeric::predicates::{orient2d, Side};
 use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL, TF_SLOPE_REL};
 use crate::projection::coverage::PixelGrid;
 use crate::projection::{refine, ClipValue, Clipper, Polyhedron, Projected, Projector};
@@ -59,7 +61,7 @@ use crate::visibility::{Piece, Sorter, SplitPolicy, NO_LEVEL};
 
 use super::group::composite_group;
 use super::scene::{ScalarsRef, Scene};
-use super::{RenderError, RenderOptions};
+use super::{Compositor, RenderError, RenderOptions};
 
 /// Pieces processed per chunk (one worker's unit of work).
 const CHUNK: usize = 2048;
@@ -91,6 +93,24 @@ pub struct ExactStats {
     /// reading the image back.
     pub gpu_total_s: f64,
     pub order: crate::visibility::OrderStats,
+    /// CPU twin with [`super::RenderOptions::watch`]: the fragments drawn
+    /// at the watched pixel, in drawing order.
+    pub watched: Vec<crate::gpu::cpu::Fragment>,
+}
+
+/// Where a frame's triangles go: the GPU, or its CPU twin.
+enum Sink<'c> {
+    Gpu(Frame<'c>),
+    Cpu(Box<CpuFrame>),
+}
+
+impl Sink<'_> {
+    fn push_triangles(&mut self, vertices: &[ExactVertex], indices: &[u32]) -> Result<(), GpuError> {
+        match self {
+            Sink::Gpu(f) => f.push_triangles(vertices, indices),
+            Sink::Cpu(f) => f.push_triangles(vertices, indices),
+        }
+    }
 }
 
 /// The smallest and largest of `values` (`(inf, -inf)` when empty).
@@ -108,15 +128,20 @@ pub(super) struct ChunkOut {
     pub(super) vertices: Vec<ExactVertex>,
     pub(super) indices: Vec<u32>,
     pub(super) culled: usize,
+    /// Pieces drawn, numbered from 0 in this chunk; [`push_out`] makes the
+    /// numbers frame-wide (the shader colours a pixel once per piece).
+    pub(super) pieces: u32,
     slabs: usize,
     refined: usize,
-    /// Triangles dropped as degenerate in f32 ([`gpu_area_positive`]).
+    /// Triangles dropped as degenerate on the sub-pixel grid
+    /// ([`grid_area_positive`]).
     degenerate: usize,
     pub(super) error: Option<String>,
     /// Scratch of [`push_projected`]: vertices used by a triangle, and
     /// their index in `vertices`.
     scratch_used: Vec<bool>,
     scratch_remap: Vec<u32>,
+    scratch_grid: Vec<[i64; 2]>,
 }
 
 impl ChunkOut {
@@ -125,6 +150,7 @@ impl ChunkOut {
         self.vertices.clear();
         self.indices.clear();
         self.culled = 0;
+        self.pieces = 0;
         self.slabs = 0;
         self.refined = 0;
         self.degenerate = 0;
@@ -374,8 +400,13 @@ fn push_projected(
                 .map(|v| vertex_values(tf, v.l, v.s_front, v.s_back)),
         );
     }
-    let (w, h) = (ctx.camera.width as f64, ctx.camera.height as f64);
-    // Index of each used vertex in `out.vertices` (u32::MAX: not emitted).
+    let mapper = ClipMapper::for_camera(ctx.camera);
+    let piece = out.pieces;
+    out.pieces += 1;
+    // Index of each used vertex in `out.vertices` (u32::MAX: not emitted),
+    // and its snapped grid position (from `first` on).
+    let first = out.vertices.len() as u32;
+    out.scratch_grid.clear();
     let remap = &mut out.scratch_remap;
     remap.clear();
     for ((v, vv), &u) in proj.vertices.iter().zip(vals.iter()).zip(used.iter()) {
@@ -383,20 +414,30 @@ fn push_projected(
             remap.push(u32::MAX);
             continue;
         }
+        // Region positions are finite and on screen or clipped near it
+        // (`clip_to_image`); one that is not cannot be drawn exactly.
+        let Some(([x, y], g)) = mapper.ndc(v.px, v.py) else {
+            remap.push(u32::MAX);
+            continue;
+        };
         remap.push(out.vertices.len() as u32);
-        let x = 2.0 * v.px / w - 1.0;
-        let y = 1.0 - 2.0 * v.py / h;
+        out.scratch_grid.push(g);
         out.vertices.push(ExactVertex::new(
-            [x as f32, y as f32, 0.5, 1.0],
+            [x, y, 0.5, 1.0],
             (v.l * k) as f32,
             (vv.tau_mean / k) as f32,
             [vv.glow[0] as f32, vv.glow[1] as f32, vv.glow[2] as f32],
-        ));
+        )
+        .with_piece(piece));
     }
     for t in &proj.triangles {
         let idx = t.map(|i| remap[i as usize]);
-        let [a, b, c] = idx.map(|i| &out.vertices[i as usize]);
-        if gpu_area_positive(a, b, c) {
+        if idx.contains(&u32::MAX) {
+            out.degenerate += 1;
+            continue;
+        }
+        let [a, b, c] = idx.map(|i| out.scratch_grid[(i - first) as usize]);
+        if grid_area_positive(a, b, c) {
             out.indices.extend_from_slice(&idx);
         } else {
             out.degenerate += 1;
@@ -435,20 +476,24 @@ fn depth_balance(ctx: &Ctx, piece: &Polyhedron) -> f64 {
 
 /// Whether the GPU sees the triangle `a, b, c` (region triangles are CCW in
 /// pixel coordinates, see [`crate::projection`]) with positive area: the
-/// exact orientation of the f32 positions it is given (`w = 1`).
+/// exact orientation of its corners on the rasteriser's sub-pixel grid
+/// (which the GPU receives exactly, [`ClipMapper::ndc`]).
 ///
 /// The projection keeps every triangle whose f64 pixel positions have a
 /// positive exact orientation; a sliver region (e.g. next to a face seen
-/// exactly edge-on, its vertices rounded off the common line) can become
-/// collinear or inverted once rounded to f32. Mesa's rasteriser gives NaN
-/// colour on pixel centres along such a zero-area triangle (its attribute
-/// planes divide by the area), and one NaN poisons all blending over it. A
-/// triangle of zero area covers nothing, so dropping it loses nothing; an
-/// inverted one would overlap its neighbours.
-fn gpu_area_positive(a: &ExactVertex, b: &ExactVertex, c: &ExactVertex) -> bool {
-    // NDC y points up, pixel y down: flip y to keep the pixel orientation.
-    let p = |v: &ExactVertex| DVec2::new(v.pos[0] as f64, -(v.pos[1] as f64));
-    orient2d(p(a), p(b), p(c)) == Side::Positive
+/// exactly edge-on) can become collinear or inverted once its corners are
+/// snapped. A triangle of zero area covers nothing (and Mesa's rasteriser
+/// gives NaN colour on pixel centres along such a triangle), so dropping it
+/// loses nothing. An inverted one overlaps its neighbours, which cover
+/// every centre it holds already: the snapped triangles still wind once
+/// around every point of the snapped silhouette, so the positive ones
+/// alone cover each centre at least once, and the depth test
+/// (`shaders/exact.wgsl`) makes it exactly once.
+fn grid_area_positive(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> bool {
+    // Integer coordinates below 2^40: the cross product is exact in i128.
+    let [a, b, c] = [a, b, c].map(|p| [p[0] as i128, p[1] as i128]);
+    // Pixel y points down, as in the region triangles.
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0
 }
 
 /// Projects `pieces` into `out` (empty, its buffers possibly reused).
@@ -633,10 +678,26 @@ pub fn split_points(tf: &TransferFunction) -> Vec<f64> {
     out
 }
 
-/// Sends one chunk's triangles to the frame and adds up its counts.
-fn push_out(frame: &mut Frame, out: &ChunkOut, stats: &mut ExactStats) -> Result<(), RenderError> {
+/// Sends one chunk's triangles to the frame and adds up its counts; its
+/// pieces are numbered on from `next_piece` (drawing order).
+fn push_out(
+    frame: &mut Sink,
+    out: &mut ChunkOut,
+    stats: &mut ExactStats,
+    next_piece: &mut u32,
+) -> Result<(), RenderError> {
     if let Some(e) = &out.error {
         return Err(RenderError::Projection(e.clone()));
+    }
+    let base = *next_piece;
+    *next_piece = base
+        .checked_add(out.pieces)
+        .filter(|&n| n <= MAX_PIECES)
+        .ok_or(RenderError::TooManyPieces(MAX_PIECES))?;
+    if base > 0 {
+        for v in &mut out.vertices {
+            v.piece += base;
+        }
     }
     stats.culled_pieces += out.culled;
     stats.slabs += out.slabs;
@@ -816,20 +877,38 @@ pub fn render_exact(
         grid: PixelGrid::new(camera.width, camera.height),
     };
     let t_open = Instant::now();
-    if gpu.is_none() {
-        *gpu = Some(match pending.take() {
-            Some(p) if p.options() == &opts.gpu => p.wait()?,
-            _ => Context::new(&opts.gpu)?,
-        });
-    }
-    let Some(gpu) = gpu.as_ref() else {
-        unreachable!("opened above")
-    };
-    stats.gpu_open_s = t_open.elapsed().as_secs_f64();
     let mut fopts = FrameOptions::new(camera.width, camera.height, opts.accum);
     fopts.length_unit = scene.unit_distance as f32;
+    fopts.draw = opts.draw;
+    let mut frame = match opts.compositor {
+        Compositor::Gpu => {
+            if gpu.is_none() {
+                *gpu = Some(match pending.take() {
+                    Some(p) if p.options() == &opts.gpu => p.wait()?,
+                    _ => Context::new(&opts.gpu)?,
+                });
+            }
+            let Some(gpu) = gpu.as_ref() else {
+                unreachable!("opened above")
+            };
+            Sink::Gpu(gpu.begin_frame_with(&fopts)?)
+        }
+        Compositor::Cpu => {
+            let mut f = CpuFrame::new(
+                camera.width,
+                camera.height,
+                opts.accum,
+                opts.draw,
+                fopts.length_unit,
+            )?;
+            if let Some((i, j)) = opts.watch {
+                f.watch(i, j);
+            }
+            Sink::Cpu(Box::new(f))
+        }
+    };
+    stats.gpu_open_s = t_open.elapsed().as_secs_f64();
     let t_gpu = Instant::now();
-    let mut frame = gpu.begin_frame_with(&fopts)?;
     let total = order.pieces.len();
     let mut done = 0;
     // Stretches of ordinary pieces, each followed by at most one group.
@@ -843,11 +922,12 @@ pub fn render_exact(
     let tp = Instant::now();
     let pool = BufferPool::default();
     let workers = rayon::current_num_threads().max(1);
+    let mut next_piece = 0u32;
     for (plain, group) in stretches {
         let pieces = &order.pieces[plain];
         let mut handed = 0;
-        pipeline(&ctx, pieces, CHUNK, workers, &pool, |out| {
-            push_out(&mut frame, &out, &mut stats)?;
+        pipeline(&ctx, pieces, CHUNK, workers, &pool, |mut out| {
+            push_out(&mut frame, &mut out, &mut stats, &mut next_piece)?;
             pool.put(out);
             handed += CHUNK;
             progress(done + handed.min(pieces.len()), total);
@@ -857,13 +937,23 @@ pub fn render_exact(
         if let Some(g) = group {
             let mut out = ChunkOut::default();
             stats.group_pixels += composite_group(&ctx, &order.pieces[g.clone()], &mut out);
-            push_out(&mut frame, &out, &mut stats)?;
+            push_out(&mut frame, &mut out, &mut stats, &mut next_piece)?;
             done += g.len();
             progress(done, total);
         }
     }
     let project_s = tp.elapsed().as_secs_f64();
-    let (image, fstats) = frame.finish_with_stats()?;
+    let (image, fstats) = match frame {
+        Sink::Gpu(f) => f.finish_with_stats()?,
+        Sink::Cpu(f) => {
+            stats.watched = f.covering().to_vec();
+            let fs = FrameStats {
+                triangles: f.triangles(),
+                ..Default::default()
+            };
+            (f.finish(), fs)
+        }
+    };
     stats.gpu = fstats;
     stats.project_s = project_s;
     stats.gpu_total_s = t_gpu.elapsed().as_secs_f64() - project_s;
@@ -952,9 +1042,16 @@ mod tests {
         for piece in &order.pieces {
             let out = process_chunk(&ctx, std::slice::from_ref(piece), ChunkOut::default());
             assert_eq!(out.error, None);
+            let mapper = ClipMapper::for_camera(&camera);
+            let half = mapper.side as f32 * 0.5;
             for t in out.indices.chunks(3) {
-                let [a, b, c] = [0, 1, 2].map(|k| &out.vertices[t[k] as usize]);
-                assert!(gpu_area_positive(a, b, c), "{piece:?}: {a:?} {b:?} {c:?}");
+                // The grid positions the rasteriser recovers from the NDC.
+                let [a, b, c] = [0, 1, 2].map(|k| {
+                    let p = out.vertices[t[k] as usize].pos;
+                    let (x, y) = (p[0] * half + half, -p[1] * half + half);
+                    [x, y].map(|v| ClipMapper::snap(v as f64).unwrap())
+                });
+                assert!(grid_area_positive(a, b, c), "{piece:?}: {a:?} {b:?} {c:?}");
             }
             degenerate += out.degenerate;
             if degenerate > 0 {

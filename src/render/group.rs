@@ -39,7 +39,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::camera::Camera;
-use crate::gpu::ExactVertex;
+use crate::gpu::{ClipMapper, ExactVertex};
 use crate::integrate::segment;
 use crate::projection::Polyhedron;
 use crate::visibility::Piece;
@@ -142,7 +142,10 @@ pub(super) fn composite_group(ctx: &Ctx, pieces: &[Piece], out: &mut ChunkOut) -
         })
         .collect();
     let unit = ctx.length_unit;
-    let (w, h) = (camera.width as f64, camera.height as f64);
+    let mapper = ClipMapper::for_camera(camera);
+    // The group's layer is one piece (its pixel quads do not overlap).
+    let piece = out.pieces;
+    out.pieces += 1;
     for (i, j, color, depth) in rows.into_iter().flatten() {
         let alpha = -(-depth).exp_m1();
         if alpha <= 0.0 {
@@ -152,14 +155,17 @@ pub(super) fn composite_group(ctx: &Ctx, pieces: &[Piece], out: &mut ChunkOut) -
         let tau = (depth / unit) as f32;
         let base = out.vertices.len() as u32;
         for (di, dj) in [(0, 0), (1, 0), (1, 1), (0, 1)] {
-            let x = 2.0 * (i + di) as f64 / w - 1.0;
-            let y = 1.0 - 2.0 * (j + dj) as f64 / h;
+            // Pixel corners are on the grid: always mapped.
+            let ([x, y], _) = mapper
+                .ndc((i + di) as f64, (j + dj) as f64)
+                .unwrap_or(([0.0; 2], [0; 2]));
             out.vertices.push(ExactVertex::new(
-                [x as f32, y as f32, 0.5, 1.0],
+                [x, y, 0.5, 1.0],
                 unit as f32,
                 tau,
                 glow,
-            ));
+            )
+            .with_piece(piece));
         }
         out.indices
             .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);

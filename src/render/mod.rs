@@ -18,7 +18,7 @@ use std::time::Instant;
 use thiserror::Error;
 
 use crate::camera::{Camera, CameraParams};
-use crate::gpu::{AccumFormat, Context, GpuError, GpuOptions, PendingContext};
+use crate::gpu::{AccumFormat, Context, DrawKind, GpuError, GpuOptions, PendingContext};
 use crate::image::Image;
 use crate::raycast::{self, FieldModel, RaycastOptions, Raycaster};
 use crate::visibility::{Sorter, VisibilityError};
@@ -73,6 +73,8 @@ pub enum RenderError {
     Visibility(#[from] VisibilityError),
     #[error("projection failed: {0}")]
     Projection(String),
+    #[error("the view draws more than {0} pieces, more than one frame can number")]
+    TooManyPieces(u32),
     #[error(transparent)]
     Gpu(#[from] GpuError),
     #[error(transparent)]
@@ -96,6 +98,24 @@ pub struct RenderOptions {
     /// ([`crate::projection::coverage`]; on by default). The image is the
     /// same either way; off only to check that.
     pub cull_to_pixels: bool,
+    /// Exact mode: where the triangles are rasterised and composited: the
+    /// GPU, or its CPU twin ([`crate::gpu::cpu`]; no adapter needed).
+    pub compositor: Compositor,
+    /// Exact mode: composite, or count coverage (tests and diagnostics).
+    pub draw: DrawKind,
+    /// Exact mode on the CPU twin: the pixel whose fragments are listed in
+    /// [`ExactStats::watched`].
+    pub watch: Option<(u32, u32)>,
+}
+
+/// Where the exact mode's triangles are drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Compositor {
+    /// wgpu ([`crate::gpu::Frame`]).
+    #[default]
+    Gpu,
+    /// The CPU twin of the GPU stage ([`crate::gpu::cpu::CpuFrame`]).
+    Cpu,
 }
 
 impl Default for RenderOptions {
@@ -108,6 +128,9 @@ impl Default for RenderOptions {
             gpu: GpuOptions::default(),
             accum: AccumFormat::Auto,
             cull_to_pixels: true,
+            compositor: Compositor::Gpu,
+            draw: DrawKind::Composite,
+            watch: None,
         }
     }
 }

@@ -1,0 +1,83 @@
+//! Takes one pixel of the exact mode apart: renders a file with the CPU twin
+//! of the GPU stage (`zoovr::gpu::cpu`) and the reference ray caster, and
+//! prints both values at the pixel, the fragments that coloured it (piece,
+//! interpolated thickness, extinction, glow) and the ray caster's segments.
+//!
+//! ```sh
+//! cargo run --release --example pixel -- FILE I J [SIZE] [--ortho] [--azimuth A] [--elevation E] [--split]
+//! ```
+
+use anyhow::{anyhow, Context as _, Result};
+use zoovr::camera::{Camera, CameraParams};
+use zoovr::io::{self, ReadOptions};
+use zoovr::raycast::FieldModel;
+use zoovr::render::{Compositor, Mode, RenderOptions, Renderer, Scene, SceneSpec};
+
+
+fn main() -> Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let file = args.first().ok_or_else(|| anyhow!("usage: pixel FILE I J [SIZE] [flags]"))?;
+    let num = |k: usize| -> Result<u32> {
+        args.get(k).context("missing pixel")?.parse().context("pixel index")
+    };
+    let (i, j) = (num(1)?, num(2)?);
+    let size = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(512);
+    let flag = |name: &str| -> Option<f64> {
+        args.iter().position(|a| a == name).and_then(|k| args.get(k + 1)?.parse().ok())
+    };
+    let camera = CameraParams {
+        width: size,
+        height: size,
+        ortho: args.iter().any(|a| a == "--ortho"),
+        azimuth: flag("--azimuth").unwrap_or(0.0),
+        elevation: flag("--elevation").unwrap_or(0.0),
+        zoom: flag("--zoom").unwrap_or(1.0),
+        ..Default::default()
+    };
+    let split_all = args.iter().any(|a| a == "--split");
+    let mesh = io::read(std::path::Path::new(file), &ReadOptions::default())?;
+    let scene = Scene::build(mesh, &SceneSpec::default())?;
+    let mut renderer = Renderer::new(&scene);
+    let opts = RenderOptions {
+        camera,
+        split_all,
+        compositor: Compositor::Cpu,
+        watch: Some((i, j)),
+        ..Default::default()
+    };
+    let (img, stats) = renderer.render(&opts, |_, _| {})?;
+    let model = if split_all { FieldModel::Tets } else { FieldModel::Faces };
+    let ropts = RenderOptions { mode: Mode::Raycast, model, ..opts.clone() };
+    let (reference, _) = renderer.render(&ropts, |_, _| {})?;
+    let gopts = RenderOptions { compositor: Compositor::Gpu, ..opts.clone() };
+    match renderer.render(&gopts, |_, _| {}) {
+        Ok((g, _)) => {
+            println!("exact (gpu)      {:?}", g.get(i, j));
+            let (d, _) = zoovr::image::compare_display(&g, &img, [0.0; 3])?;
+            println!("gpu vs twin: max {:.3e} at {:?}, rms {:.3e}", d.max_abs, d.worst, d.rms);
+        }
+        Err(e) => println!("exact (gpu)      unavailable: {e}"),
+    }
+    println!("exact (cpu twin) {:?}", img.get(i, j));
+    println!("raycast ({})    {:?}", model.name(), reference.get(i, j));
+    for f in &stats.exact.map(|e| e.watched).unwrap_or_default() {
+        println!("  fragment {f:?}");
+    }
+    let cam = Camera::fit(scene.mesh.bounds(), &opts.camera);
+    let rc = zoovr::raycast::Raycaster::new(
+        zoovr::raycast::Scene {
+            mesh: &scene.mesh,
+            topology: &scene.topology,
+            scalars: match scene.scalars() {
+                zoovr::render::ScalarsRef::Point(v) => zoovr::raycast::Scalars::Point(v),
+                zoovr::render::ScalarsRef::Cell(v) => zoovr::raycast::Scalars::Cell(v),
+                zoovr::render::ScalarsRef::Constant(c) => zoovr::raycast::Scalars::Constant(c),
+            },
+        },
+        model,
+    )?;
+    for s in rc.segments(&cam.pixel_ray(i, j), if cam.ortho { 0.0 } else { cam.near }) {
+        println!("  segment {s:?}");
+    }
+    Ok(())
+}
