@@ -53,6 +53,23 @@ impl Default for CameraParams {
 pub struct Ray {
     pub origin: DVec3,
     pub dir: DVec3,
+    /// The image's right direction for a pixel ray (zero when the ray has
+    /// no image): the ray caster breaks ties (a ray through an edge or a
+    /// vertex) by moving the ray's origin towards it, then towards the
+    /// image's down direction, which is the rasteriser's top-left rule
+    /// ([`crate::raycast::geometry`]).
+    pub right: DVec3,
+}
+
+impl Ray {
+    /// A ray with no image (ties broken in an arbitrary fixed direction).
+    pub fn new(origin: DVec3, dir: DVec3) -> Ray {
+        Ray {
+            origin,
+            dir,
+            right: DVec3::ZERO,
+        }
+    }
 }
 
 /// A fitted camera for one image.
@@ -180,11 +197,13 @@ impl Camera {
             Ray {
                 origin: self.position + self.right * x + self.up * y,
                 dir: self.forward,
+                right: self.right,
             }
         } else {
             Ray {
                 origin: self.position,
                 dir: (self.forward + self.right * x + self.up * y).normalize(),
+                right: self.right,
             }
         }
     }

@@ -53,7 +53,7 @@ fn cell_data_uses_the_homogeneous_integral() {
             } else {
                 DVec3::new(2.0, 0.37, 0.61)
             };
-            let ray = Ray { origin, dir };
+            let ray = Ray::new(origin, dir);
             let opts = RaycastOptions {
                 model,
                 early_termination: 0.0,
@@ -105,10 +105,7 @@ fn early_termination_loses_at_most_its_threshold() {
         scalars: Scalars::Point(&s),
     };
     let tf = tf();
-    let ray = Ray {
-        origin: DVec3::new(-1.0, 0.41, 0.53),
-        dir: DVec3::X,
-    };
+    let ray = Ray::new(DVec3::new(-1.0, 0.41, 0.53), DVec3::X);
     let full = |eps: f64| {
         let opts = RaycastOptions {
             early_termination: eps,

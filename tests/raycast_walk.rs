@@ -33,18 +33,12 @@ fn boxes(mesh: &Mesh) -> Vec<(DVec3, DVec3)> {
 
 /// Sum of the exact box chords of the boxes whose interior the ray enters
 /// once it is displaced the way the ray caster's tie-breaking rule displaces
-/// it (first along `u = helper x d`, then along `v = d x u`; see
-/// `raycast::geometry`). A ray along a shared face or edge thus counts in
-/// exactly one of the boxes around it.
+/// it (first along `u`, then along `v = d x u`, `raycast::geometry::tie_basis`:
+/// the image's right and down directions for a pixel ray). A ray along a
+/// shared face or edge thus counts in exactly one of the boxes around it.
 fn oracle(bx: &[(DVec3, DVec3)], r: &Ray, t0: f64) -> f64 {
-    let d = r.dir;
-    let helper = if d.x.abs() < 0.6 { DVec3::X } else { DVec3::Y };
-    let u = helper.cross(d).normalize();
-    let v = d.cross(u);
-    let moved = Ray {
-        origin: r.origin + u * 1e-7 + v * 1e-10,
-        dir: d,
-    };
+    let (u, v) = zoovr::raycast::geometry::tie_basis(r);
+    let moved = Ray::new(r.origin + u * 1e-7 + v * 1e-10, r.dir);
     bx.iter()
         .filter(|&&(lo, hi)| convex_chord(&moved, &box_planes(lo, hi), t0) > 0.0)
         .map(|&(lo, hi)| convex_chord(r, &box_planes(lo, hi), t0))

@@ -49,6 +49,27 @@ pub struct Proj {
     pub n2: f64,
 }
 
+/// The orthonormal `u, v` (`u x v = d`) of a ray's frame, which are also
+/// the directions of the symbolic perturbation: `u` is the image's right
+/// direction made orthogonal to the ray ([`Ray::right`]), so `v = d x u` is
+/// the image's down direction, and moving the origin by `e u + e^2 v` moves
+/// the point where the ray meets any surface by a positive multiple of it
+/// on the image: a pixel centre on a projected edge belongs to the triangle
+/// on its right, or below it for a horizontal edge — the rasteriser's
+/// top-left rule (`gpu::cpu`). A ray with no image direction gets a fixed
+/// arbitrary basis.
+pub fn tie_basis(ray: &Ray) -> (DVec3, DVec3) {
+    let d = ray.dir;
+    let r = ray.right - d * ray.right.dot(d);
+    let u = if r.length_squared() > 1e-12 {
+        r.normalize()
+    } else {
+        let helper = if d.x.abs() < 0.6 { DVec3::X } else { DVec3::Y };
+        helper.cross(d).normalize()
+    };
+    (u, d.cross(u))
+}
+
 /// One ray with its frame and symbolic perturbation.
 #[derive(Clone, Copy, Debug)]
 pub struct RayFrame {
@@ -78,10 +99,7 @@ impl RayFrame {
     pub fn new(ray: &Ray, center: DVec3, radius: f64) -> RayFrame {
         let d = ray.dir;
         let o = ray.origin;
-        // Orthonormal u, v with u x v = d.
-        let helper = if d.x.abs() < 0.6 { DVec3::X } else { DVec3::Y };
-        let u = helper.cross(d).normalize();
-        let v = d.cross(u);
+        let (u, v) = tie_basis(ray);
         let l = 2.0 * ((o - center).length() + radius) + 1.0;
         let q = o + d * l;
         // The direction actually used by the exact predicate is (q - o) / l;
@@ -174,10 +192,7 @@ mod tests {
 
     fn frame(o: DVec3, d: DVec3) -> RayFrame {
         RayFrame::new(
-            &Ray {
-                origin: o,
-                dir: d.normalize(),
-            },
+            &Ray::new(o, d.normalize()),
             DVec3::ZERO,
             2.0,
         )

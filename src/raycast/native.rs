@@ -1005,10 +1005,7 @@ mod tests {
         .map(|p| DVec3::from_array(*p))
         .collect();
         let s: Vec<f64> = x.iter().map(|p| p.x + 2.0 * p.y - p.z).collect();
-        let ray = Ray {
-            origin: DVec3::new(0.3, 0.4, -1.0),
-            dir: DVec3::Z,
-        };
+        let ray = Ray::new(DVec3::new(0.3, 0.4, -1.0), DVec3::Z);
         let mut f = IsoRay::new(CellKind::Hexahedron, &x, &s, &ray).unwrap();
         let (v, dv) = f.eval(1.5).unwrap();
         // s is not exactly linear in x for a general hex, but the point maps

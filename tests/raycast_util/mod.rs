@@ -262,8 +262,5 @@ pub fn topo(mesh: &Mesh) -> Topology {
 
 /// A unit-direction ray.
 pub fn ray(o: DVec3, d: DVec3) -> Ray {
-    Ray {
-        origin: o,
-        dir: d.normalize(),
-    }
+    Ray::new(o, d.normalize())
 }
