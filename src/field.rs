@@ -4,6 +4,12 @@
 //! without loss, integers widened to `i64`). [`select_field`] turns a
 //! `--field` request (or its absence: the default-field rule of DESIGN.md) into
 //! a [`ScalarField`]: one `f64` per point or per cell, with its range.
+//!
+//! The default-field rule passes over VTK's bookkeeping arrays
+//! ([`VTK_BOOKKEEPING_ARRAYS`]: `vtkGhostType`, `vtkOriginalCellIds`,
+//! `vtkOriginalPointIds`), which hold flags and ids rather than data: the
+//! rule runs over the other arrays first, and over all of them only when
+//! it found nothing there. `--field` names any array.
 
 use thiserror::Error;
 
@@ -349,34 +355,55 @@ fn select_named(mesh: &Mesh, spec: &FieldSpec) -> Result<ScalarField, FieldError
     }
 }
 
+/// Arrays VTK adds for its own bookkeeping (ghost flags, the ids of cells
+/// and points before a filter): the default-field rule takes them only
+/// when the mesh has no other array it could take.
+pub const VTK_BOOKKEEPING_ARRAYS: [&str; 3] =
+    ["vtkGhostType", "vtkOriginalCellIds", "vtkOriginalPointIds"];
+
+/// Whether `name` is one of [`VTK_BOOKKEEPING_ARRAYS`].
+pub fn is_vtk_bookkeeping(name: &str) -> bool {
+    VTK_BOOKKEEPING_ARRAYS.contains(&name)
+}
+
 fn select_default(mesh: &Mesh) -> Result<Option<ScalarField>, FieldError> {
+    match default_among(mesh, |a| !is_vtk_bookkeeping(&a.name))? {
+        Some(f) => Ok(Some(f)),
+        None => default_among(mesh, |_| true),
+    }
+}
+
+/// The default-field rule over the arrays `usable` accepts.
+fn default_among(
+    mesh: &Mesh,
+    usable: fn(&DataArray) -> bool,
+) -> Result<Option<ScalarField>, FieldError> {
     use Association::{Cell, Point};
     let pd = &mesh.point_data;
     let cd = &mesh.cell_data;
     // (1) active point scalars with one component
     if let Some(name) = &mesh.active_point_scalars {
-        if let Some(a) = pd.iter().find(|a| &a.name == name && a.components == 1) {
+        if let Some(a) = pd
+            .iter()
+            .find(|a| &a.name == name && a.components == 1 && usable(a))
+        {
             return extract(a, Point, Component::Auto).map(Some);
         }
     }
     type Rule<'a> = (&'a Vec<DataArray>, Association, fn(&DataArray) -> bool);
-    let rules: [Rule; 4] = [
+    let rules: [Rule; 6] = [
         (pd, Point, |a| a.data.is_float() && a.components == 1),
         (cd, Cell, |a| a.data.is_float() && a.components == 1),
         (pd, Point, |a| a.data.is_float() && a.components > 1),
         (cd, Cell, |a| a.data.is_float() && a.components > 1),
+        // (6) the first integer array, point before cell
+        (pd, Point, |a| !a.data.is_float()),
+        (cd, Cell, |a| !a.data.is_float()),
     ];
     for (arrays, assoc, pred) in rules {
-        if let Some(a) = arrays.iter().find(|a| pred(a)) {
+        if let Some(a) = arrays.iter().find(|a| usable(a) && pred(a)) {
             return extract(a, assoc, Component::Auto).map(Some);
         }
-    }
-    // (6) the first integer array, point before cell
-    if let Some(a) = pd.iter().find(|a| !a.data.is_float()) {
-        return extract(a, Point, Component::Auto).map(Some);
-    }
-    if let Some(a) = cd.iter().find(|a| !a.data.is_float()) {
-        return extract(a, Cell, Component::Auto).map(Some);
     }
     Ok(None)
 }

@@ -18,6 +18,9 @@
 //! - [`ring_grid`]: a square ring of hexahedra (a square hole through the
 //!   middle): non-convex, one component.
 //! - [`time_series`]: the warped grid with `f` advancing in time.
+//! - [`ghost_grid`]: the warped grid as VTK exports a reservoir grid with
+//!   inactive cells: a `vtkGhostType` cell array marking some cells hidden
+//!   and some duplicate, VTK's id arrays, an integer and a float cell array.
 //!
 //! Every generated mesh is positively oriented and conforming; tests rely
 //! on that (no inverted consistent tetrahedra).
@@ -164,6 +167,84 @@ pub fn warped_hex_grid_dims(dims: [usize; 3], warp: &Warp) -> Mesh {
     finish(mesh, 0.0)
 }
 
+/// Value of the [`ghost_grid`] cell array `value` in hidden cells (an
+/// "inactive" marker far outside the other cells' range).
+pub const GHOST_GRID_HIDDEN_VALUE: f32 = -999.0;
+
+/// The `vtkGhostType` flags of cell `(i, j, k)` of an `n`-grid in
+/// [`ghost_grid`]: 32 (hidden) where `(i + 2j + 3k) % 5 == 0`, plus 1
+/// (duplicate) on the column `i = n - 1, j = 1` (for `n = 4` its bottom
+/// cell has both flags).
+pub fn ghost_grid_flags(n: usize, i: usize, j: usize, k: usize) -> u8 {
+    let mut g = 0;
+    if (i + 2 * j + 3 * k) % 5 == 0 {
+        g |= 32;
+    }
+    if i + 1 == n && j == 1 {
+        g |= 1;
+    }
+    g
+}
+
+/// An `n x n x n` warped hexahedral grid shaped like VTK's export of a
+/// reservoir grid with inactive cells. Point data: `vtkOriginalPointIds`
+/// (Int64) only. Cell data, in this order: `vtkGhostType` (UInt8, the flags
+/// of [`ghost_grid_flags`]), `vtkOriginalCellIds` (Int64), `layer` (Int32,
+/// the `k` index) and `value` (Float32: [`scalar_f`] at the cell centre;
+/// 2 in duplicate cells and [`GHOST_GRID_HIDDEN_VALUE`] in hidden ones, so
+/// a range over every cell differs from the range over the others).
+pub fn ghost_grid(n: usize, warp: &Warp) -> Mesh {
+    let mut mesh = warped_hex_grid(n, warp);
+    mesh.point_data.clear();
+    mesh.active_point_scalars = None;
+    let np = mesh.points.len() as i64;
+    let (mut ghost, mut layer, mut value) = (Vec::new(), Vec::new(), Vec::new());
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let g = ghost_grid_flags(n, i, j, k);
+                let c = ghost.len();
+                let centre = mesh
+                    .cells
+                    .nodes(c)
+                    .iter()
+                    .map(|&p| mesh.points[p as usize])
+                    .sum::<DVec3>()
+                    / 8.0;
+                ghost.push(g as i64);
+                layer.push(k as i64);
+                value.push(if g & 32 != 0 {
+                    GHOST_GRID_HIDDEN_VALUE
+                } else if g & 1 != 0 {
+                    2.0
+                } else {
+                    scalar_f(centre, 0.0) as f32
+                });
+            }
+        }
+    }
+    let nc = ghost.len() as i64;
+    let int = |name: &str, vtk_type: &str, data: Vec<i64>| DataArray {
+        name: name.into(),
+        components: 1,
+        data: ArrayData::Int(data),
+        vtk_type: vtk_type.into(),
+    };
+    mesh.point_data = vec![int("vtkOriginalPointIds", "Int64", (0..np).collect())];
+    mesh.cell_data = vec![
+        int("vtkGhostType", "UInt8", ghost),
+        int("vtkOriginalCellIds", "Int64", (0..nc).collect()),
+        int("layer", "Int32", layer),
+        DataArray {
+            name: "value".into(),
+            components: 1,
+            data: ArrayData::F32(value),
+            vtk_type: "Float32".into(),
+        },
+    ];
+    mesh
+}
+
 /// The kind of cube `i` of `n` along x in [`zoo_grid`].
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Block {
@@ -268,50 +349,7 @@ pub fn ring_grid(n: usize, warp: &Warp) -> Mesh {
     finish(mesh, 0.0)
 }
 
-/// Removes points no cell uses (renumbering in order) and the matching
-/// point-array tuples; returns how many were removed.
-pub fn remove_unused_points(mesh: &mut Mesh) -> usize {
-    let mut new_id = vec![u32::MAX; mesh.points.len()];
-    for &i in &mesh.cells.conn {
-        if let Some(x) = new_id.get_mut(i as usize) {
-            *x = 0;
-        }
-    }
-    let mut next = 0u32;
-    let mut keep = Vec::new();
-    for (i, x) in new_id.iter_mut().enumerate() {
-        if *x == 0 {
-            *x = next;
-            next += 1;
-            keep.push(i);
-        }
-    }
-    let removed = mesh.points.len() - keep.len();
-    mesh.points = keep.iter().map(|&i| mesh.points[i]).collect();
-    for a in &mut mesh.point_data {
-        let nc = a.components;
-        a.data = match &a.data {
-            ArrayData::F32(v) => ArrayData::F32(pick(v, &keep, nc)),
-            ArrayData::F64(v) => ArrayData::F64(pick(v, &keep, nc)),
-            ArrayData::Int(v) => ArrayData::Int(pick(v, &keep, nc)),
-        };
-    }
-    for i in &mut mesh.cells.conn {
-        *i = new_id[*i as usize];
-    }
-    for faces in mesh.cells.poly_faces.values_mut() {
-        for i in faces.iter_mut().flatten() {
-            *i = new_id.get(*i as usize).copied().unwrap_or(*i);
-        }
-    }
-    removed
-}
-
-fn pick<T: Copy>(v: &[T], keep: &[usize], nc: usize) -> Vec<T> {
-    keep.iter()
-        .flat_map(|&i| v.get(i * nc..(i + 1) * nc).unwrap_or(&[]).iter().copied())
-        .collect()
-}
+pub use crate::mesh::subset::remove_unused_points;
 
 /// One positively oriented, convex cell of `kind` (unit size) with the point
 /// scalar `f`. [`CellKind::Polyhedron`] gives a "house": a cube with a

@@ -10,7 +10,11 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use serde_json::Value;
-use zoovr::generate::{ring_grid, single_cell, warped_hex_grid, zoo_grid, Warp};
+use zoovr::field::ArrayData;
+use zoovr::generate::{
+    ghost_grid, ghost_grid_flags, ring_grid, single_cell, warped_hex_grid, zoo_grid, Warp,
+};
+use zoovr::io::writer::{write_vtu, Compression};
 use zoovr::mesh::report::MeshReport;
 use zoovr::mesh::{CellKind, Mesh};
 use zoovr::testdata::mesh_file;
@@ -216,4 +220,73 @@ fn q_solution_on_a_non_plot3d_grid_is_an_error() {
         err.contains("tetra.vtk") && err.contains("solution.q") && err.contains("PLOT3D"),
         "{err}"
     );
+}
+
+/// `hidden_cells` / `duplicate_cells` count the flags of a `vtkGhostType`
+/// cell array (0 without one); the text output has a line for them only
+/// when the array exists. Every cell is still counted in `cells3d`.
+#[test]
+fn ghost_cells_are_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("ghost.vtu");
+    write_vtu(&file, &ghost_grid(4, &Warp::default()), Compression::Zlib).unwrap();
+    let (mut hidden, mut duplicate) = (0, 0);
+    for k in 0..4 {
+        for j in 0..4 {
+            for i in 0..4 {
+                let g = ghost_grid_flags(4, i, j, k);
+                hidden += usize::from(g & 32 != 0);
+                duplicate += usize::from(g & 1 != 0);
+            }
+        }
+    }
+    assert_eq!((hidden, duplicate), (13, 4));
+    let v = info_json(&file);
+    assert_eq!(v["hidden_cells"], hidden);
+    assert_eq!(v["duplicate_cells"], duplicate);
+    assert_eq!(v["cells3d"], 64);
+    let out = zoovr(&["info", file.to_str().unwrap()]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("ghost cells: 13 hidden, 4 duplicate"),
+        "{text}"
+    );
+
+    let plain = mesh_file("hexahedron.vtk");
+    let v = info_json(&plain);
+    assert_eq!(
+        (&v["hidden_cells"], &v["duplicate_cells"]),
+        (&0.into(), &0.into())
+    );
+    let out = zoovr(&["info", plain.to_str().unwrap()]);
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("ghost cells:"));
+}
+
+/// A ghost array that is not one flag per cell is an error naming the file
+/// and the array, exit 1.
+#[test]
+fn malformed_ghost_arrays_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, components, len) in [("two_comp.vtu", 2, 128), ("short.vtu", 1, 10)] {
+        let mut m = ghost_grid(4, &Warp::default());
+        m.cell_data[0].components = components;
+        m.cell_data[0].data = ArrayData::Int(vec![0; len]);
+        let file = dir.path().join(name);
+        write_vtu(&file, &m, Compression::None).unwrap();
+        for json in [true, false] {
+            let mut args = vec!["info", file.to_str().unwrap()];
+            if json {
+                args.push("--json");
+            }
+            let out = zoovr(&args);
+            assert_eq!(out.status.code(), Some(1), "{name}");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                err.contains(name) && err.contains("vtkGhostType"),
+                "{name}: {err}"
+            );
+            assert!(out.stdout.is_empty());
+        }
+    }
 }

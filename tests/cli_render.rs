@@ -3,7 +3,11 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
+use zoovr::field::{ArrayData, DataArray};
+use zoovr::generate::{ghost_grid, Warp};
 use zoovr::image::Image;
+use zoovr::io::writer::{write_vtu, Compression};
+use zoovr::mesh::{Cells, Mesh};
 use zoovr::testdata::mesh_file;
 
 fn zoovr(args: &[&str]) -> Output {
@@ -269,4 +273,146 @@ fn interrupted_render_leaves_no_file() {
     );
     let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert!(left.is_empty(), "left behind: {left:?}");
+}
+
+/// `generate::ghost_grid` written as `.vtu`, and the same grid with its
+/// hidden and duplicate cells removed by hand (no ghost array at all).
+fn ghost_files(dir: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    let full = ghost_grid(4, &Warp::default());
+    let flags = match &full.cell_data[0].data {
+        ArrayData::Int(v) => v.clone(),
+        other => panic!("{other:?}"),
+    };
+    let keep: Vec<usize> = (0..flags.len()).filter(|&c| flags[c] & 33 == 0).collect();
+    assert!(keep.len() < flags.len());
+    let mut cells = Cells::default();
+    for &c in &keep {
+        cells.push(full.cells.kinds[c], full.cells.nodes(c));
+    }
+    let cell_data = full.cell_data[1..]
+        .iter()
+        .map(|a| {
+            let data = match &a.data {
+                ArrayData::Int(v) => ArrayData::Int(keep.iter().map(|&c| v[c]).collect()),
+                ArrayData::F32(v) => ArrayData::F32(keep.iter().map(|&c| v[c]).collect()),
+                ArrayData::F64(v) => ArrayData::F64(keep.iter().map(|&c| v[c]).collect()),
+            };
+            DataArray { data, ..a.clone() }
+        })
+        .collect();
+    let hand = Mesh {
+        cells,
+        cell_data,
+        ..full.clone()
+    };
+    let (a, b) = (dir.join("ghost.vtu"), dir.join("by_hand.vtu"));
+    write_vtu(&a, &full, Compression::None).unwrap();
+    write_vtu(&b, &hand, Compression::None).unwrap();
+    (a, b)
+}
+
+fn max_pixel_diff(a: &Path, b: &Path) -> f32 {
+    let (a, b) = (Image::read(a).unwrap(), Image::read(b).unwrap());
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .flat_map(|(p, q)| (0..4).map(move |k| (p[k] - q[k]).abs()))
+        .fold(0.0, f32::max)
+}
+
+/// Cells flagged hidden or duplicate in `vtkGhostType` are not drawn (the
+/// image equals the grid without them, in both modes), `--show-hidden`
+/// draws them, and `--stats` says how many were left out.
+#[test]
+fn hidden_cells_are_left_out_unless_show_hidden() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ghost, hand) = ghost_files(dir.path());
+    for mode in ["raycast", "exact"] {
+        let run = |file: &Path, out: &str, extra: &[&str]| {
+            let png = dir.path().join(format!("{mode}_{out}.png"));
+            let mut args = vec![
+                "render",
+                file.to_str().unwrap(),
+                "-o",
+                png.to_str().unwrap(),
+                "--size",
+                "48x48",
+                "--azimuth",
+                "30",
+                "--elevation",
+                "25",
+                "--mode",
+                mode,
+            ];
+            args.extend(extra);
+            (zoovr(&args), png)
+        };
+        let (o, ghost_png) = run(&ghost, "ghost", &["--stats"]);
+        if mode == "exact" && !o.status.success() && stderr(&o).contains("adapter") {
+            eprintln!("skipping the exact mode: {}", stderr(&o));
+            continue;
+        }
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("ghost cells  16 left out"),
+            "{mode}: {}",
+            stderr(&o)
+        );
+        let (o, hand_png) = run(&hand, "hand", &[]);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        let (o, shown_png) = run(&ghost, "shown", &["--show-hidden"]);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        assert_eq!(
+            max_pixel_diff(&ghost_png, &hand_png),
+            0.0,
+            "{mode}: ghost vs removed by hand"
+        );
+        let d = max_pixel_diff(&ghost_png, &shown_png);
+        assert!(d > 0.05, "{mode}: --show-hidden should differ, max {d}");
+    }
+}
+
+#[test]
+fn help_documents_show_hidden() {
+    let o = zoovr(&["render", "--help"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("--show-hidden") && text.contains("vtkGhostType"),
+        "{text}"
+    );
+}
+
+/// A ghost array zoovr cannot read as flags (two components; a tuple count
+/// that is not the cell count) is an error naming the file and the array.
+#[test]
+fn malformed_ghost_arrays_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    for (name, components, len) in [("two_comp.vtu", 2, 128), ("short.vtu", 1, 10)] {
+        let mut m = ghost_grid(4, &Warp::default());
+        m.cell_data[0].components = components;
+        m.cell_data[0].data = ArrayData::Int(vec![0; len]);
+        let file = dir.path().join(name);
+        write_vtu(&file, &m, Compression::None).unwrap();
+        let o = zoovr(&[
+            "render",
+            file.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--size",
+            "16x16",
+            "--mode",
+            "raycast",
+        ]);
+        assert_eq!(o.status.code(), Some(1), "{name}: {}", stderr(&o));
+        let e = stderr(&o);
+        eprintln!("{name}: {e}");
+        assert!(
+            e.contains(name) && e.contains("vtkGhostType"),
+            "{name}: {e}"
+        );
+        assert!(!out.exists());
+    }
 }

@@ -78,6 +78,70 @@ fn default_rule_in_order() {
     assert_eq!(pick(&m), Some(("ps".into(), Association::Point)));
 }
 
+/// VTK's bookkeeping arrays (ghost flags, original ids) are passed over by
+/// the default rule while any other array exists, and taken (in the usual
+/// order) when nothing else is there; `--field` names them as any array.
+#[test]
+fn default_rule_skips_vtk_bookkeeping_arrays() {
+    let np = 27;
+    let nc = 8;
+    let ghost = |m: &mut Mesh| {
+        let mut a = arr("vtkGhostType", 1, ArrayData::Int(vec![0; nc]));
+        a.vtk_type = "UInt8".into();
+        m.cell_data.push(a);
+    };
+    let mut m = grid();
+    ghost(&mut m);
+    assert_eq!(
+        pick(&m),
+        Some(("vtkGhostType".into(), Association::Cell)),
+        "only the ghost array: taken"
+    );
+    m.cell_data.push(arr(
+        "vtkOriginalCellIds",
+        1,
+        ArrayData::Int((0..nc as i64).collect()),
+    ));
+    assert_eq!(pick(&m), Some(("vtkGhostType".into(), Association::Cell)));
+    // a point id array wins over cell ones when only bookkeeping is there
+    m.point_data.push(arr(
+        "vtkOriginalPointIds",
+        1,
+        ArrayData::Int((0..np as i64).collect()),
+    ));
+    assert_eq!(
+        pick(&m),
+        Some(("vtkOriginalPointIds".into(), Association::Point))
+    );
+    // any other array is preferred, even an integer cell array after them
+    m.cell_data.push(arr(
+        "layer",
+        1,
+        ArrayData::Int(vec![1, 1, 1, 1, 2, 2, 2, 2]),
+    ));
+    assert_eq!(pick(&m), Some(("layer".into(), Association::Cell)));
+    // ids stored as floats (rule 2/3 would take them first) are skipped too
+    m.point_data
+        .insert(0, arr("vtkOriginalPointIds", 1, pf(np, 1, |i| i as f64)));
+    m.cell_data
+        .insert(0, arr("vtkOriginalCellIds", 1, pf(nc, 1, |i| i as f64)));
+    assert_eq!(pick(&m), Some(("layer".into(), Association::Cell)));
+    // ... as are active point scalars that are ids
+    m.active_point_scalars = Some("vtkOriginalPointIds".into());
+    assert_eq!(pick(&m), Some(("layer".into(), Association::Cell)));
+    m.cell_data
+        .push(arr("poro", 1, pf(nc, 1, |i| i as f64 / 10.0)));
+    assert_eq!(pick(&m), Some(("poro".into(), Association::Cell)));
+    // named explicitly, they are used
+    let f = select_field(&m, Some(&FieldSpec::parse("vtkGhostType").unwrap()))
+        .unwrap()
+        .unwrap();
+    assert_eq!(
+        (f.name.as_str(), f.association),
+        ("vtkGhostType", Association::Cell)
+    );
+}
+
 #[test]
 fn named_fields_components_and_errors() {
     let np = 27;

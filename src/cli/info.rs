@@ -3,15 +3,18 @@
 //! quality facts of [`MeshReport`] (boundary faces, components, convexity,
 //! inverted / degenerate cells, nonplanar faces, inverted consistent tets).
 //! The JSON keys are a contract (DESIGN.md, Conventions); the text output
-//! prints the same values.
+//! prints the same values. `hidden_cells` and `duplicate_cells` count the
+//! cells a `vtkGhostType` cell array flags (0 without one); the text output
+//! prints them only when the array exists.
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context as _, Result};
 use clap::Args;
 use serde_json::{json, Value};
 
 use zoovr::io::{self, ReadOptions};
+use zoovr::mesh::ghost::{cell_ghost_array, GhostCounts};
 use zoovr::mesh::report::MeshReport;
 use zoovr::mesh::Mesh;
 
@@ -33,11 +36,11 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         q_file: args.q.clone(),
     };
     let mesh = io::read(&args.file, &opts)?;
-    let v = describe(&mesh, steps.len());
+    let v = describe(&mesh, steps.len()).with_context(|| format!("{}", args.file.display()))?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        print_text(&args.file, &v);
+        print_text(&args.file, &v, cell_ghost_array(&mesh).is_some());
     }
     Ok(())
 }
@@ -72,9 +75,10 @@ fn num(x: f64) -> Value {
     }
 }
 
-pub(crate) fn describe(mesh: &Mesh, timesteps: usize) -> Value {
+pub(crate) fn describe(mesh: &Mesh, timesteps: usize) -> Result<Value> {
+    let ghosts = GhostCounts::of(mesh)?;
     let r = MeshReport::compute(mesh);
-    json!({
+    Ok(json!({
         "cells3d": mesh.cells.len(),
         "cells_by_type": mesh.source.cells_by_type,
         "ignored_cells": mesh.source.ignored_cells,
@@ -98,10 +102,12 @@ pub(crate) fn describe(mesh: &Mesh, timesteps: usize) -> Value {
         "inverted_tets": r.inverted_tets,
         "flat_tets": r.flat_tets,
         "coincident_points": r.coincident_points,
-    })
+        "hidden_cells": ghosts.hidden,
+        "duplicate_cells": ghosts.duplicate,
+    }))
 }
 
-fn print_text(file: &std::path::Path, v: &Value) {
+fn print_text(file: &std::path::Path, v: &Value, ghost_array: bool) {
     println!("file:        {}", file.display());
     println!("cells (3D):  {}", v["cells3d"]);
     if let Some(m) = v["cells_by_type"].as_object() {
@@ -135,6 +141,12 @@ fn print_text(file: &std::path::Path, v: &Value) {
     );
     println!("ignored:     {} 0D-2D cells", v["ignored_cells"]);
     println!("coincident:  {} points", v["coincident_points"]);
+    if ghost_array {
+        println!(
+            "ghost cells: {} hidden, {} duplicate (vtkGhostType; not drawn without --show-hidden)",
+            v["hidden_cells"], v["duplicate_cells"]
+        );
+    }
     if let Some(arrs) = v["arrays"].as_array() {
         println!("arrays:");
         for a in arrs {
@@ -153,12 +165,12 @@ fn print_text(file: &std::path::Path, v: &Value) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoovr::generate::{ring_grid, warped_hex_grid, zoo_grid, Warp};
+    use zoovr::generate::{ghost_grid, ring_grid, warped_hex_grid, zoo_grid, Warp};
 
     #[test]
     fn json_of_a_generated_grid() {
         let m = warped_hex_grid(3, &Warp::default());
-        let v = describe(&m, 1);
+        let v = describe(&m, 1).unwrap();
         assert_eq!(v["cells3d"], 27);
         assert_eq!(v["cells_by_type"]["hexahedron"], 27);
         assert_eq!(v["points"], 64);
@@ -183,7 +195,8 @@ mod tests {
                 },
             ),
             1,
-        );
+        )
+        .unwrap();
         let c = straight["convexity"].as_f64().unwrap();
         assert!((c - 1.0).abs() < 1e-12, "{c}");
         assert_eq!(straight["nonplanar_faces"], 0);
@@ -206,16 +219,37 @@ mod tests {
                 },
             ),
             1,
-        );
+        )
+        .unwrap();
         // 6x6x2 minus the 2x2x2 hole
         assert_eq!(v["cells3d"], 64);
         let c = v["convexity"].as_f64().unwrap();
         assert!((c - 32.0 / 36.0).abs() < 1e-12, "{c}");
-        let z = describe(&zoo_grid(3, &Warp::default()), 1);
+        let z = describe(&zoo_grid(3, &Warp::default()), 1).unwrap();
         for k in ["hexahedron", "wedge", "pyramid", "tetra"] {
             assert!(z["cells_by_type"][k].as_u64().unwrap() > 0, "{k}");
         }
         assert_eq!(z["components"], 1);
         assert_eq!(z["inverted_tets"], 0);
+    }
+
+    #[test]
+    fn json_counts_ghost_cells() {
+        let v = describe(&warped_hex_grid(2, &Warp::default()), 1).unwrap();
+        assert_eq!(
+            (&v["hidden_cells"], &v["duplicate_cells"]),
+            (&json!(0), &json!(0))
+        );
+        let mut m = ghost_grid(4, &Warp::default());
+        let v = describe(&m, 1).unwrap();
+        let c = GhostCounts::of(&m).unwrap();
+        assert!(c.hidden > 0 && c.duplicate > 0);
+        assert_eq!(v["hidden_cells"], c.hidden);
+        assert_eq!(v["duplicate_cells"], c.duplicate);
+        // every cell is still described
+        assert_eq!(v["cells3d"], 64);
+        m.cell_data[0].components = 2;
+        let err = describe(&m, 1).unwrap_err().to_string();
+        assert!(err.contains("vtkGhostType"), "{err}");
     }
 }

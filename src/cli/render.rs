@@ -35,6 +35,12 @@ pub struct ViewArgs {
     /// Average cell data to points.
     #[arg(long)]
     pub cell_to_point: bool,
+    /// Draw the cells that the file's `vtkGhostType` cell array flags hidden
+    /// (32) or duplicate (1). By default they are left out, as ParaView does
+    /// (and the default range is over the cells drawn); point flags never
+    /// remove cells.
+    #[arg(long)]
+    pub show_hidden: bool,
     /// PLOT3D solution file for a PLOT3D grid.
     #[arg(long)]
     pub q: Option<PathBuf>,
@@ -94,6 +100,7 @@ impl ViewArgs {
             preset: self.preset.clone(),
             range: self.range,
             cell_to_point: self.cell_to_point,
+            show_hidden: self.show_hidden,
         }
     }
 
@@ -273,6 +280,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         image.write_exr(out)?;
     }
     if args.view.stats {
+        if scene.ghost_cells > 0 {
+            eprintln!(
+                "ghost cells  {} left out (hidden or duplicate in vtkGhostType; --show-hidden draws them)",
+                scene.ghost_cells
+            );
+        }
         print_stats(&stats, load_s);
     }
     // The process ends right after: leave the mesh, the sort's state and

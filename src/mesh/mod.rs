@@ -10,15 +10,19 @@
 //! tetrahedralisation in [`tetra`]; connected components in [`components`];
 //! cell volumes, orientation, degeneracy and nonplanarity in [`quality`];
 //! orientation repair in [`orient`]; coincident-point merging in [`merge`];
-//! the convex hull in [`hull`]; everything `info` prints in [`report`].
+//! the convex hull in [`hull`]; everything `info` prints in [`report`];
+//! keeping a subset of the cells (with their data) in [`subset`]; the cells
+//! a file marks hidden or duplicate (VTK's `vtkGhostType`) in [`ghost`].
 
 pub mod cell;
 pub mod components;
+pub mod ghost;
 pub mod hull;
 pub mod merge;
 pub mod orient;
 pub mod quality;
 pub mod report;
+pub mod subset;
 pub mod tetra;
 pub mod topology;
 

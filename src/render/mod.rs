@@ -65,6 +65,12 @@ impl std::str::FromStr for Mode {
 pub enum RenderError {
     #[error("the mesh has no 3D cells to render")]
     NoCells,
+    #[error(
+        "all {0} cells are flagged hidden or duplicate in 'vtkGhostType'; --show-hidden draws them"
+    )]
+    AllCellsHidden(usize),
+    #[error(transparent)]
+    Ghost(#[from] crate::mesh::ghost::GhostError),
     #[error(transparent)]
     Field(#[from] crate::field::FieldError),
     #[error("{path}: {msg}")]

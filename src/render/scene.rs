@@ -2,13 +2,21 @@
 //!
 //! [`Scene::build`] applies the conventions of DESIGN.md in one place, so every
 //! mode renders the same thing:
+//! - cells the file flags hidden or duplicate in its `vtkGhostType` cell
+//!   array are left out first, with their cell-data values and the points
+//!   only they used ([`crate::mesh::ghost`]), unless
+//!   [`SceneSpec::show_hidden`]: the topology, the visibility order, the
+//!   exact mode and the ray caster then see only the cells drawn, and cell
+//!   data stays aligned with them. Point ghost flags remove nothing;
 //! - coincident points are merged (a merged point keeps the smallest original
 //!   index, so the smallest-vertex diagonals are unchanged where points were
 //!   already shared) and face adjacency is built;
 //! - the field is `--field`, else the TF file's `scalar` key, else the
 //!   default-field rule ([`crate::field::select_field`]); `--cell-to-point`
 //!   averages cell data to points;
-//! - the range is `--range`, else the field's min..max;
+//! - the range is `--range`, else the field's min..max over what is drawn
+//!   (hidden and duplicate cells, and the points only they use, are gone
+//!   by then, as ParaView computes ranges over non-ghost data);
 //! - the TF is the file (absolute scalar values), else the preset normalised
 //!   onto the range, else the default (viridis, opacity ramp, unit distance =
 //!   bounds diagonal / 10, glow).
@@ -16,6 +24,7 @@
 use std::path::PathBuf;
 
 use crate::field::{self, Association, FieldSpec, ScalarField};
+use crate::mesh::ghost::remove_ghost_cells;
 use crate::mesh::merge::merge_coincident_points;
 use crate::mesh::topology::Topology;
 use crate::mesh::Mesh;
@@ -37,6 +46,9 @@ pub struct SceneSpec {
     pub range: Option<(f64, f64)>,
     /// `--cell-to-point`.
     pub cell_to_point: bool,
+    /// `--show-hidden`: draw the cells that `vtkGhostType` flags hidden or
+    /// duplicate too.
+    pub show_hidden: bool,
 }
 
 /// The scalar values a renderer integrates.
@@ -61,6 +73,8 @@ pub struct Scene {
     pub unit_distance: f64,
     /// Points merged when building the scene.
     pub merged_points: usize,
+    /// Cells left out because `vtkGhostType` flags them hidden or duplicate.
+    pub ghost_cells: usize,
 }
 
 impl Scene {
@@ -68,6 +82,14 @@ impl Scene {
     pub fn build(mut mesh: Mesh, spec: &SceneSpec) -> Result<Scene, RenderError> {
         if mesh.cells.is_empty() {
             return Err(RenderError::NoCells);
+        }
+        let ghost_cells = if spec.show_hidden {
+            0
+        } else {
+            remove_ghost_cells(&mut mesh)?
+        };
+        if mesh.cells.is_empty() {
+            return Err(RenderError::AllCellsHidden(ghost_cells));
         }
         let merged_points = merge_coincident_points(&mut mesh);
         let topology = Topology::build(&mesh.cells);
@@ -124,6 +146,7 @@ impl Scene {
             tf,
             unit_distance,
             merged_points,
+            ghost_cells,
         })
     }
 
