@@ -13,17 +13,23 @@ use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
 use zoovr::render::{Compositor, Mode, RenderOptions, Renderer, Scene, SceneSpec};
 
-
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let file = args.first().ok_or_else(|| anyhow!("usage: pixel FILE I J [SIZE] [flags]"))?;
+    let file = args
+        .first()
+        .ok_or_else(|| anyhow!("usage: pixel FILE I J [SIZE] [flags]"))?;
     let num = |k: usize| -> Result<u32> {
-        args.get(k).context("missing pixel")?.parse().context("pixel index")
+        args.get(k)
+            .context("missing pixel")?
+            .parse()
+            .context("pixel index")
     };
     let (i, j) = (num(1)?, num(2)?);
     let size = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(512);
     let flag = |name: &str| -> Option<f64> {
-        args.iter().position(|a| a == name).and_then(|k| args.get(k + 1)?.parse().ok())
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|k| args.get(k + 1)?.parse().ok())
     };
     let camera = CameraParams {
         width: size,
@@ -46,15 +52,29 @@ fn main() -> Result<()> {
         ..Default::default()
     };
     let (img, stats) = renderer.render(&opts, |_, _| {})?;
-    let model = if split_all { FieldModel::Tets } else { FieldModel::Faces };
-    let ropts = RenderOptions { mode: Mode::Raycast, model, ..opts.clone() };
+    let model = if split_all {
+        FieldModel::Tets
+    } else {
+        FieldModel::Faces
+    };
+    let ropts = RenderOptions {
+        mode: Mode::Raycast,
+        model,
+        ..opts.clone()
+    };
     let (reference, _) = renderer.render(&ropts, |_, _| {})?;
-    let gopts = RenderOptions { compositor: Compositor::Gpu, ..opts.clone() };
+    let gopts = RenderOptions {
+        compositor: Compositor::Gpu,
+        ..opts.clone()
+    };
     match renderer.render(&gopts, |_, _| {}) {
         Ok((g, _)) => {
             println!("exact (gpu)      {:?}", g.get(i, j));
             let (d, _) = zoovr::image::compare_display(&g, &img, [0.0; 3])?;
-            println!("gpu vs twin: max {:.3e} at {:?}, rms {:.3e}", d.max_abs, d.worst, d.rms);
+            println!(
+                "gpu vs twin: max {:.3e} at {:?}, rms {:.3e}",
+                d.max_abs, d.worst, d.rms
+            );
         }
         Err(e) => println!("exact (gpu)      unavailable: {e}"),
     }

@@ -9,7 +9,8 @@
 //! 1. **Viewport.** Clip positions (`w = 1` in the exact mode; others are
 //!    divided) become framebuffer coordinates in `f32`,
 //!    `x = ndc_x * S/2 + S/2`, `y = -ndc_y * S/2 + S/2` (row 0 at the top;
-//!    `S` the square viewport's side, [`raster_side`]), then are snapped to
+//!    `S` the square viewport's side, [`raster_side`]; the image starts
+//!    [`super::vertex::RASTER_BORDER`] pixels in), then are snapped to
 //!    a grid of 1/[`super::vertex::SUBPIXEL`] pixel (8 bits of sub-pixel
 //!    precision, as lavapipe, llvmpipe and the desktop drivers have),
 //!    rounding to nearest. Positions from [`ClipMapper`] are on that grid
@@ -169,8 +170,9 @@ impl CpuFrame {
         let half = raster_side(self.width, self.height) as f32 * 0.5;
         let w = v.pos[3];
         let (nx, ny) = (v.pos[0] / w, v.pos[1] / w);
-        let x = nx * half + half;
-        let y = -ny * half + half;
+        let b = super::vertex::RASTER_BORDER as f32;
+        let x = nx * half + half - b;
+        let y = -ny * half + half - b;
         // Beyond 2^40 sub-pixels (4e9 px) the hardware clips; such
         // positions never reach here from the exact mode.
         Some([ClipMapper::snap(x as f64)?, ClipMapper::snap(y as f64)?])

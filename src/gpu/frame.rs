@@ -35,7 +35,7 @@ use wgpu::util::DeviceExt;
 use super::context::Context;
 use super::exptable::{shader_params, TABLE_N};
 use super::readback::read_image;
-use super::vertex::{raster_side, ExactVertex};
+use super::vertex::{raster_side, ExactVertex, RASTER_BORDER};
 use super::{AccumFormat, GpuError};
 use crate::image::Image;
 
@@ -191,8 +191,8 @@ impl Context {
         }
 
         // The square power-of-two viewport that makes sub-pixel positions
-        // exact (`raster_side`); the image is its top-left corner, and the
-        // scissor keeps fragments there.
+        // exact (`raster_side`); the image is inside it, `RASTER_BORDER`
+        // from its edges, and the scissor keeps fragments there.
         let side = raster_side(opts.width, opts.height);
         if side > max {
             return Err(GpuError::BadSize {
@@ -402,7 +402,7 @@ impl Frame<'_> {
         {
             let mut pass = self.begin_pass(&mut encoder);
             pass.set_pipeline(self.ctx.pipeline(self.format, self.draw));
-            pass.set_scissor_rect(0, 0, self.width, self.height);
+            pass.set_scissor_rect(RASTER_BORDER, RASTER_BORDER, self.width, self.height);
             pass.set_bind_group(0, &self.bind_group, &[]);
             pass.set_vertex_buffer(0, vbuf.slice(..vbytes.len() as u64));
             pass.set_index_buffer(ibuf.slice(..ibytes.len() as u64), wgpu::IndexFormat::Uint32);

@@ -37,8 +37,8 @@
 //! Errors never panic: wgpu's uncaptured-error and device-lost callbacks are
 //! captured and turned into [`GpuError`] at the next check.
 
-pub mod cpu;
 mod context;
+pub mod cpu;
 pub mod exptable;
 mod frame;
 mod readback;

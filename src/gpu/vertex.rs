@@ -102,17 +102,24 @@ impl ExactVertex {
 /// pixel (8 bits, what lavapipe, llvmpipe and the desktop drivers use).
 pub const SUBPIXEL: f64 = 256.0;
 
+/// Pixels between the image and the viewport's edges on every side: more
+/// than the margin to which the projection clips regions
+/// ([`crate::numeric::tolerance::IMAGE_CLIP_MARGIN_PX`]), so the GPU never
+/// clips a triangle (clipping would make corners off the sub-pixel grid).
+pub const RASTER_BORDER: u32 = 8;
+
 /// The side of the square viewport (and render target) for a `width x
-/// height` image: the next power of two of the larger side. With it, a
-/// position on the sub-pixel grid has an exact `f32` NDC value, and the
-/// rasteriser's viewport transform (`ndc * side/2 + side/2`, in `f32`)
-/// gives back exactly that position: the GPU draws the triangles the CPU
-/// decided on, so no snapping moves a corner, and a covered pixel centre
-/// is inside the very triangle whose corners the attributes are
-/// interpolated from (no extrapolation on slivers). The image is the
-/// top-left `width x height` corner.
+/// height` image: the next power of two of the larger side plus a border
+/// of [`RASTER_BORDER`] on each side. With it, a position on the sub-pixel
+/// grid has an exact `f32` NDC value, and the rasteriser's viewport
+/// transform (`ndc * side/2 + side/2`, in `f32`) gives back exactly that
+/// position: the GPU draws the triangles the CPU decided on, so no
+/// snapping moves a corner, and a covered pixel centre is inside the very
+/// triangle whose corners the attributes are interpolated from (no
+/// extrapolation on slivers). The image is the `width x height` rectangle
+/// at `(RASTER_BORDER, RASTER_BORDER)`.
 pub fn raster_side(width: u32, height: u32) -> u32 {
-    width.max(height).max(1).next_power_of_two()
+    (width.max(height).max(1) + 2 * RASTER_BORDER).next_power_of_two()
 }
 
 /// Maps continuous pixel coordinates and view depth to clip space.
@@ -157,8 +164,9 @@ impl ClipMapper {
     pub fn ndc(&self, px: f64, py: f64) -> Option<([f32; 2], [i64; 2])> {
         let (gx, gy) = (Self::snap(px)?, Self::snap(py)?);
         let scale = 2.0 / (SUBPIXEL * self.side as f64);
-        let nx = gx as f64 * scale - 1.0;
-        let ny = 1.0 - gy as f64 * scale;
+        let b = RASTER_BORDER as f64 * SUBPIXEL;
+        let nx = (gx as f64 + b) * scale - 1.0;
+        let ny = 1.0 - (gy as f64 + b) * scale;
         Some(([nx as f32, ny as f32], [gx, gy]))
     }
 
@@ -200,9 +208,10 @@ impl ClipMapper {
         let w = pos[3] as f64;
         let nx = pos[0] as f64 / w;
         let ny = pos[1] as f64 / w;
+        let b = RASTER_BORDER as f64;
         (
-            (nx + 1.0) * 0.5 * self.side as f64,
-            (1.0 - ny) * 0.5 * self.side as f64,
+            (nx + 1.0) * 0.5 * self.side as f64 - b,
+            (1.0 - ny) * 0.5 * self.side as f64 - b,
         )
     }
 }
@@ -233,13 +242,13 @@ mod tests {
             assert_eq!(p[3], if ortho { 1.0 } else { 7.25 });
             assert!(p[2] > 0.0 && p[2] < p[3]);
         }
+        // The viewport (32 wide) has the image 8 pixels in from its edges.
         let m = ClipMapper::new(4, 4, false);
-        assert_eq!(m.clip(0.0, 0.0, 1.0), Some([-1.0, 1.0, 0.5, 1.0]));
-        // Not a power of two: the viewport is 512 wide, the image its
-        // top-left corner.
+        assert_eq!(m.side, 32);
+        assert_eq!(m.clip(0.0, 0.0, 1.0), Some([-0.5, 0.5, 0.5, 1.0]));
         let m = ClipMapper::new(300, 200, true);
         assert_eq!(m.side, 512);
-        assert_eq!(m.clip(256.0, 0.0, 1.0), Some([0.0, 1.0, 0.5, 1.0]));
+        assert_eq!(m.clip(248.0, -8.0, 1.0), Some([0.0, 1.0, 0.5, 1.0]));
         assert!(m.clip(1.0, 1.0, 0.0).is_none());
         assert!(m.clip(f64::NAN, 1.0, 1.0).is_none());
     }
@@ -257,7 +266,8 @@ mod tests {
                 assert_eq!(g, [k, k]);
                 let x = nx * half + half;
                 let y = -ny * half + half;
-                assert_eq!((x as f64, y as f64), (p, p), "{w}x{h} k={k}");
+                let b = RASTER_BORDER as f64;
+                assert_eq!((x as f64 - b, y as f64 - b), (p, p), "{w}x{h} k={k}");
             }
         }
     }

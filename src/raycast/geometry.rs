@@ -191,11 +191,7 @@ mod tests {
     use super::*;
 
     fn frame(o: DVec3, d: DVec3) -> RayFrame {
-        RayFrame::new(
-            &Ray::new(o, d.normalize()),
-            DVec3::ZERO,
-            2.0,
-        )
+        RayFrame::new(&Ray::new(o, d.normalize()), DVec3::ZERO, 2.0)
     }
 
     fn cross(f: &RayFrame, ids: [u32; 3], p: [DVec3; 3]) -> Option<Crossing> {

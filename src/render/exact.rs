@@ -46,7 +46,8 @@ use glam::DVec3;
 use crate::camera::Camera;
 use crate::gpu::cpu::CpuFrame;
 use crate::gpu::{
-    ClipMapper, Context, ExactVertex, Frame, FrameOptions, FrameStats, GpuError, PendingContext, MAX_PIECES,
+    ClipMapper, Context, ExactVertex, Frame, FrameOptions, FrameStats, GpuError, PendingContext,
+    MAX_PIECES,
 };
 use crate::image::Image;
 use crate::integrate::{vertex_values, VertexValues};
@@ -107,7 +108,11 @@ enum Sink<'c> {
 }
 
 impl Sink<'_> {
-    fn push_triangles(&mut self, vertices: &[ExactVertex], indices: &[u32]) -> Result<(), GpuError> {
+    fn push_triangles(
+        &mut self,
+        vertices: &[ExactVertex],
+        indices: &[u32],
+    ) -> Result<(), GpuError> {
         match self {
             Sink::Gpu(f) => f.push_triangles(vertices, indices),
             Sink::Cpu(f) => f.push_triangles(vertices, indices),
@@ -454,13 +459,15 @@ fn push_projected(
         };
         remap.push(out.vertices.len() as u32);
         out.scratch_grid.push(g);
-        out.vertices.push(ExactVertex::new(
-            [x, y, 0.5, 1.0],
-            (v.l * k) as f32,
-            (vv.tau_mean / k) as f32,
-            [vv.glow[0] as f32, vv.glow[1] as f32, vv.glow[2] as f32],
-        )
-        .with_piece(piece));
+        out.vertices.push(
+            ExactVertex::new(
+                [x, y, 0.5, 1.0],
+                (v.l * k) as f32,
+                (vv.tau_mean / k) as f32,
+                [vv.glow[0] as f32, vv.glow[1] as f32, vv.glow[2] as f32],
+            )
+            .with_piece(piece),
+        );
     }
     for t in &proj.triangles {
         let idx = t.map(|i| remap[i as usize]);

@@ -159,13 +159,8 @@ pub(super) fn composite_group(ctx: &Ctx, pieces: &[Piece], out: &mut ChunkOut) -
             let ([x, y], _) = mapper
                 .ndc((i + di) as f64, (j + dj) as f64)
                 .unwrap_or(([0.0; 2], [0; 2]));
-            out.vertices.push(ExactVertex::new(
-                [x, y, 0.5, 1.0],
-                unit as f32,
-                tau,
-                glow,
-            )
-            .with_piece(piece));
+            out.vertices
+                .push(ExactVertex::new([x, y, 0.5, 1.0], unit as f32, tau, glow).with_piece(piece));
         }
         out.indices
             .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
