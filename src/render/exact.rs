@@ -103,7 +103,7 @@ pub struct ExactStats {
 
 /// Where a frame's triangles go: the GPU, or its CPU twin.
 enum Sink<'c> {
-    Gpu(Frame<'c>),
+    Gpu(Box<Frame<'c>>),
     Cpu(Box<CpuFrame>),
 }
 
@@ -949,7 +949,7 @@ pub fn render_exact(
             let Some(gpu) = gpu.as_ref() else {
                 unreachable!("opened above")
             };
-            Sink::Gpu(gpu.begin_frame_with(&fopts)?)
+            Sink::Gpu(Box::new(gpu.begin_frame_with(&fopts)?))
         }
         Compositor::Cpu => {
             let mut f = CpuFrame::new(
