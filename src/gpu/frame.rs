@@ -135,6 +135,8 @@ pub struct Frame<'c> {
     view: wgpu::TextureView,
     depth_view: wgpu::TextureView,
     draw: DrawKind,
+    /// Side of the square viewport ([`raster_side`]).
+    side: u32,
     bind_group: wgpu::BindGroup,
     cap_vertices: usize,
     cap_indices: usize,
@@ -191,21 +193,22 @@ impl Context {
         }
 
         // The square power-of-two viewport that makes sub-pixel positions
-        // exact (`raster_side`); the image is inside it, `RASTER_BORDER`
-        // from its edges, and the scissor keeps fragments there.
+        // exact (`raster_side`), placed `RASTER_BORDER` pixels up and left
+        // of the target so that the image is inside it with a border
+        // (viewports may extend past the attachment).
         let side = raster_side(opts.width, opts.height);
         if side > max {
             return Err(GpuError::BadSize {
                 width: opts.width,
                 height: opts.height,
-                max: max.checked_next_power_of_two().map_or(max, |p| p / 2),
+                max: (max / 2).saturating_sub(2 * RASTER_BORDER),
             });
         }
         let target = self.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("accumulation"),
             size: wgpu::Extent3d {
-                width: side,
-                height: side,
+                width: opts.width,
+                height: opts.height,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -221,8 +224,8 @@ impl Context {
         let depth = self.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("piece keys"),
             size: wgpu::Extent3d {
-                width: side,
-                height: side,
+                width: opts.width,
+                height: opts.height,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -273,6 +276,7 @@ impl Context {
             view,
             depth_view,
             draw: opts.draw,
+            side,
             bind_group,
             cap_vertices,
             cap_indices,
@@ -402,7 +406,8 @@ impl Frame<'_> {
         {
             let mut pass = self.begin_pass(&mut encoder);
             pass.set_pipeline(self.ctx.pipeline(self.format, self.draw));
-            pass.set_scissor_rect(RASTER_BORDER, RASTER_BORDER, self.width, self.height);
+            let (b, side) = (RASTER_BORDER as f32, self.side as f32);
+            pass.set_viewport(-b, -b, side, side, 0.0, 1.0);
             pass.set_bind_group(0, &self.bind_group, &[]);
             pass.set_vertex_buffer(0, vbuf.slice(..vbytes.len() as u64));
             pass.set_index_buffer(ibuf.slice(..ibytes.len() as u64), wgpu::IndexFormat::Uint32);

@@ -11,7 +11,6 @@
 use std::sync::{Arc, Mutex};
 
 use super::context::Context;
-use super::vertex::RASTER_BORDER;
 use super::{AccumFormat, GpuError};
 use crate::image::Image;
 
@@ -55,11 +54,7 @@ pub(crate) fn read_image(
             wgpu::TexelCopyTextureInfo {
                 texture,
                 mip_level: 0,
-                origin: wgpu::Origin3d {
-                    x: RASTER_BORDER,
-                    y: RASTER_BORDER + y0,
-                    z: 0,
-                },
+                origin: wgpu::Origin3d { x: 0, y: y0, z: 0 },
                 aspect: wgpu::TextureAspect::All,
             },
             wgpu::TexelCopyBufferInfo {

@@ -117,7 +117,9 @@ pub const RASTER_BORDER: u32 = 8;
 /// snapping moves a corner, and a covered pixel centre is inside the very
 /// triangle whose corners the attributes are interpolated from (no
 /// extrapolation on slivers). The image is the `width x height` rectangle
-/// at `(RASTER_BORDER, RASTER_BORDER)`.
+/// at `(RASTER_BORDER, RASTER_BORDER)` of the viewport, which the frame
+/// places that far up and left of its `width x height` target (viewports
+/// may extend past the attachment), so the target holds just the image.
 pub fn raster_side(width: u32, height: u32) -> u32 {
     (width.max(height).max(1) + 2 * RASTER_BORDER).next_power_of_two()
 }
