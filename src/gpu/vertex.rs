@@ -248,9 +248,9 @@ mod tests {
         let m = ClipMapper::new(4, 4, false);
         assert_eq!(m.side, 32);
         assert_eq!(m.clip(0.0, 0.0, 1.0), Some([-0.5, 0.5, 0.5, 1.0]));
-        let m = ClipMapper::new(300, 200, true);
-        assert_eq!(m.side, 512);
-        assert_eq!(m.clip(248.0, -8.0, 1.0), Some([0.0, 1.0, 0.5, 1.0]));
+        let wide = ClipMapper::new(300, 200, true);
+        assert_eq!(wide.side, 512);
+        assert_eq!(wide.clip(248.0, -8.0, 1.0), Some([0.0, 1.0, 0.5, 1.0]));
         assert!(m.clip(1.0, 1.0, 0.0).is_none());
         assert!(m.clip(f64::NAN, 1.0, 1.0).is_none());
     }
