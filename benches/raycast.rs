@@ -303,8 +303,8 @@ fn walk_vs_brute(c: &mut Criterion) {
         eprintln!(
             "{model:?} persp {size}: first frame walk {walk_s:.3} s wall / {walk_cpu:.2} s CPU, \
              brute {brute_s:.3} s wall / {brute_cpu:.2} s CPU; max |walk - brute| {diff:e}; \
-             brute tested {} pieces for {} segments ({} overlapping)",
-            st.pieces_tested, st.segments, st.overlapping_segments
+             brute tested {} cells for {} segments ({} overlapping)",
+            st.cells_tested, st.segments, st.overlapping_segments
         );
         g.bench_function(format!("{model:?}_walk_{size}"), |bch| {
             bch.iter(|| walk.render(&tf, &cam, &opts))

@@ -254,9 +254,9 @@ pub fn print_stats(stats: &RenderStats, load_s: f64) {
         if r.traversal == Traversal::Brute {
             let b = &r.brute;
             eprintln!(
-                "brute        {} pieces tested, {} segments, {} of them overlapping another \
+                "brute        {} cells tested, {} segments, {} of them overlapping another \
                  piece's in depth",
-                b.pieces_tested, b.segments, b.overlapping_segments
+                b.cells_tested, b.segments, b.overlapping_segments
             );
         }
         if r.model == FieldModel::Native {

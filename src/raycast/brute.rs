@@ -16,10 +16,13 @@
 //! out: its surface is the boundary of those tets as a chain, so its
 //! winding number is zero off their planes.
 //!
-//! **Candidates.** A [`Bvh`] over the pieces' boxes, plus a test of each
-//! candidate's own box (rounded outwards to `f32`), gives the pieces whose
+//! **Candidates.** A [`Bvh`] over the cells' boxes, plus a test of each
+//! candidate's own box (rounded outwards to `f32`), gives the cells whose
 //! box the line meets at `t >= t_near`, leaf by leaf in order of depth
-//! ([`Bvh::query_ordered`]).
+//! ([`Bvh::query_ordered`]). A candidate cell's points are projected onto
+//! the ray's frame once; if they all lie clearly on one side of the line
+//! ([`RayFrame::clear_sides`]) the cell is skipped, otherwise its pieces
+//! (the cell, or its tets) are crossed, sharing the edge values.
 //!
 //! **Crossings.** For each candidate, the line's crossings with all its
 //! triangles are decided by the walk's exact predicate ([`RayFrame::edge`]
@@ -72,7 +75,6 @@
 //! The `native` model is not offered ([`RaycastError::BruteModel`]): its
 //! pieces are bounded by bilinear patches, not triangles.
 
-use std::borrow::Cow;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
@@ -84,16 +86,17 @@ use super::{stop_depth, Segment};
 use crate::camera::{Camera, Ray};
 use crate::image::Image;
 use crate::integrate::{RayAccumulator, RayMaterial};
-use crate::mesh::tetra::tetrahedralize_cell;
-use crate::mesh::{CellKind, Cells};
+use crate::mesh::tetra::{tetrahedralize, tetrahedralize_cell};
+use crate::mesh::CellKind;
 use crate::numeric::predicates::{orient3d, Side};
 use crate::numeric::tolerance::BRUTE_OVERLAP_REPORT_REL;
 
 /// Counts of a brute-force render (summed over every ray traced so far).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct BruteStats {
-    /// Candidate pieces whose triangles were tested.
-    pub pieces_tested: u64,
+    /// Candidate cells: those whose own box the ray meets (their points
+    /// are projected onto the ray).
+    pub cells_tested: u64,
     /// Segments integrated (after clipping; none after a ray terminated).
     pub segments: u64,
     /// Segments that start before the segments ahead of them end (by more
@@ -106,9 +109,11 @@ impl BruteStats {
     /// The counts accumulated since `before`.
     pub fn since(&self, before: &BruteStats) -> BruteStats {
         BruteStats {
-            pieces_tested: self.pieces_tested - before.pieces_tested,
-            segments: self.segments - before.segments,
-            overlapping_segments: self.overlapping_segments - before.overlapping_segments,
+            cells_tested: self.cells_tested.saturating_sub(before.cells_tested),
+            segments: self.segments.saturating_sub(before.segments),
+            overlapping_segments: self
+                .overlapping_segments
+                .saturating_sub(before.overlapping_segments),
         }
     }
 }
@@ -135,11 +140,12 @@ pub struct BruteScratch {
 pub struct Brute<'a> {
     scene: Scene<'a>,
     model: FieldModel,
-    /// The pieces as cells: the mesh's cells, or the consistent tets.
-    pieces: Cow<'a, Cells>,
-    /// `tets`: the mesh cell of each tet.
-    parent: Option<Vec<u32>>,
-    /// BVH item `k` is piece `ids[k]`, with box `boxes[k]` (lo, hi).
+    /// `tets`: the non-flat consistent tets, cell `c`'s at
+    /// `tets[tet_offsets[c]..tet_offsets[c + 1]]`.
+    tets: Option<(Vec<[u32; 4]>, Vec<u32>)>,
+    /// Pieces traced (cells or tets).
+    pieces: usize,
+    /// BVH item `k` is cell `ids[k]`, with box `boxes[k]` (lo, hi).
     ids: Vec<u32>,
     boxes: Vec<[f32; 6]>,
     bvh: Bvh,
@@ -169,16 +175,6 @@ fn f32_down(x: f64) -> f32 {
 
 fn f32_up(x: f64) -> f32 {
     -f32_down(-x)
-}
-
-/// Whether every consistent tet of cell `c` is flat (exactly).
-fn is_flat(points: &[DVec3], cells: &Cells, c: usize, buf: &mut Vec<[u32; 4]>) -> bool {
-    buf.clear();
-    tetrahedralize_cell(cells, c, buf);
-    buf.iter().all(|t| {
-        let [a, b, cc, d] = t.map(|v| points[v as usize]);
-        orient3d(a, b, cc, d) == Side::On
-    })
 }
 
 /// The three local indices sorted by point id (then local index), and
@@ -213,61 +209,66 @@ impl<'a> Brute<'a> {
         validate(&scene)?;
         let mesh = scene.mesh;
         let points = &mesh.points[..];
-        let (pieces, parent) = if model == FieldModel::Tets {
-            let mut cells = Cells::default();
-            let mut parent = Vec::new();
-            let mut buf = Vec::new();
-            for c in 0..mesh.cells.len() {
-                buf.clear();
-                tetrahedralize_cell(&mesh.cells, c, &mut buf);
-                for t in &buf {
-                    cells.push(CellKind::Tetra, t);
-                    parent.push(c as u32);
-                }
-            }
-            (Cow::Owned(cells), Some(parent))
-        } else {
-            (Cow::Borrowed(&mesh.cells), None)
+        let cells = &mesh.cells;
+        let flat_tet = |t: &[u32; 4]| {
+            let [a, b, c, d] = t.map(|v| points[v as usize]);
+            orient3d(a, b, c, d) == Side::On
         };
-        // The walk's bounding sphere (over every piece's nodes), so that the
-        // ray frame and its tie-breaking far point are the walk's.
+        // The walk's bounding sphere (over the nodes of its cells or tets),
+        // so that the ray frame and its tie-breaking far point are the
+        // walk's.
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for &n in &pieces.conn {
+        let mut grow = |n: u32| {
             lo = lo.min(points[n as usize]);
             hi = hi.max(points[n as usize]);
-        }
+        };
+        let mut kept = vec![true; cells.len()];
+        let (tets, pieces, flat) = if model == FieldModel::Tets {
+            let (all, offsets) = tetrahedralize(cells);
+            all.iter().flatten().for_each(|&n| grow(n));
+            let mut list = Vec::with_capacity(all.len());
+            let mut offs = Vec::with_capacity(cells.len() + 1);
+            offs.push(0);
+            for c in 0..cells.len() {
+                let ts = &all[offsets[c] as usize..offsets[c + 1] as usize];
+                list.extend(ts.iter().filter(|t| !flat_tet(t)));
+                kept[c] = list.len() > *offs.last().unwrap_or(&0) as usize;
+                offs.push(list.len() as u32);
+            }
+            let (n, flat) = (list.len(), all.len() - list.len());
+            (Some((list, offs)), n, flat)
+        } else {
+            cells.conn.iter().for_each(|&n| grow(n));
+            let mut buf = Vec::new();
+            let mut flat = 0;
+            for (c, k) in kept.iter_mut().enumerate() {
+                buf.clear();
+                tetrahedralize_cell(cells, c, &mut buf);
+                if buf.iter().all(flat_tet) {
+                    *k = false;
+                    flat += 1;
+                }
+            }
+            (None, cells.len() - flat, flat)
+        };
         if lo.x > hi.x {
             lo = DVec3::ZERO;
             hi = DVec3::ZERO;
         }
         let center = (lo + hi) * 0.5;
         let radius = (hi - lo).length() * 0.5;
-        let mut ids = Vec::with_capacity(pieces.len());
-        let mut boxes = Vec::with_capacity(pieces.len());
-        let mut dboxes = Vec::with_capacity(pieces.len());
-        let mut buf = Vec::new();
-        let mut flat = 0;
-        for p in 0..pieces.len() {
-            let nodes = pieces.nodes(p);
-            let flat_piece = match model {
-                FieldModel::Tets => {
-                    let [a, b, c, d] = [0, 1, 2, 3].map(|k| points[nodes[k] as usize]);
-                    orient3d(a, b, c, d) == Side::On
-                }
-                _ => is_flat(points, &pieces, p, &mut buf),
-            };
-            if flat_piece {
-                flat += 1;
-                continue;
-            }
+        let mut ids = Vec::with_capacity(cells.len());
+        let mut boxes = Vec::with_capacity(cells.len());
+        let mut dboxes = Vec::with_capacity(cells.len());
+        for c in (0..cells.len()).filter(|&c| kept[c]) {
             let mut plo = DVec3::splat(f64::INFINITY);
             let mut phi = DVec3::splat(f64::NEG_INFINITY);
-            for &n in nodes {
+            for &n in cells.nodes(c) {
                 plo = plo.min(points[n as usize]);
                 phi = phi.max(points[n as usize]);
             }
-            ids.push(p as u32);
+            ids.push(c as u32);
             dboxes.push((plo, phi));
         }
         let pad = 1e-9 * (radius + center.abs().max_element()).max(f64::MIN_POSITIVE);
@@ -289,8 +290,8 @@ impl<'a> Brute<'a> {
         Ok(Brute {
             scene,
             model,
+            tets,
             pieces,
-            parent,
             ids,
             boxes,
             bvh,
@@ -312,19 +313,16 @@ impl<'a> Brute<'a> {
         self.flat
     }
 
-    /// Number of pieces traced.
+    /// Number of pieces traced (cells or tets, flat ones left out).
     pub fn piece_count(&self) -> usize {
-        self.ids.len()
+        self.pieces
     }
 
     /// Bytes of memory the prepared structures hold (beyond the mesh).
     pub fn bytes(&self) -> usize {
         let mut b = self.bvh.bytes() + self.ids.len() * 4 + self.boxes.len() * 24;
-        if let Cow::Owned(c) = &self.pieces {
-            b += c.conn.len() * 4 + c.offsets.len() * 4 + c.kinds.len();
-        }
-        if let Some(p) = &self.parent {
-            b += p.len() * 4;
+        if let Some((t, o)) = &self.tets {
+            b += t.len() * 16 + o.len() * 4;
         }
         b
     }
@@ -333,16 +331,9 @@ impl<'a> Brute<'a> {
     pub fn stats(&self) -> BruteStats {
         let c = |k: usize| self.counts[k].load(Ordering::Relaxed);
         BruteStats {
-            pieces_tested: c(0),
+            cells_tested: c(0),
             segments: c(1),
             overlapping_segments: c(2),
-        }
-    }
-
-    fn mesh_cell(&self, piece: u32) -> u32 {
-        match &self.parent {
-            Some(p) => p.get(piece as usize).copied().unwrap_or(piece),
-            None => piece,
         }
     }
 
@@ -372,7 +363,7 @@ impl<'a> Brute<'a> {
         let inv = DVec3::ONE / frame.d;
         self.bvh.query(frame.o, frame.d, t_near, &mut stack, |k| {
             if self.item_hit(k, frame.o, inv, t_near) {
-                self.piece_segments(&frame, self.ids[k as usize], t_near, scratch, &mut segs);
+                self.cell_segments(&frame, self.ids[k as usize], t_near, scratch, &mut segs);
             }
         });
         segs.sort_unstable_by(|a, b| a.0.t_in.total_cmp(&b.0.t_in).then(a.1.cmp(&b.1)));
@@ -380,22 +371,23 @@ impl<'a> Brute<'a> {
         scratch.stack = stack;
     }
 
-    /// Appends the segments of piece `p` along the ray (see the module docs:
-    /// non-zero winding, clipped at `t_near`).
-    fn piece_segments(
+    /// Appends the segments of cell `c`'s pieces along the ray (see the
+    /// module docs: non-zero winding, clipped at `t_near`).
+    fn cell_segments(
         &self,
         frame: &RayFrame,
-        p: u32,
+        c: u32,
         t_near: f64,
         scratch: &mut BruteScratch,
         out: &mut Vec<(Segment, u32)>,
     ) {
-        let c = p as usize;
-        let nodes = self.pieces.nodes(c);
+        let cells = &self.scene.mesh.cells;
+        let ci = c as usize;
+        let nodes = cells.nodes(ci);
         let points = &self.scene.mesh.points;
         let proj = &mut scratch.proj;
         proj.clear();
-        // Quick reject: every vertex clearly on one side of the line.
+        // Quick reject: every point clearly on one side of the line.
         let mut shared = 0xff;
         for &n in nodes {
             let q = points[n as usize];
@@ -407,105 +399,66 @@ impl<'a> Brute<'a> {
             return;
         }
         let nn = nodes.len();
-        let edges = &mut scratch.edges;
-        edges.clear();
-        edges.resize(nn * nn, f64::NAN);
-        let crossings = &mut scratch.crossings;
-        crossings.clear();
-        let scalars = self.scene.scalars;
-        let cell = self.mesh_cell(p);
-        let mut tri = |t: [usize; 3]| {
-            let mut edge = |i: usize, j: usize| {
-                let v = edges[i * nn + j];
-                if !v.is_nan() {
-                    return v;
-                }
-                let (a, b) = (&proj[i], &proj[j]);
-                let v = frame.edge(a.0, a.1, &a.2, b.0, b.1, &b.2);
-                edges[i * nn + j] = v;
-                edges[j * nn + i] = -v;
-                v
-            };
-            // The crossing test's own sign condition first (most triangles
-            // fail it), then the test itself in the canonical order.
-            let e = [edge(t[0], t[1]), edge(t[1], t[2]), edge(t[2], t[0])];
-            if !(e.iter().all(|&x| x > 0.0) || e.iter().all(|&x| x < 0.0)) {
-                return;
-            }
-            let (k, parity) = canonical(t, nodes);
-            let e = [edge(k[0], k[1]), edge(k[1], k[2]), edge(k[2], k[0])];
-            let Some(x) = RayFrame::crossing(e, k.map(|i| proj[i].2.z)) else {
-                return;
-            };
-            let s = match scalars {
-                Scalars::Point(v) => {
-                    x.w[0] * v[nodes[k[0]] as usize]
-                        + x.w[1] * v[nodes[k[1]] as usize]
-                        + x.w[2] * v[nodes[k[2]] as usize]
-                }
-                Scalars::Cell(v) => v[cell as usize],
-                Scalars::Constant(s) => s,
-            };
-            crossings.push((x.t, x.sign * parity, s));
+        scratch.edges.clear();
+        scratch.edges.resize(nn * nn, f64::NAN);
+        let mut ray = CellRay {
+            frame,
+            proj: &scratch.proj,
+            edges: &mut scratch.edges,
+            nodes,
+            scalars: self.scene.scalars,
+            cell: c,
         };
-        let kind = self.pieces.kinds[c];
-        if kind != CellKind::Polyhedron {
-            for lf in kind.faces() {
-                let n = lf.len();
-                let k0 = (0..n).min_by_key(|&i| nodes[lf[i] as usize]).unwrap_or(0);
-                for i in 1..n.saturating_sub(1) {
-                    tri([
-                        lf[k0] as usize,
-                        lf[(k0 + i) % n] as usize,
-                        lf[(k0 + i + 1) % n] as usize,
-                    ]);
-                }
-            }
-        } else {
-            let local = &mut scratch.local;
-            self.pieces.for_each_face(c, |_, face| {
-                local.clear();
-                for &g in face {
-                    match nodes.iter().position(|&n| n == g) {
-                        Some(k) => local.push(k),
-                        None => return,
+        let crossings = &mut scratch.crossings;
+        match &self.tets {
+            None => {
+                crossings.clear();
+                let kind = cells.kinds[ci];
+                if kind != CellKind::Polyhedron {
+                    for lf in kind.faces() {
+                        let n = lf.len();
+                        let k0 = (0..n).min_by_key(|&i| nodes[lf[i] as usize]).unwrap_or(0);
+                        for i in 1..n.saturating_sub(1) {
+                            let t = [lf[k0], lf[(k0 + i) % n], lf[(k0 + i + 1) % n]];
+                            crossings.extend(ray.crossing(t.map(|k| k as usize)));
+                        }
                     }
+                } else {
+                    let local = &mut scratch.local;
+                    cells.for_each_face(ci, |_, face| {
+                        local.clear();
+                        for &g in face {
+                            match nodes.iter().position(|&n| n == g) {
+                                Some(k) => local.push(k),
+                                None => return,
+                            }
+                        }
+                        let n = local.len();
+                        let k0 = (0..n).min_by_key(|&i| nodes[local[i]]).unwrap_or(0);
+                        for i in 1..n.saturating_sub(1) {
+                            let t = [local[k0], local[(k0 + i) % n], local[(k0 + i + 1) % n]];
+                            crossings.extend(ray.crossing(t));
+                        }
+                    });
                 }
-                let n = local.len();
-                let k0 = (0..n).min_by_key(|&i| nodes[local[i]]).unwrap_or(0);
-                for i in 1..n.saturating_sub(1) {
-                    tri([local[k0], local[(k0 + i) % n], local[(k0 + i + 1) % n]]);
+                pair_crossings(crossings, c, c, t_near, out);
+            }
+            Some((tets, offsets)) => {
+                let range = offsets[ci] as usize..offsets[ci + 1] as usize;
+                for (ti, tet) in tets[range.clone()].iter().enumerate() {
+                    let local = tet.map(|g| nodes.iter().position(|&n| n == g).unwrap_or(0));
+                    crossings.clear();
+                    for f in CellKind::Tetra.faces() {
+                        let t = [
+                            local[f[0] as usize],
+                            local[f[1] as usize],
+                            local[f[2] as usize],
+                        ];
+                        crossings.extend(ray.crossing(t));
+                    }
+                    let piece = (range.start + ti) as u32;
+                    pair_crossings(crossings, c, piece, t_near, out);
                 }
-            });
-        }
-        if crossings.len() < 2 {
-            return;
-        }
-        crossings.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let mut winding = 0i32;
-        let mut open = (0.0, 0.0);
-        for &(t, sign, s) in crossings.iter() {
-            let before = winding;
-            winding += sign as i32;
-            if before == 0 && winding != 0 {
-                open = (t, s);
-            } else if before != 0 && winding == 0 {
-                let mut seg = Segment {
-                    cell,
-                    t_in: open.0,
-                    t_out: t,
-                    s_in: open.1,
-                    s_out: s,
-                };
-                if seg.t_out <= t_near || seg.t_out <= seg.t_in {
-                    continue;
-                }
-                if seg.t_in < t_near {
-                    let x = (t_near - seg.t_in) / (seg.t_out - seg.t_in);
-                    seg.s_in += x * (seg.s_out - seg.s_in);
-                    seg.t_in = t_near;
-                }
-                out.push((seg, p));
             }
         }
     }
@@ -553,7 +506,7 @@ impl<'a> Brute<'a> {
                 for &k in items {
                     if self.item_hit(k, frame.o, inv, t_near) {
                         counts[0] += 1;
-                        self.piece_segments(
+                        self.cell_segments(
                             &frame,
                             self.ids[k as usize],
                             t_near,
@@ -663,6 +616,112 @@ impl<'a> Brute<'a> {
                 self.trace(material, ray, t_near, opts, scratch).rgba()
             },
         )
+    }
+}
+
+/// One candidate cell on one ray: its points projected onto the ray's
+/// frame and the edge values between them, computed on first use.
+struct CellRay<'r> {
+    frame: &'r RayFrame,
+    proj: &'r [(u32, DVec3, Proj)],
+    /// By local node pair, `nodes.len()` squared (NaN: not yet).
+    edges: &'r mut [f64],
+    nodes: &'r [u32],
+    scalars: Scalars<'r>,
+    cell: u32,
+}
+
+impl CellRay<'_> {
+    /// The value of edge `i -> j` (local nodes): [`RayFrame::edge`], cached
+    /// for both directions.
+    #[inline]
+    fn edge(&mut self, i: usize, j: usize) -> f64 {
+        let nn = self.nodes.len();
+        let v = self.edges[i * nn + j];
+        if !v.is_nan() {
+            return v;
+        }
+        let (a, b) = (&self.proj[i], &self.proj[j]);
+        let v = self.frame.edge(a.0, a.1, &a.2, b.0, b.1, &b.2);
+        self.edges[i * nn + j] = v;
+        self.edges[j * nn + i] = -v;
+        v
+    }
+
+    /// The crossing of triangle `t` (local nodes, in the piece's winding):
+    /// depth, sign along the winding normal, scalar.
+    #[inline]
+    fn crossing(&mut self, t: [usize; 3]) -> Option<(f64, i8, f64)> {
+        // The crossing test's own sign condition first (most triangles
+        // fail it), then the test itself in the canonical order.
+        let e = [
+            self.edge(t[0], t[1]),
+            self.edge(t[1], t[2]),
+            self.edge(t[2], t[0]),
+        ];
+        if !(e.iter().all(|&x| x > 0.0) || e.iter().all(|&x| x < 0.0)) {
+            return None;
+        }
+        let (k, parity) = canonical(t, self.nodes);
+        let e = [
+            self.edge(k[0], k[1]),
+            self.edge(k[1], k[2]),
+            self.edge(k[2], k[0]),
+        ];
+        let x = RayFrame::crossing(e, k.map(|i| self.proj[i].2.z))?;
+        let nodes = self.nodes;
+        let s = match self.scalars {
+            Scalars::Point(v) => {
+                x.w[0] * v[nodes[k[0]] as usize]
+                    + x.w[1] * v[nodes[k[1]] as usize]
+                    + x.w[2] * v[nodes[k[2]] as usize]
+            }
+            Scalars::Cell(v) => v[self.cell as usize],
+            Scalars::Constant(s) => s,
+        };
+        Some((x.t, x.sign * parity, s))
+    }
+}
+
+/// Pairs one piece's crossings (depth, sign, scalar) into segments where
+/// their winding number is non-zero, clipped at `t_near`, and appends them
+/// with the piece's index (see the module docs).
+fn pair_crossings(
+    crossings: &mut [(f64, i8, f64)],
+    cell: u32,
+    piece: u32,
+    t_near: f64,
+    out: &mut Vec<(Segment, u32)>,
+) {
+    if crossings.len() < 2 {
+        return;
+    }
+    crossings.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let mut winding = 0i32;
+    let mut open = (0.0, 0.0);
+    for &(t, sign, s) in crossings.iter() {
+        let before = winding;
+        winding += sign as i32;
+        if before == 0 && winding != 0 {
+            open = (t, s);
+        } else if before != 0 && winding == 0 {
+            let mut seg = Segment {
+                cell,
+                t_in: open.0,
+                t_out: t,
+                s_in: open.1,
+                s_out: s,
+            };
+            if seg.t_out <= t_near || seg.t_out <= seg.t_in {
+                continue;
+            }
+            if seg.t_in < t_near {
+                let x = (t_near - seg.t_in) / (seg.t_out - seg.t_in);
+                seg.s_in += x * (seg.s_out - seg.s_in);
+                seg.t_in = t_near;
+            }
+            out.push((seg, piece));
+        }
     }
 }
 
