@@ -69,11 +69,11 @@ pub struct ViewArgs {
     /// brute.
     ///
     /// `walk` goes from cell to cell across shared faces (face adjacency).
-    /// `brute` ignores adjacency: it tests every cell (`--model faces`) or
-    /// consistent tet (`--model tets`) whose bounding box the ray meets
-    /// (a bounding volume hierarchy), with the walk's exact crossing test,
-    /// and composites all their segments in depth order; where pieces
-    /// overlap, their extinctions add. On a conforming mesh both give the
+    /// `brute` ignores adjacency: it tests every cell whose bounding box the
+    /// ray meets (a bounding volume hierarchy), whole (`--model faces`) or
+    /// as its consistent tets (`--model tets`), with the walk's exact
+    /// crossing test, and composites all their segments in depth order;
+    /// where pieces overlap, their extinctions add. On a conforming mesh both give the
     /// same image (to rounding); brute force is slower and is the
     /// reference where adjacency cannot be trusted: non-conforming faces
     /// that only partly overlap (faults in corner-point grids, hanging

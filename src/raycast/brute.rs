@@ -124,7 +124,7 @@ pub struct BruteScratch {
     stack: Vec<u32>,
     queue: NodeQueue,
     proj: Vec<(u32, DVec3, Proj)>,
-    /// Edge values of the current piece by local node pair (NaN: not yet).
+    /// Edge values of the current cell by local node pair (NaN: not yet).
     edges: Vec<f64>,
     local: Vec<usize>,
     /// Crossings of the current piece: depth, sign, scalar.

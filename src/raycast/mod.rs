@@ -7,7 +7,8 @@
 //! segment is integrated exactly for the chosen [`FieldModel`] and composited
 //! front to back in a [`RayAccumulator`]. [`Traversal::Brute`] replaces the
 //! walk by a search of every piece the ray meets ([`brute`]: a BVH over the
-//! cells or tets, the same crossing predicate, no adjacency), the reference
+//! cells, each crossed whole or as its tets with the same crossing
+//! predicate, no adjacency), the reference
 //! for meshes whose adjacency cannot be trusted (`faces` and `tets` only).
 //! Field models:
 //! - [`FieldModel::Faces`] (default): entry and exit on the cell's face
