@@ -43,6 +43,8 @@ pub fn run() -> i32 {
     if let Command::Render(args) = &cli.command {
         if let Some(msg) = args.view.usage_error() {
             let mut cmd = Cli::command();
+            // Built, so that the subcommand's usage line reads `zoovr render`.
+            cmd.build();
             let e = match cmd.find_subcommand_mut("render") {
                 Some(render) => render.error(ErrorKind::ArgumentConflict, msg),
                 None => cmd.error(ErrorKind::ArgumentConflict, msg),
