@@ -7,7 +7,12 @@
 //! of `bench_tf.json` (extinction = opacity / 0.5, glow colour).
 //!
 //! `cargo bench --bench raycast` prints setup time and memory, then criterion
-//! timings per frame for faces/tets x perspective/ortho and native.
+//! timings per frame for faces/tets x perspective/ortho and native
+//! (`RAYCAST_BENCH_MODELS`, default `faces,tets,native`), then walk against
+//! brute-force traversal (`raycast_walk_vs_brute`: perspective, models
+//! `RAYCAST_BENCH_BRUTE_MODELS`, default `faces,tets`; the largest
+//! difference between the two images is printed). `RAYCAST_BENCH_SIZE`
+//! sets the image size (default 512).
 
 use std::time::Instant;
 
@@ -16,6 +21,7 @@ use glam::DVec3;
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::topology::Topology;
 use zoovr::mesh::{CellKind, Cells, Mesh};
+use zoovr::raycast::brute::Brute;
 use zoovr::raycast::{FieldModel, RaycastOptions, Raycaster, Scalars, Scene};
 use zoovr::tf::TransferFunction;
 
@@ -163,6 +169,21 @@ fn camera(mesh: &Mesh, ortho: bool, size: u32) -> Camera {
     Camera::fit(mesh.bounds(), &p)
 }
 
+fn bench_size() -> u32 {
+    std::env::var("RAYCAST_BENCH_SIZE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(512)
+}
+
+fn models(var: &str, default: &str) -> Vec<FieldModel> {
+    std::env::var(var)
+        .unwrap_or_else(|_| default.into())
+        .split(',')
+        .filter_map(|m| m.parse().ok())
+        .collect()
+}
+
 fn bench(c: &mut Criterion) {
     let t = Instant::now();
     let (mesh, f) = hex_shell();
@@ -180,18 +201,10 @@ fn bench(c: &mut Criterion) {
         scalars: Scalars::Point(&f),
     };
     let tf = TransferFunction::from_json_str(BENCH_TF, 0.5).expect("bench_tf");
-    let size: u32 = std::env::var("RAYCAST_BENCH_SIZE")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(512);
+    let size = bench_size();
     let mut g = c.benchmark_group("raycast_hex_shell");
     g.sample_size(10);
-    let models: Vec<FieldModel> = std::env::var("RAYCAST_BENCH_MODELS")
-        .unwrap_or_else(|_| "faces,tets,native".into())
-        .split(',')
-        .filter_map(|m| m.parse().ok())
-        .collect();
-    for model in models {
+    for model in models("RAYCAST_BENCH_MODELS", "faces,tets,native") {
         let t = Instant::now();
         let rc = Raycaster::new(scene, model).unwrap();
         eprintln!(
@@ -237,5 +250,71 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+/// Walk against brute force on the hex_shell scene (perspective view):
+/// setup, first-frame wall and CPU time, the largest pixel difference, and
+/// criterion timings per frame.
+fn walk_vs_brute(c: &mut Criterion) {
+    let list = models("RAYCAST_BENCH_BRUTE_MODELS", "faces,tets");
+    if list.is_empty() {
+        return;
+    }
+    let (mesh, f) = hex_shell();
+    let topology = Topology::build(&mesh.cells);
+    let scene = Scene {
+        mesh: &mesh,
+        topology: &topology,
+        scalars: Scalars::Point(&f),
+    };
+    let tf = TransferFunction::from_json_str(BENCH_TF, 0.5).expect("bench_tf");
+    let size = bench_size();
+    let cam = camera(&mesh, false, size);
+    let mut g = c.benchmark_group("raycast_walk_vs_brute");
+    g.sample_size(10);
+    for model in list {
+        let opts = RaycastOptions {
+            model,
+            ..Default::default()
+        };
+        let t = Instant::now();
+        let walk = Raycaster::new(scene, model).unwrap();
+        let walk_setup = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let brute = Brute::new(scene, model).unwrap();
+        eprintln!(
+            "{model:?}: setup walk {walk_setup:.2} s, brute {:.2} s ({} pieces, {:.1} MiB); peak RSS {:.0} MiB",
+            t.elapsed().as_secs_f64(),
+            brute.piece_count(),
+            brute.bytes() as f64 / 1048576.0,
+            peak_rss_mib()
+        );
+        let (t, cpu) = (Instant::now(), cpu_seconds());
+        let a = walk.render(&tf, &cam, &opts);
+        let (walk_s, walk_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - cpu);
+        let (t, cpu) = (Instant::now(), cpu_seconds());
+        let b = brute.render(&tf, &cam, &opts);
+        let (brute_s, brute_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - cpu);
+        let diff = a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .flat_map(|(p, q)| (0..4).map(move |k| (p[k] - q[k]).abs()))
+            .fold(0.0f32, f32::max);
+        let st = brute.stats();
+        eprintln!(
+            "{model:?} persp {size}: first frame walk {walk_s:.3} s wall / {walk_cpu:.2} s CPU, \
+             brute {brute_s:.3} s wall / {brute_cpu:.2} s CPU; max |walk - brute| {diff:e}; \
+             brute tested {} cells for {} segments ({} overlapping)",
+            st.cells_tested, st.segments, st.overlapping_segments
+        );
+        g.bench_function(format!("{model:?}_walk_{size}"), |bch| {
+            bch.iter(|| walk.render(&tf, &cam, &opts))
+        });
+        g.bench_function(format!("{model:?}_brute_{size}"), |bch| {
+            bch.iter(|| brute.render(&tf, &cam, &opts))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, walk_vs_brute);
 criterion_main!(benches);

@@ -4,7 +4,7 @@
 //! interpolated thickness, extinction, glow) and the ray caster's segments.
 //!
 //! ```sh
-//! cargo run --release --example pixel -- FILE I J [SIZE] [--ortho] [--azimuth A] [--elevation E] [--split]
+//! cargo run --release --example pixel -- FILE I J [WIDTH] [--height H] [--ortho] [--azimuth A] [--elevation E] [--zoom Z] [--split]
 //! ```
 
 use anyhow::{anyhow, Context as _, Result};
@@ -25,15 +25,17 @@ fn main() -> Result<()> {
             .context("pixel index")
     };
     let (i, j) = (num(1)?, num(2)?);
-    let size = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(512);
     let flag = |name: &str| -> Option<f64> {
         args.iter()
             .position(|a| a == name)
             .and_then(|k| args.get(k + 1)?.parse().ok())
     };
+    let size = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(512);
+    let height = flag("--height").map_or(size, |h| h as u32);
+
     let camera = CameraParams {
         width: size,
-        height: size,
+        height,
         ortho: args.iter().any(|a| a == "--ortho"),
         azimuth: flag("--azimuth").unwrap_or(0.0),
         elevation: flag("--elevation").unwrap_or(0.0),

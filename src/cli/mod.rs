@@ -6,7 +6,8 @@ mod compare;
 mod info;
 mod render;
 
-use clap::{Parser, Subcommand};
+use clap::error::ErrorKind;
+use clap::{CommandFactory, Parser, Subcommand};
 
 /// zoovr: exact volume rendering of unstructured and curvilinear zoo-cell grids.
 #[derive(Parser, Debug)]
@@ -39,6 +40,19 @@ pub fn run() -> i32 {
             return code;
         }
     };
+    if let Command::Render(args) = &cli.command {
+        if let Some(msg) = args.view.usage_error() {
+            let mut cmd = Cli::command();
+            // Built, so that the subcommand's usage line reads `zoovr render`.
+            cmd.build();
+            let e = match cmd.find_subcommand_mut("render") {
+                Some(render) => render.error(ErrorKind::ArgumentConflict, msg),
+                None => cmd.error(ErrorKind::ArgumentConflict, msg),
+            };
+            let _ = e.print();
+            return 2;
+        }
+    }
     let result = match cli.command {
         Command::Info(args) => info::run(&args),
         Command::Render(args) => render::run(&args),

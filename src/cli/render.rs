@@ -9,7 +9,7 @@ use clap::Args;
 use zoovr::camera::CameraParams;
 use zoovr::gpu::{AccumFormat, Backend, GpuOptions};
 use zoovr::io::{self, ReadOptions};
-use zoovr::raycast::FieldModel;
+use zoovr::raycast::{FieldModel, Traversal};
 use zoovr::render::{Mode, RenderOptions, RenderStats, Renderer, Scene, SceneSpec};
 
 use super::args::{parse_finite, parse_positive, parse_range, parse_rgb, parse_size};
@@ -71,6 +71,22 @@ pub struct ViewArgs {
     /// `--split all`.
     #[arg(long)]
     pub model: Option<FieldModel>,
+    /// How the ray caster finds the cells along each ray: walk (default) or
+    /// brute.
+    ///
+    /// `walk` goes from cell to cell across shared faces (face adjacency).
+    /// `brute` ignores adjacency: it tests every cell whose bounding box the
+    /// ray meets (a bounding volume hierarchy), whole (`--model faces`) or
+    /// as its consistent tets (`--model tets`), with the walk's exact
+    /// crossing test, and composites all their segments in depth order;
+    /// where pieces overlap, their extinctions add. On a conforming mesh both give the
+    /// same image (to rounding); brute force is slower and is the
+    /// reference where adjacency cannot be trusted: non-conforming faces
+    /// that only partly overlap (faults in corner-point grids, hanging
+    /// nodes), overlapping or duplicated cells, duplicated points. Not
+    /// available with `--model native`.
+    #[arg(long)]
+    pub traversal: Option<Traversal>,
     /// `--split all`: draw every cell as its consistent tetrahedra.
     #[arg(long, value_parser = ["all"])]
     pub split: Option<String>,
@@ -119,6 +135,7 @@ impl ViewArgs {
             },
             mode: self.mode,
             model: self.model.unwrap_or_default(),
+            traversal: self.traversal.unwrap_or_default(),
             split_all: self.split.is_some(),
             gpu: GpuOptions {
                 backend: self.backend,
@@ -127,6 +144,18 @@ impl ViewArgs {
             accum: AccumFormat::Auto,
             ..Default::default()
         }
+    }
+
+    /// Flag combinations that are usage errors (beyond what clap checks).
+    pub fn usage_error(&self) -> Option<String> {
+        if self.traversal == Some(Traversal::Brute) && self.model == Some(FieldModel::Native) {
+            return Some(
+                "--traversal brute supports --model faces and --model tets, not --model native \
+                 (the native model's cells are bounded by bilinear patches, not triangles)"
+                    .into(),
+            );
+        }
+        None
     }
 
     /// Reads the file and builds the scene.
@@ -224,10 +253,19 @@ pub fn print_stats(stats: &RenderStats, load_s: f64) {
     }
     if let Some(r) = &stats.raycast {
         eprintln!(
-            "raycast      model {}, early ray termination below transmittance {:e}",
+            "raycast      model {}, traversal {}, early ray termination below transmittance {:e}",
             r.model.name(),
+            r.traversal.name(),
             r.termination_transmittance
         );
+        if r.traversal == Traversal::Brute {
+            let b = &r.brute;
+            eprintln!(
+                "brute        {} cells tested, {} segments, {} of them overlapping another \
+                 piece's in depth",
+                b.cells_tested, b.segments, b.overlapping_segments
+            );
+        }
         if r.model == FieldModel::Native {
             let n = &r.native;
             eprintln!(
@@ -269,6 +307,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
              (`--model tets` integrates the consistent tets)"
         ),
         _ => {}
+    }
+    if opts.mode == Mode::Exact && args.view.traversal.is_some() {
+        eprintln!(
+            "zoovr: note: --traversal is the ray caster's (--mode raycast); the exact mode \
+             projects every cell"
+        );
     }
     let (image, stats) = renderer
         .render(&opts, progress_bar("rendering"))

@@ -175,3 +175,12 @@ pub const BSP_SLIVER_REL: f64 = 1e-12;
 /// Treating points 1e-10 of the size away as on the plane moves a cut by at
 /// most that much: invisible at any image resolution.
 pub const BSP_ON_PLANE_REL: f64 = 1e-10;
+
+/// Brute-force ray traversal (`raycast::brute`): a segment that starts less
+/// than this fraction of the bounds diagonal before the segments ahead of
+/// it end is not counted as overlapping in its statistics. Two pieces that
+/// meet at one point (a ray through an edge or vertex) cross it through
+/// different triangles, whose depths round differently (~1e-16), so they
+/// overlap by that much without overlapping in space. Only the count uses
+/// this; the compositing splits every overlap exactly.
+pub const BRUTE_OVERLAP_REPORT_REL: f64 = 1e-9;

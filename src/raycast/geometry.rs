@@ -129,6 +129,35 @@ impl RayFrame {
         }
     }
 
+    /// The sides of the ray a projected vertex is clearly on, as bits: 1
+    /// for `x > 0`, 2 for `x < 0`, 4 for `y > 0`, 8 for `y < 0`, 16 for
+    /// `x + y > 0`, 32 for `x + y < 0`, 64 for `x - y > 0`, 128 for
+    /// `x - y < 0`; each set only when the value exceeds four times the
+    /// filter's error bound at the vertex's distance (twice that for the
+    /// sums), so that the vertex is on that side of a plane through the
+    /// exact line (`o`, `q`). When every vertex of a polyhedron shares a
+    /// bit, the line crosses none of its triangles (under any perturbation),
+    /// so [`RayFrame::crossing`] need not be asked.
+    #[inline]
+    pub fn clear_sides(&self, p: &Proj) -> u8 {
+        let m2 = 16.0 * self.bound2 * p.n2;
+        let side = |v: f64, m2: f64, pos: u8| {
+            if v * v > m2 {
+                if v > 0.0 {
+                    pos
+                } else {
+                    pos << 1
+                }
+            } else {
+                0
+            }
+        };
+        side(p.x, m2, 1)
+            | side(p.y, m2, 4)
+            | side(p.x + p.y, 4.0 * m2, 16)
+            | side(p.x - p.y, 4.0 * m2, 64)
+    }
+
     /// Signed Plücker value of edge `a -> b` (point ids `ia`, `ib`): its sign
     /// is the exact, symbolically perturbed sign; its magnitude the floating
     /// value (tiny when the exact predicate had to decide). 0 only for

@@ -1,11 +1,16 @@
-//! The reference software ray caster (issue 4).
+//! The reference software ray caster.
 //!
 //! One ray per pixel centre ([`Camera::pixel_ray`]), walked through the cells
 //! it crosses by face adjacency ([`walk`]), with exact crossing decisions and
 //! a documented tie-breaking rule ([`geometry`]: simulation of simplicity on
 //! the ray's origin, canonical edge orientation by point id). Each cell
 //! segment is integrated exactly for the chosen [`FieldModel`] and composited
-//! front to back in a [`RayAccumulator`]:
+//! front to back in a [`RayAccumulator`]. [`Traversal::Brute`] replaces the
+//! walk by a search of every piece the ray meets ([`brute`]: a BVH over the
+//! cells, each crossed whole or as its tets with the same crossing
+//! predicate, no adjacency), the reference
+//! for meshes whose adjacency cannot be trusted (`faces` and `tets` only).
+//! Field models:
 //! - [`FieldModel::Faces`] (default): entry and exit on the cell's face
 //!   triangles, the scalar linear on each triangle (barycentric) and along the
 //!   ray, integrated by `material.segment(l, s_in, s_out)`;
@@ -47,6 +52,7 @@
 //! tiles (rayon) with early termination at transmittance
 //! [`RAY_TERMINATION_TRANSMITTANCE`] (`RaycastOptions::early_termination`).
 
+pub mod brute;
 pub mod bvh;
 pub mod geometry;
 pub mod native;
@@ -56,6 +62,7 @@ use std::borrow::Cow;
 
 use std::collections::HashSet;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::mpsc;
 
 use rayon::prelude::*;
 use thiserror::Error;
@@ -102,10 +109,46 @@ impl std::str::FromStr for FieldModel {
     }
 }
 
+/// How the ray caster finds the pieces along a ray.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Traversal {
+    /// From cell to cell by face adjacency ([`walk`]; [`Raycaster`]).
+    #[default]
+    Walk,
+    /// Every cell or tet the ray meets, through a BVH, without adjacency
+    /// ([`brute`]; [`brute::Brute`]); `faces` and `tets` only.
+    Brute,
+}
+
+impl Traversal {
+    /// The name `--traversal` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Traversal::Walk => "walk",
+            Traversal::Brute => "brute",
+        }
+    }
+}
+
+impl std::str::FromStr for Traversal {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "walk" => Ok(Traversal::Walk),
+            "brute" => Ok(Traversal::Brute),
+            _ => Err(format!("unknown traversal '{s}' (walk, brute)")),
+        }
+    }
+}
+
 /// Ray caster options.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RaycastOptions {
     pub model: FieldModel,
+    /// Walk by adjacency (default) or test every piece ([`Traversal`]);
+    /// used by [`render`] and [`trace_ray`] (a prepared [`Raycaster`]
+    /// always walks).
+    pub traversal: Traversal,
     /// A ray stops when its transmittance drops below this (default
     /// [`RAY_TERMINATION_TRANSMITTANCE`] = 1e-6); 0 disables it.
     pub early_termination: f64,
@@ -117,6 +160,7 @@ impl Default for RaycastOptions {
     fn default() -> Self {
         RaycastOptions {
             model: FieldModel::Faces,
+            traversal: Traversal::Walk,
             early_termination: RAY_TERMINATION_TRANSMITTANCE,
             tile: 16,
         }
@@ -168,6 +212,8 @@ pub enum RaycastError {
     NonFinitePoint(usize),
     #[error("the topology does not belong to this mesh ({0} cells vs {1})")]
     TopologyMismatch(usize, usize),
+    #[error("the brute-force traversal supports the `faces` and `tets` models, not `{0}`")]
+    BruteModel(&'static str),
 }
 
 /// One cell's part of a ray (front to back), as integrated.
@@ -584,11 +630,7 @@ impl<'a> Raycaster<'a> {
         scratch: &mut Scratch,
     ) -> RayAccumulator {
         let mut acc = RayAccumulator::default();
-        let stop_depth = if opts.early_termination > 0.0 {
-            -opts.early_termination.ln()
-        } else {
-            f64::INFINITY
-        };
+        let stop_depth = stop_depth(opts);
         if self.model == FieldModel::Native {
             if let Some(acc) = self.trace_native(material, ray, t_near, stop_depth, scratch) {
                 return acc;
@@ -619,58 +661,99 @@ impl<'a> Raycaster<'a> {
         material: &M,
         camera: &Camera,
         opts: &RaycastOptions,
-        mut progress: impl FnMut(usize, usize),
+        progress: impl FnMut(usize, usize),
     ) -> Image {
-        let (w, h) = (camera.width, camera.height);
-        let tile = opts.tile.max(1);
-        let tiles_x = w.div_ceil(tile);
-        let tiles_y = h.div_ceil(tile);
-        let total = (tiles_x * tiles_y) as usize;
-        let t_near = if camera.ortho { 0.0 } else { camera.near };
-        let done = AtomicUsize::new(0);
-        let trace_tiles = || -> Vec<(u32, u32, Vec<[f32; 4]>)> {
-            (0..tiles_x * tiles_y)
-                .into_par_iter()
-                .map_init(Scratch::default, |scratch, k| {
-                    let (tx, ty) = (k % tiles_x, k / tiles_x);
-                    let mut px = Vec::with_capacity((tile * tile) as usize);
-                    for j in ty * tile..((ty + 1) * tile).min(h) {
-                        for i in tx * tile..((tx + 1) * tile).min(w) {
-                            let ray = camera.pixel_ray(i, j);
-                            px.push(self.trace(material, &ray, t_near, opts, scratch).rgba());
-                        }
+        render_tiles(
+            camera,
+            opts,
+            progress,
+            |ray, t_near, scratch: &mut Scratch| {
+                self.trace(material, ray, t_near, opts, scratch).rgba()
+            },
+        )
+    }
+}
+
+/// The optical depth at which a ray stops (`opts.early_termination`).
+fn stop_depth(opts: &RaycastOptions) -> f64 {
+    if opts.early_termination > 0.0 {
+        -opts.early_termination.ln()
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The parallel render loop of both traversals: `opts.tile`-square tiles
+/// traced on the rayon pool (one scratch `S` per worker) by
+/// `trace(ray, t_near, scratch)`, with `t_near` the near plane (0 for
+/// orthographic cameras); `progress(done, total)` (in tiles) is called from
+/// the calling thread about ten times a second and once at the end.
+fn render_tiles<S: Default + Send>(
+    camera: &Camera,
+    opts: &RaycastOptions,
+    mut progress: impl FnMut(usize, usize),
+    trace: impl Fn(&Ray, f64, &mut S) -> [f32; 4] + Sync,
+) -> Image {
+    let (w, h) = (camera.width, camera.height);
+    let tile = opts.tile.max(1);
+    let tiles_x = w.div_ceil(tile);
+    let tiles_y = h.div_ceil(tile);
+    let total = (tiles_x * tiles_y) as usize;
+    let t_near = if camera.ortho { 0.0 } else { camera.near };
+    let done = AtomicUsize::new(0);
+    let trace_tiles = || -> Vec<(u32, u32, Vec<[f32; 4]>)> {
+        (0..tiles_x * tiles_y)
+            .into_par_iter()
+            .map_init(S::default, |scratch, k| {
+                let (tx, ty) = (k % tiles_x, k / tiles_x);
+                let mut px = Vec::with_capacity((tile * tile) as usize);
+                for j in ty * tile..((ty + 1) * tile).min(h) {
+                    for i in tx * tile..((tx + 1) * tile).min(w) {
+                        let ray = camera.pixel_ray(i, j);
+                        px.push(trace(&ray, t_near, scratch));
                     }
-                    done.fetch_add(1, Ordering::Relaxed);
-                    (tx, ty, px)
-                })
-                .collect()
-        };
-        let tiles = std::thread::scope(|scope| {
-            let worker = scope.spawn(trace_tiles);
-            while !worker.is_finished() {
-                progress(done.load(Ordering::Relaxed), total);
-                std::thread::sleep(std::time::Duration::from_millis(100));
-            }
-            worker.join()
+                }
+                done.fetch_add(1, Ordering::Relaxed);
+                (tx, ty, px)
+            })
+            .collect()
+    };
+    // The tiles are traced on another thread; this one reports progress
+    // every 100 ms until they arrive (at once when they are done).
+    let tiles = std::thread::scope(|scope| {
+        let (tx, rx) = mpsc::channel();
+        let worker = scope.spawn(move || {
+            let _ = tx.send(trace_tiles());
         });
-        let tiles = match tiles {
-            Ok(t) => t,
-            Err(panic) => std::panic::resume_unwind(panic),
-        };
-        progress(total, total);
-        let mut img = Image::new(w, h);
-        for (tx, ty, px) in tiles {
-            let mut it = px.into_iter();
-            for j in ty * tile..((ty + 1) * tile).min(h) {
-                for i in tx * tile..((tx + 1) * tile).min(w) {
-                    if let Some(p) = it.next() {
-                        img.set(i, j, p);
+        loop {
+            match rx.recv_timeout(std::time::Duration::from_millis(100)) {
+                Ok(tiles) => return tiles,
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    progress(done.load(Ordering::Relaxed), total)
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    // The worker panicked before sending: pass the panic on.
+                    if let Err(panic) = worker.join() {
+                        std::panic::resume_unwind(panic);
                     }
+                    return Vec::new();
                 }
             }
         }
-        img
+    });
+    progress(total, total);
+    let mut img = Image::new(w, h);
+    for (tx, ty, px) in tiles {
+        let mut it = px.into_iter();
+        for j in ty * tile..((ty + 1) * tile).min(h) {
+            for i in tx * tile..((tx + 1) * tile).min(w) {
+                if let Some(p) = it.next() {
+                    img.set(i, j, p);
+                }
+            }
+        }
     }
+    img
 }
 
 /// Renders `scene` through `camera` (validates and prepares the scene, then
@@ -681,7 +764,10 @@ pub fn render<M: RayMaterial>(
     camera: &Camera,
     opts: &RaycastOptions,
 ) -> Result<Image, RaycastError> {
-    Ok(Raycaster::new(*scene, opts.model)?.render(material, camera, opts))
+    Ok(match opts.traversal {
+        Traversal::Walk => Raycaster::new(*scene, opts.model)?.render(material, camera, opts),
+        Traversal::Brute => brute::Brute::new(*scene, opts.model)?.render(material, camera, opts),
+    })
 }
 
 /// Integrates one ray (from its origin on) through `scene`.
@@ -691,6 +777,14 @@ pub fn trace_ray<M: RayMaterial>(
     ray: &Ray,
     opts: &RaycastOptions,
 ) -> Result<RayAccumulator, RaycastError> {
-    let rc = Raycaster::new(*scene, opts.model)?;
-    Ok(rc.trace(material, ray, 0.0, opts, &mut Scratch::default()))
+    Ok(match opts.traversal {
+        Traversal::Walk => {
+            let rc = Raycaster::new(*scene, opts.model)?;
+            rc.trace(material, ray, 0.0, opts, &mut Scratch::default())
+        }
+        Traversal::Brute => {
+            let b = brute::Brute::new(*scene, opts.model)?;
+            b.trace(material, ray, 0.0, opts, &mut Default::default())
+        }
+    })
 }

@@ -7,7 +7,9 @@
 //! image. Modes:
 //! - [`Mode::Exact`]: projection of convex pieces with exact vertex integrals,
 //!   composited by wgpu ([`exact`]);
-//! - [`Mode::Raycast`]: the CPU reference ray caster ([`crate::raycast`]).
+//! - [`Mode::Raycast`]: the CPU reference ray caster ([`crate::raycast`]),
+//!   walking by adjacency or, with [`Traversal::Brute`], testing every
+//!   piece ([`crate::raycast::brute`]).
 
 pub mod exact;
 mod group;
@@ -20,7 +22,8 @@ use thiserror::Error;
 use crate::camera::{Camera, CameraParams};
 use crate::gpu::{AccumFormat, Context, DrawKind, GpuError, GpuOptions, PendingContext};
 use crate::image::Image;
-use crate::raycast::{self, FieldModel, RaycastOptions, Raycaster};
+use crate::raycast::brute::{Brute, BruteStats};
+use crate::raycast::{self, FieldModel, RaycastOptions, Raycaster, Traversal};
 use crate::visibility::{Sorter, VisibilityError};
 
 pub use exact::ExactStats;
@@ -96,6 +99,9 @@ pub struct RenderOptions {
     pub mode: Mode,
     /// Field model of the ray caster.
     pub model: FieldModel,
+    /// How the ray caster finds the pieces along a ray (walk by adjacency,
+    /// or brute force: `faces` and `tets` only).
+    pub traversal: Traversal,
     /// `--split all`: every cell drawn as its consistent tets.
     pub split_all: bool,
     pub gpu: GpuOptions,
@@ -130,6 +136,7 @@ impl Default for RenderOptions {
             camera: CameraParams::default(),
             mode: Mode::Exact,
             model: FieldModel::Faces,
+            traversal: Traversal::Walk,
             split_all: false,
             gpu: GpuOptions::default(),
             accum: AccumFormat::Auto,
@@ -156,12 +163,16 @@ pub struct RenderStats {
 #[derive(Clone, Copy, Debug)]
 pub struct RaycastStats {
     pub model: FieldModel,
+    pub traversal: Traversal,
     /// Rays stop once their transmittance falls below this (0: never), so
     /// a pixel's opacity may fall short of the full integral by at most it.
     pub termination_transmittance: f64,
     /// Native model: intervals integrated and what fell back from the
     /// exact method during this render (zero for other models).
     pub native: crate::raycast::native::NativeStats,
+    /// Brute-force traversal: pieces tested, segments, and segments that
+    /// overlapped another piece's (zero for the walk).
+    pub brute: BruteStats,
 }
 
 /// Reusable state for rendering many views of one scene.
@@ -171,6 +182,7 @@ pub struct Renderer<'s> {
     gpu: Option<Context>,
     pending_gpu: Option<PendingContext>,
     raycaster: Option<(FieldModel, Raycaster<'s>)>,
+    brute: Option<(FieldModel, Brute<'s>)>,
 }
 
 impl<'s> Renderer<'s> {
@@ -182,6 +194,7 @@ impl<'s> Renderer<'s> {
             gpu: None,
             pending_gpu: None,
             raycaster: None,
+            brute: None,
         }
     }
 
@@ -255,35 +268,55 @@ impl<'s> Renderer<'s> {
                 img
             }
             Mode::Raycast => {
-                let rc = match self.raycaster.take() {
-                    Some((m, rc)) if m == opts.model => rc,
-                    _ => {
-                        let scalars = match scene.scalars() {
-                            ScalarsRef::Point(v) => raycast::Scalars::Point(v),
-                            ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
-                            ScalarsRef::Constant(c) => raycast::Scalars::Constant(c),
-                        };
-                        let rs = raycast::Scene {
-                            mesh: &scene.mesh,
-                            topology: &scene.topology,
-                            scalars,
-                        };
-                        Raycaster::new(rs, opts.model)?
-                    }
+                let scalars = match scene.scalars() {
+                    ScalarsRef::Point(v) => raycast::Scalars::Point(v),
+                    ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
+                    ScalarsRef::Constant(c) => raycast::Scalars::Constant(c),
                 };
-                stats.setup_s = t0.elapsed().as_secs_f64();
+                let rs = raycast::Scene {
+                    mesh: &scene.mesh,
+                    topology: &scene.topology,
+                    scalars,
+                };
                 let ro = RaycastOptions {
                     model: opts.model,
+                    traversal: opts.traversal,
                     ..Default::default()
                 };
-                let before = rc.native_stats();
-                let img = rc.render_with_progress(&scene.tf, &camera, &ro, progress);
-                stats.raycast = Some(RaycastStats {
+                let mut rstats = RaycastStats {
                     model: opts.model,
+                    traversal: opts.traversal,
                     termination_transmittance: ro.early_termination,
-                    native: rc.native_stats().since(&before),
-                });
-                self.raycaster = Some((opts.model, rc));
+                    native: Default::default(),
+                    brute: Default::default(),
+                };
+                let img = match opts.traversal {
+                    Traversal::Walk => {
+                        let rc = match self.raycaster.take() {
+                            Some((m, rc)) if m == opts.model => rc,
+                            _ => Raycaster::new(rs, opts.model)?,
+                        };
+                        stats.setup_s = t0.elapsed().as_secs_f64();
+                        let before = rc.native_stats();
+                        let img = rc.render_with_progress(&scene.tf, &camera, &ro, progress);
+                        rstats.native = rc.native_stats().since(&before);
+                        self.raycaster = Some((opts.model, rc));
+                        img
+                    }
+                    Traversal::Brute => {
+                        let b = match self.brute.take() {
+                            Some((m, b)) if m == opts.model => b,
+                            _ => Brute::new(rs, opts.model)?,
+                        };
+                        stats.setup_s = t0.elapsed().as_secs_f64();
+                        let before = b.stats();
+                        let img = b.render_with_progress(&scene.tf, &camera, &ro, progress);
+                        rstats.brute = b.stats().since(&before);
+                        self.brute = Some((opts.model, b));
+                        img
+                    }
+                };
+                stats.raycast = Some(rstats);
                 img
             }
         };
