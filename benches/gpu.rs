@@ -31,7 +31,7 @@ fn scene(count: usize, size: u32) -> Vec<ExactVertex> {
     let mut r = Rng(0x5eed_1234);
     let m = ClipMapper::new(size, size, false);
     let mut v = Vec::with_capacity(3 * count);
-    for _ in 0..count {
+    for piece in 0..count {
         let cx = r.f64() * size as f64;
         let cy = r.f64() * size as f64;
         let s = 1.0 + 5.0 * r.f64();
@@ -45,7 +45,8 @@ fn scene(count: usize, size: u32) -> Vec<ExactVertex> {
                     1.0 + r.f64(),
                 )
                 .unwrap_or([0.0, 0.0, 0.5, 1.0]);
-            v.push(ExactVertex::new(p, r.f64() as f32, tau, glow));
+            // Every triangle a piece of its own (all are blended).
+            v.push(ExactVertex::new(p, r.f64() as f32, tau, glow).with_piece(piece as u32));
         }
     }
     v

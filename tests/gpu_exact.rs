@@ -186,8 +186,10 @@ fn thin_layers_on(ctx: &Context, backend: Backend) {
         let mut frame = ctx
             .begin_frame_with(&FrameOptions::new(w, h, format))
             .unwrap();
-        for _ in 0..n {
-            frame.push_triangles(&quad, &[0, 1, 2, 2, 1, 3]).unwrap();
+        // Each layer is a piece of its own (one piece colours a pixel once).
+        for layer in 0..n {
+            let q: Vec<ExactVertex> = quad.iter().map(|v| v.with_piece(layer as u32)).collect();
+            frame.push_triangles(&q, &[0, 1, 2, 2, 1, 3]).unwrap();
         }
         let img = frame.finish().unwrap();
         let (mut err_exact, mut err_acc) = (0.0f64, 0.0f64);
@@ -310,14 +312,13 @@ fn no_nan_on_triangles_crossing_the_edge_with_different_w() {
             ((900.0, -200.0), (600.0, 900.0), 5.0),
             ((400.0, 800.0), (-400.0, 500.0), 0.5),
         ];
-        for &(a, b, zb) in &far {
+        // Each triangle is its own piece (overlapping layers).
+        for (piece, &(a, b, zb)) in far.iter().enumerate() {
             for (p, z) in [((16.0, 16.0), 0.01), (a, 1000.0), (b, zb)] {
-                verts.push(ExactVertex::new(
-                    m.clip(p.0, p.1, z).unwrap(),
-                    1.0,
-                    0.5,
-                    [0.3, 0.6, 0.9],
-                ));
+                verts.push(
+                    ExactVertex::new(m.clip(p.0, p.1, z).unwrap(), 1.0, 0.5, [0.3, 0.6, 0.9])
+                        .with_piece(piece as u32),
+                );
             }
         }
         let idx: Vec<u32> = (0..verts.len() as u32).collect();
