@@ -1,5 +1,5 @@
 //! Benchmarks of the exact segment integral and the pre-integration table
-//! fills (issue 3). Fixed seeds; transfer functions built in code (the
+//! fills. Fixed seeds; transfer functions built in code (the
 //! default viridis/ramp TF over [0, 1] and a 7-node TF with a jump).
 //!
 //! `cargo bench --bench integrate`. Per-segment figures: the batch benches

@@ -1,4 +1,4 @@
-//! Load + topology benchmarks (issue 2): a generated warped 100^3 (1M) hex
+//! Load + topology benchmarks: a generated warped 100^3 (1M) hex
 //! grid in memory (`generate::warped_hex_grid(100, Warp::default())`, seed 1),
 //! the same grid read back from a zlib `.vtu` written to a temp dir, and
 //! `../shared/data/bluntfin/bluntfin_converted.vts` when present and

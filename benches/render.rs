@@ -1,4 +1,4 @@
-//! The exact mode end to end (issue 7): bluntfin (default field and TF), the
+//! The exact mode end to end: bluntfin (default field and TF), the
 //! hex_shell scene of `../shared/data/synthetic/README.md` (bench_tf.json,
 //! azimuth 20, elevation 35, zoom 1.25, perspective) and the generated
 //! 1M-hex grid, at 512^2 and 1024^2, on every backend present (Vulkan

@@ -1,6 +1,6 @@
 //! The camera, identical to vtkCamera + vtkRenderer::ResetCamera.
 //!
-//! Construction follows VTK exactly (the contract in DESIGN.md, Conventions):
+//! Construction follows VTK exactly (the contract in docs/conventions.md, Conventions):
 //! 1. start looking down -Z with +Y up;
 //! 2. ResetCamera: focal point = bounds centre, radius = half the bounds
 //!    diagonal, distance = radius / sin(view_angle / 2) (view angle vertical,

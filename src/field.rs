@@ -2,7 +2,7 @@
 //!
 //! [`DataArray`] keeps the values as the file stored them (`f32` and `f64`
 //! without loss, integers widened to `i64`). [`select_field`] turns a
-//! `--field` request (or its absence: the default-field rule of DESIGN.md) into
+//! `--field` request (or its absence: the default-field rule of docs/conventions.md) into
 //! a [`ScalarField`]: one `f64` per point or per cell, with its range.
 //!
 //! The default-field rule passes over VTK's bookkeeping arrays
@@ -298,7 +298,7 @@ pub fn finite_range(values: &[f64]) -> (f64, f64) {
 }
 
 /// Selects the scalar field: the named one, or by the default rule of
-/// DESIGN.md when `spec` is `None`. Returns `Ok(None)` when the mesh has no
+/// docs/conventions.md when `spec` is `None`. Returns `Ok(None)` when the mesh has no
 /// usable array (render the geometry with a constant scalar).
 pub fn select_field(
     mesh: &Mesh,

@@ -1,6 +1,6 @@
 //! Images: linear premultiplied RGBA `f32`, PNG/EXR output and comparison.
 //!
-//! Every renderer produces an [`Image`]. PNG output follows DESIGN.md:
+//! Every renderer produces an [`Image`]. PNG output follows docs/conventions.md:
 //! 8-bit RGB of the premultiplied colour composited over the background,
 //! written linearly (no sRGB curve); with `alpha`, RGBA with straight alpha.
 //! Float output is OpenEXR (RGBA f32, linear premultiplied). Files are written
@@ -67,7 +67,7 @@ impl Image {
             .count()
     }
 
-    /// Display values in [0, 1] per DESIGN.md: RGB over `background`, or
+    /// Display values in [0, 1] per docs/conventions.md: RGB over `background`, or
     /// straight-alpha RGBA when `alpha` is set. Values are clamped, not gamma
     /// encoded. Returns 3 or 4 channels per pixel.
     pub fn display_values(&self, background: [f32; 3], alpha: bool) -> Vec<f32> {
@@ -93,7 +93,7 @@ impl Image {
         out
     }
 
-    /// 8-bit PNG bytes per DESIGN.md.
+    /// 8-bit PNG bytes per docs/conventions.md.
     pub fn to_png_bytes(&self, background: [f32; 3], alpha: bool) -> Vec<u8> {
         self.display_values(background, alpha)
             .iter()

@@ -4,7 +4,7 @@
 //! meshes` from `zoovr::generate`; every expected value here is computed
 //! independently in memory from the same generator (or by hand for the
 //! degenerate cells), so these tests check the readers and `info` together.
-//! They need the legacy and XML readers (issue 2).
+//! They need the legacy and XML readers.
 
 use std::path::Path;
 use std::process::{Command, Output};

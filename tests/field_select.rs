@@ -1,4 +1,4 @@
-//! The default-field rule of DESIGN.md (Conventions), `--field` selection and
+//! The default-field rule of docs/conventions.md (Conventions), `--field` selection and
 //! `--cell-to-point` averaging, on small hand-built meshes and real data.
 
 use zoovr::field::{

@@ -1,4 +1,4 @@
-//! VTK XML readers and time collections (issue 2).
+//! VTK XML readers and time collections.
 //!
 //! - Real files from `../shared/data` (skipped when absent): counts from the
 //!   data README, and every array's range checked against the

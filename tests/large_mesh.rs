@@ -1,4 +1,4 @@
-//! A generated 5M-cell mesh through the exact mode at 512 x 512 (issue 8):
+//! A generated 5M-cell mesh through the exact mode at 512 x 512:
 //! streamed in GPU batches, bounded memory, no NaN. Too slow for CI (about
 //! two minutes on 2 cores); run it by hand:
 //! `cargo test --release --test large_mesh -- --ignored --nocapture`.

@@ -1,7 +1,7 @@
 //! `MeshReport` on the shared real datasets against the numbers in
 //! `../shared/data/README.md` (cells, "neg" = inverted cells in VTK node
 //! order, "vol/hull" to 0.01). Skips cleanly when the data is absent; needs
-//! the legacy and XML readers (issue 2). can_crush's distorted hexahedra give
+//! the legacy and XML readers. can_crush's distorted hexahedra give
 //! inverted consistent tets: counted, never a failure.
 
 use zoovr::io::{read, ReadOptions};

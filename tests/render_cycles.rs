@@ -1,10 +1,10 @@
-//! Visibility cycles that no order of whole pieces resolves (issue 5): three
+//! Visibility cycles that no order of whole pieces resolves: three
 //! interlocked tetrahedra ([`generate::interlocked_tets`]) each in front of
 //! the next where they cross. The sorter cuts them by planes through their
 //! faces into fragments that have an order; without the cuts it reports
 //! them as a group, which the exact mode composites per pixel on the CPU.
 //! Either way the image must match the ray caster as tightly as anywhere
-//! (issue 7's bounds); drawing the three tets in any fixed order puts one
+//! (the bounds of `tests/render_exact.rs`); drawing the three tets in any fixed order puts one
 //! crossing the wrong way round (measured 0.27).
 
 use zoovr::camera::{Camera, CameraParams};

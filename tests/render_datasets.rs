@@ -1,4 +1,4 @@
-//! Issue 7, across the data and the backends: every dataset in
+//! The exact mode across the data and the backends: every dataset in
 //! `../shared/data` renders in the exact mode at 256 x 256 with the CLI's
 //! defaults (field, transfer function, camera) and no NaN; a full render of a
 //! mesh agrees between Vulkan and GL with the same accumulation format

@@ -1,4 +1,4 @@
-//! Numerical stress scenes (issue 8): generated meshes in the corners of the
+//! Numerical stress scenes: generated meshes in the corners of the
 //! domain, each rendered in every mode that exists (exact whole cells, exact
 //! `--split all`, ray caster `faces` and `tets`), with no NaN/Inf and the
 //! exact mode within the bounds of `tests/render_exact.rs` against the ray
@@ -21,7 +21,7 @@ use zoovr::raycast::FieldModel;
 use zoovr::render::{Mode, RenderOptions, Renderer, Scene, SceneSpec};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
-/// Issue 7's bounds on 99.9 % of pixels, isolated edge pixels up to
+/// Bounds on 99.9 % of pixels, isolated edge pixels up to
 /// `OUTLIER_MAX` (as in `tests/render_exact.rs`).
 const P999: f64 = 1e-2;
 const RMS: f64 = 2e-3;
@@ -80,7 +80,7 @@ struct Case<'a> {
     range: (f64, f64),
     tau_max: f64,
     views: Vec<View>,
-    /// A known gap of the exact mode (issue 8 note): the comparison is
+    /// A known gap of the exact mode (documented where the case is defined): the comparison is
     /// measured and printed, and only non-finite pixels fail.
     gap: Option<&'a str>,
 }
@@ -455,7 +455,7 @@ fn eye_inside_a_constant_block_matches_the_closed_form() {
     }
 }
 
-/// Geometry faults (issue 8) in one file: an inverted hexahedron and wedge,
+/// Geometry faults in one file: an inverted hexahedron and wedge,
 /// a flat (zero-volume) hexahedron, a tetrahedron with a repeated index,
 /// five disconnected components, a non-manifold face and coincident points
 /// (merged). Every mode renders it without NaN, and the exact mode matches
@@ -493,7 +493,7 @@ fn geometry_faults_render_consistently() {
     }
 }
 
-/// Watertightness through the GPU (issue 6): a warped block of many cells
+/// Watertightness through the GPU: a warped block of many cells
 /// (nonplanar faces, problem cells split per view) with constant extinction
 /// and colour. Every pixel's opacity is `1 - exp(-tau L)` for the ray's
 /// chord `L` through the block, which the ray caster computes exactly; a

@@ -2,7 +2,7 @@
 //!
 //! Two EXR files are compared on their float values (linear premultiplied
 //! RGBA); anything else on PNG display values (RGB over black in [0, 1],
-//! DESIGN.md "Images"). Prints the maximum absolute difference (and where),
+//! docs/conventions.md "Images"). Prints the maximum absolute difference (and where),
 //! the RMS over pixels and channels and the PSNR for a peak of 1.
 
 use std::path::{Path, PathBuf};

@@ -2,7 +2,7 @@
 //! bounds, arrays with types and ranges, time steps) and the structure and
 //! quality facts of [`MeshReport`] (boundary faces, components, convexity,
 //! inverted / degenerate cells, nonplanar faces, inverted consistent tets).
-//! The JSON keys are a contract (DESIGN.md, Conventions); the text output
+//! The JSON keys are a contract (docs/conventions.md, Conventions); the text output
 //! prints the same values. `hidden_cells` and `duplicate_cells` count the
 //! cells a `vtkGhostType` cell array flags (0 without one); the text output
 //! prints them only when the array exists.

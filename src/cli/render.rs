@@ -19,7 +19,7 @@ use super::args::{parse_finite, parse_positive, parse_range, parse_rgb, parse_si
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
     /// Field to render: NAME, point:NAME or cell:NAME, with :mag, :x, :y, :z or
-    /// :N for vectors. Default: the DESIGN.md default-field rule.
+    /// :N for vectors. Default: the docs/conventions.md default-field rule.
     #[arg(long)]
     pub field: Option<String>,
     /// Transfer-function file: zoovr JSON or a ParaView colour map (absolute

@@ -25,7 +25,7 @@
 //!    256 bytes, in chunks no larger than the adapter allows), maps it, waits
 //!    with a poll loop that tolerates GL's `Timeout`, and converts f16 -> f32.
 //!
-//! Conventions (DESIGN.md): pixel `(i, j)` samples its centre
+//! Conventions (docs/conventions.md): pixel `(i, j)` samples its centre
 //! `(i + 0.5, j + 0.5)`, row 0 at the top; [`ClipMapper`] turns continuous
 //! pixel coordinates into clip space so that the rasteriser samples exactly
 //! those points. Ties (a pixel centre exactly on a shared edge) follow the

@@ -1,4 +1,4 @@
-//! Exact Williams-Max segment integrals and pre-integration tables (issue 3).
+//! Exact Williams-Max segment integrals and pre-integration tables.
 //!
 //! The interface every renderer uses is [`RayMaterial`]: the exact integral
 //! of one segment over which the scalar is linear, the transfer function's

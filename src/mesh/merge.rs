@@ -3,7 +3,7 @@
 //! Points with exactly equal coordinates (`-0.0` equals `0.0`; NaN never
 //! merges) form a group; every cell reference to a point of a group is
 //! replaced by the group's smallest original index (the vertex-order
-//! convention of `DESIGN.md`). Points are not removed, so point arrays stay
+//! convention of `docs/conventions.md`). Points are not removed, so point arrays stay
 //! aligned; the merged-away points simply become unused. Cells that shared
 //! positions but not indices become face neighbours once the topology is
 //! rebuilt. Groups are found by sorting point indices by coordinates.

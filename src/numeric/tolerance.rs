@@ -34,18 +34,13 @@ pub const EXP_TABLE_MAX_ABS_ERROR: f64 = 1.2e-4;
 /// depth <= 1 with colour spread 1. 0.02 left 0.06 on single pixels of
 /// coarse tet meshes seen up close (`tetraMesh`, 128 px, oblique
 /// orthographic view); 0.004 brings every pixel of the shared datasets
-/// within 2/255 of the ray caster, for 1.3 % more triangles on the
-/// hex_shell benchmark scene.
+/// within 2/255 of the ray caster (0.01 does not), for 1.3 % more
+/// triangles on the hex_shell benchmark scene but 7x the refined triangles
+/// on meshes of few, large, optically thick cells (zoo_3x3x3 filling the
+/// view: 31k -> 224k). A test of the interpolation error itself instead of
+/// the end values would refine less.
 pub const COLOR_REFINE_TOL: f64 = 0.004;
 
-/// Exact mode, in refined pieces: a region edge is also refined when the
-/// glow colour interpolated at its midpoint differs from the exact value
-/// there by more than this, times the opacity there. End values alone miss
-/// a colour that dips and rises between them (viridis' red falls from 0.27
-/// to 0.13 and climbs to 0.99): on the 170-tet `tetraMesh` in an oblique
-/// orthographic view the spread test alone left such pixels. 1e-3 of a
-/// PNG value is a quarter of one 8-bit step.
-pub const COLOR_INTERP_TOL: f64 = 1e-3;
 
 /// Exact mode: at most this many levels of midpoint refinement per region
 /// triangle for colour accuracy (each level splits a triangle in up to 4).

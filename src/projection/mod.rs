@@ -1,4 +1,4 @@
-//! Projection of one convex piece into screen regions (issue 6; MWS section II).
+//! Projection of one convex piece into screen regions (MWS section II).
 //!
 //! A [`Polyhedron`] (a cell, tetrahedron or breakpoint slab in camera view
 //! space, its boundary triangulated) is projected onto the image plane and

@@ -77,7 +77,7 @@ use crate::numeric::tolerance::RAY_TERMINATION_TRANSMITTANCE;
 use geometry::RayFrame;
 use walk::{RawSegment, Scratch, WalkMesh};
 
-/// Which scalar field is integrated inside a cell (DESIGN.md, Conventions).
+/// Which scalar field is integrated inside a cell (docs/conventions.md, Conventions).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum FieldModel {
     #[default]

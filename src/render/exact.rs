@@ -52,9 +52,7 @@ use crate::gpu::{
 use crate::image::Image;
 use crate::integrate::{vertex_values, VertexValues};
 use crate::mesh::Mesh;
-use crate::numeric::tolerance::{
-    COLOR_INTERP_TOL, COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL, TF_SLOPE_REL,
-};
+use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL, TF_SLOPE_REL};
 use crate::projection::coverage::PixelGrid;
 use crate::projection::{refine, ClipValue, Clipper, Polyhedron, Projected, Projector};
 use crate::tf::TransferFunction;
@@ -384,19 +382,6 @@ fn push_projected(
             hi - lo
         })
         .fold(0.0, f64::max);
-    // Equal colours at the vertices may hide a colour that dips and rises
-    // inside: then the TF's colour spread over the piece's scalars decides.
-    let spread = if depth * spread > COLOR_REFINE_TOL || depth <= COLOR_REFINE_TOL {
-        spread
-    } else {
-        let (lo, hi) = value_range(
-            proj.vertices
-                .iter()
-                .flat_map(|v| [v.s_front, v.s_back])
-                .filter(|s| s.is_finite()),
-        );
-        tf_color_spread(tf, lo, hi)
-    };
     if depth * spread > COLOR_REFINE_TOL {
         let before = proj.triangles.len();
         refine(proj, COLOR_REFINE_MAX_DEPTH, |a, b| {
@@ -406,24 +391,7 @@ fn push_projected(
             let spread = (0..3)
                 .map(|k| (va.glow[k] - vb.glow[k]).abs())
                 .fold(0.0, f64::max);
-            if depth * spread > COLOR_REFINE_TOL {
-                return true;
-            }
-            // The colour along the edge need not be monotone (a TF colour
-            // that dips and rises): compare the interpolated colour at the
-            // midpoint with its exact value there (the region's front and
-            // back are planes, so l, s_f and s_b are affine along the edge).
-            let vm = vertex_values(
-                tf,
-                0.5 * (a.l + b.l),
-                0.5 * (a.s_front + b.s_front),
-                0.5 * (a.s_back + b.s_back),
-            );
-            let alpha = -(-vm.depth).exp_m1();
-            let off = (0..3)
-                .map(|k| (vm.glow[k] - 0.5 * (va.glow[k] + vb.glow[k])).abs())
-                .fold(0.0, f64::max);
-            off * alpha > COLOR_INTERP_TOL
+            depth * spread > COLOR_REFINE_TOL
         });
         if ctx.cull {
             proj.cull_to_pixels(&ctx.grid);
@@ -482,25 +450,6 @@ fn push_projected(
             out.degenerate += 1;
         }
     }
-}
-
-/// The largest spread of a colour channel of `tf` over scalars `[lo, hi]`
-/// (0 for an empty range): the colour is piecewise linear, so its extremes
-/// are at the ends or at nodes inside.
-fn tf_color_spread(tf: &TransferFunction, lo: f64, hi: f64) -> f64 {
-    if lo > hi {
-        return 0.0;
-    }
-    let mut min = tf.color_at(lo);
-    let mut max = min;
-    let inner = tf.nodes().into_iter().filter(|n| n.s > lo && n.s < hi);
-    for c in [tf.color_at(hi)].into_iter().chain(inner.map(|n| n.color)) {
-        for k in 0..3 {
-            min[k] = min[k].min(c[k]);
-            max[k] = max[k].max(c[k]);
-        }
-    }
-    (0..3).map(|k| max[k] - min[k]).fold(0.0, f64::max)
 }
 
 /// Per-piece scale `k` sending `l k` and `tau / k` to the shader (their

@@ -1,5 +1,5 @@
 //! Cycle groups composited per pixel: the last resort of the visibility
-//! order (issue 5).
+//! order.
 //!
 //! A group ([`crate::visibility::Order::groups`]) is a range of pieces with
 //! no back-to-front order the sorter could find; every piece outside the

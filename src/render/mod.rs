@@ -216,7 +216,7 @@ impl<'s> Renderer<'s> {
     }
 
     /// Renders one image with the camera of `opts.camera` (fitted to the
-    /// mesh bounds, DESIGN.md Conventions).
+    /// mesh bounds, docs/conventions.md Conventions).
     pub fn render(
         &mut self,
         opts: &RenderOptions,

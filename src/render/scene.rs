@@ -1,6 +1,6 @@
 //! A scene ready to render: mesh, topology, scalar field and transfer function.
 //!
-//! [`Scene::build`] applies the conventions of DESIGN.md in one place, so every
+//! [`Scene::build`] applies the conventions of docs/conventions.md in one place, so every
 //! mode renders the same thing:
 //! - cells the file flags hidden or duplicate in its `vtkGhostType` cell
 //!   array are left out first, with their cell-data values and the points

@@ -1,4 +1,4 @@
-//! Piecewise-linear transfer functions (issue 3): breakpoints, extinction and
+//! Piecewise-linear transfer functions: breakpoints, extinction and
 //! colour, emission models, presets, JSON and ParaView import.
 //!
 //! # Model

@@ -220,7 +220,7 @@ pub fn preset(
 }
 
 impl TransferFunction {
-    /// The default transfer function (DESIGN.md, Conventions): viridis over
+    /// The default transfer function (docs/conventions.md, Conventions): viridis over
     /// `range`, opacity ramp 0 -> 1, unit distance = `diagonal / 10`
     /// (1 if the diagonal is not positive), glow emission. An empty or
     /// reversed range is handled by [`usable_range`].

@@ -1,4 +1,4 @@
-//! Cycles among tetrahedra broken by planes through their members (issue 5;
+//! Cycles among tetrahedra broken by planes through their members (
 //! MWS section IV's last exact step before per-pixel ordering).
 //!
 //! A cycle left after cells were split into tets (tets can overlap

@@ -1,4 +1,4 @@
-//! Exact back-to-front visibility order of drawable pieces (issue 5).
+//! Exact back-to-front visibility order of drawable pieces.
 //!
 //! # What it produces
 //! [`Sorter::order`] lists the [`Piece`]s of a mesh back to front for one
