@@ -54,10 +54,8 @@ pub struct Ray {
     pub origin: DVec3,
     pub dir: DVec3,
     /// The image's right direction for a pixel ray (zero when the ray has
-    /// no image): the ray caster breaks ties (a ray through an edge or a
-    /// vertex) by moving the ray's origin towards it, then towards the
-    /// image's down direction, which is the rasteriser's top-left rule
-    /// ([`crate::raycast::geometry`]).
+    /// no image), for breaking ties by the rasteriser's top-left rule
+    /// ([`crate::raycast::geometry::tie_basis`], not yet switched on).
     pub right: DVec3,
 }
 

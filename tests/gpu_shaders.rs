@@ -48,6 +48,9 @@ fn format_of(inner: &TypeInner) -> Option<wgpu::VertexFormat> {
         TypeInner::Scalar(s) if s.kind == ScalarKind::Float && s.width == 4 => {
             Some(wgpu::VertexFormat::Float32)
         }
+        TypeInner::Scalar(s) if s.kind == ScalarKind::Uint && s.width == 4 => {
+            Some(wgpu::VertexFormat::Uint32)
+        }
         TypeInner::Vector { size, scalar } if scalar.kind == ScalarKind::Float => {
             Some(match size {
                 VectorSize::Bi => wgpu::VertexFormat::Float32x2,
@@ -101,7 +104,14 @@ fn exact_vertex_inputs_match_rust_layout() {
             if let TypeInner::Struct { members, .. } = &module.types[arg.ty].inner {
                 for m in members {
                     if let Some(Binding::Location { interpolation, .. }) = m.binding {
-                        assert_eq!(interpolation, Some(Interpolation::Perspective));
+                        // Integers (the piece number) are flat.
+                        let want = match module.types[m.ty].inner {
+                            TypeInner::Scalar(s) if s.kind == ScalarKind::Uint => {
+                                Interpolation::Flat
+                            }
+                            _ => Interpolation::Perspective,
+                        };
+                        assert_eq!(interpolation, Some(want));
                     }
                 }
             }

@@ -41,7 +41,6 @@ pub const EXP_TABLE_MAX_ABS_ERROR: f64 = 1.2e-4;
 /// the end values would refine less.
 pub const COLOR_REFINE_TOL: f64 = 0.004;
 
-
 /// Exact mode: at most this many levels of midpoint refinement per region
 /// triangle for colour accuracy (each level splits a triangle in up to 4).
 pub const COLOR_REFINE_MAX_DEPTH: u32 = 6;
