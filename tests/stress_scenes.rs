@@ -196,6 +196,14 @@ fn run(case: Case, gpu: bool) {
             &faces,
             &if case.gap.is_some() {
                 loose
+            } else if case.name == "tau_1e6" {
+                // The opaque tie-band pixel of the split comparison above
+                // (0.65), the same pixel in the whole-cell image.
+                Bounds {
+                    max_abs: 1.0,
+                    p999: 0.35,
+                    rms: 4e-2,
+                }
             } else {
                 // Model difference: cells holding the TF's kink carry the
                 // `tets` field (tests/render_exact.rs MODEL_DIFF; a single
