@@ -22,7 +22,8 @@
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use zoovr::gpu::{AccumFormat, Backend, ClipMapper, Context, ExactVertex, GpuOptions};
+use zoovr::gpu::{AccumFormat, Backend, ClipMapper, Context, GpuOptions, GpuVertex};
+use zoovr::render::modes::exact::{bind_exact_stage, ExactVertex};
 use zoovr::testdata::Rng;
 
 const CHUNK: usize = 1 << 16;
@@ -69,8 +70,10 @@ fn frame(ctx: &Context, verts: &[ExactVertex], idx: &[u32], size: u32) -> zoovr:
     let mut f = ctx
         .begin_frame(size, size, AccumFormat::Auto)
         .expect("frame");
+    let stage = bind_exact_stage(ctx, 1.0).expect("stage");
     for chunk in verts.chunks(3 * CHUNK) {
-        f.push_triangles(chunk, &idx[..chunk.len()]).expect("push");
+        f.push_triangles(&stage, chunk, &idx[..chunk.len()])
+            .expect("push");
     }
     f.finish_with_stats().expect("finish").1
 }

@@ -114,7 +114,7 @@ fn bench(c: &mut Criterion) {
                 // The first frame builds the sorter and opens the device.
                 let (_, first) = renderer.render(&opts, |_, _| {}).unwrap();
                 let (_, s) = renderer.render(&opts, |_, _| {}).unwrap();
-                let e = s.exact.as_ref().unwrap();
+                let e = s.projected().unwrap();
                 eprintln!(
                     "{name} {bname} {size}: frame {:.2} s (first {:.2} s) = sort {:.3} + project/integrals {:.2} + gpu {:.2} (upload+draw {:.2}, wait {:.2}, readback {:.3}); {} pieces, {} triangles, {} batches",
                     s.total_s,

@@ -82,7 +82,11 @@ fn main() -> Result<()> {
     }
     println!("exact (cpu twin) {:?}", img.get(i, j));
     println!("raycast ({})    {:?}", model.name(), reference.get(i, j));
-    for f in &stats.exact.map(|e| e.watched).unwrap_or_default() {
+    for f in &stats
+        .projected()
+        .map(|e| e.watched.clone())
+        .unwrap_or_default()
+    {
         println!("  fragment {f:?}");
     }
     let cam = Camera::fit(scene.mesh.bounds(), &opts.camera);

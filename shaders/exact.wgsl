@@ -2,8 +2,9 @@
 //
 // Per vertex: clip position, thickness l, mean extinction tau, glow C / alpha,
 // and the number of the piece (convex polyhedron) the triangle belongs to.
+// (`piece_depth` and `finite` come from shaders/common.wgsl.)
 // Per fragment: alpha = 1 - exp(-l tau) from the 2D exponential table
-// (src/gpu/exptable.rs documents range, warp and clamping; its `sample` is the
+// (src/render/modes/exptable.rs documents range, warp and clamping; its `sample` is the
 // CPU twin of `alpha_of` below), colour = glow * alpha, premultiplied. The
 // pipeline blends with src + (1 - src.a) * dst on all channels, and tests
 // depth (less, write) against the piece's key: a pixel centre that two
@@ -15,7 +16,7 @@
 // @interpolate(linear) (Mesa gives NaN with it on triangles crossing the
 // viewport edge whose vertices have different w).
 
-// Keep in sync with `FrameUniforms` in src/gpu/frame.rs.
+// Keep in sync with `ExactParams` in src/render/modes/exact.rs.
 struct Params {
     // 1 / length unit: l' = l * inv_unit.
     inv_unit: f32,
@@ -34,7 +35,7 @@ struct Params {
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var table: texture_2d<f32>;
 
-// Keep in sync with `ExactVertex` in src/gpu/vertex.rs.
+// Keep in sync with `ExactVertex` in src/render/modes/exact.rs.
 struct VertexIn {
     @location(0) pos: vec4<f32>,
     @location(1) thickness: f32,
@@ -57,16 +58,6 @@ struct VertexOut {
 struct FragOut {
     @location(0) color: vec4<f32>,
     @builtin(frag_depth) depth: f32,
-}
-
-// The depth key of piece number `piece` in drawing order (twin:
-// gpu::vertex::piece_depth): the f32 just below 1.0 for piece 0, and one
-// representable value lower for each later piece, so later pieces pass a
-// strict less-than test against earlier ones while a second fragment of the
-// same piece at the same pixel fails it. Flat and written per fragment, the
-// key is exact (an interpolated position z need not be).
-fn piece_depth(piece: u32) -> f32 {
-    return bitcast<f32>(0x3F7FFFFFu - piece);
 }
 
 @vertex
@@ -113,12 +104,6 @@ fn alpha_of(l: f32, tau: f32) -> f32 {
     return r0 * (1.0 - fv) + r1 * fv;
 }
 
-// Whether a value is finite: false for NaN (every comparison with NaN is
-// false) and for infinities.
-fn finite(x: f32) -> bool {
-    return abs(x) <= 3.4028235e38;
-}
-
 @fragment
 fn fs_main(f: VertexOut) -> FragOut {
     // Every vertex the CPU sends is finite, but a rasteriser may still
@@ -131,6 +116,7 @@ fn fs_main(f: VertexOut) -> FragOut {
         && finite(f.glow.z)) {
         discard;
     }
+    // Twin: render::modes::exact::ExactTwin.
     let alpha = alpha_of(f.thickness, f.tau);
     var out: FragOut;
     out.color = vec4<f32>(f.glow * alpha, alpha);

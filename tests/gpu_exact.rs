@@ -2,12 +2,12 @@
 //! when no adapter exists at all; on this project's machines lavapipe
 //! (Vulkan) and llvmpipe (GL) are installed, so they run.
 
-use zoovr::gpu::exptable::{exact_alpha, ExpTable, TABLE_N};
-use zoovr::gpu::{
-    AccumFormat, Backend, ClipMapper, Context, ExactVertex, FrameOptions, GpuError, GpuOptions,
-};
+use zoovr::gpu::GpuVertex;
+use zoovr::gpu::{AccumFormat, Backend, ClipMapper, Context, FrameOptions, GpuError, GpuOptions};
 use zoovr::image::Image;
 use zoovr::numeric::tolerance::EXP_TABLE_MAX_ABS_ERROR;
+use zoovr::render::modes::exact::{bind_exact_stage, ExactVertex};
+use zoovr::render::modes::exptable::{exact_alpha, ExpTable, TABLE_N};
 use zoovr::testdata::Rng;
 
 fn open(backend: Option<Backend>) -> Option<Context> {
@@ -34,7 +34,8 @@ fn render(
     idx: &[u32],
 ) -> Result<Image, GpuError> {
     let mut frame = ctx.begin_frame_with(opts)?;
-    frame.push_triangles(verts, idx)?;
+    let stage = bind_exact_stage(ctx, 1.0)?;
+    frame.push_triangles(&stage, verts, idx)?;
     frame.finish()
 }
 
@@ -71,8 +72,9 @@ fn constant_triangle_gives_glow_times_alpha() {
         let mut frame = ctx
             .begin_frame_with(&FrameOptions::new(w, h, format))
             .unwrap();
+        let stage = bind_exact_stage(&ctx, 1.0).unwrap();
         let fmt = frame.format();
-        frame.push_triangles(&verts, &[0, 1, 2]).unwrap();
+        frame.push_triangles(&stage, &verts, &[0, 1, 2]).unwrap();
         let img = frame.finish().unwrap();
         assert_eq!(img.count_non_finite(), 0);
         let alpha = exact_alpha(l as f64, tau as f64);
@@ -186,10 +188,16 @@ fn thin_layers_on(ctx: &Context, backend: Backend) {
         let mut frame = ctx
             .begin_frame_with(&FrameOptions::new(w, h, format))
             .unwrap();
+        let stage = bind_exact_stage(&ctx, 1.0).unwrap();
         // Each layer is a piece of its own (one piece colours a pixel once).
         for layer in 0..n {
-            let q: Vec<ExactVertex> = quad.iter().map(|v| v.with_piece(layer as u32)).collect();
-            frame.push_triangles(&q, &[0, 1, 2, 2, 1, 3]).unwrap();
+            let q: Vec<ExactVertex> = quad
+                .iter()
+                .map(|v| GpuVertex::with_piece(*v, layer as u32))
+                .collect();
+            frame
+                .push_triangles(&stage, &q, &[0, 1, 2, 2, 1, 3])
+                .unwrap();
         }
         let img = frame.finish().unwrap();
         let (mut err_exact, mut err_acc) = (0.0f64, 0.0f64);
@@ -266,9 +274,10 @@ fn many_small_batches_equal_one_batch() {
         ..FrameOptions::new(w, h, AccumFormat::Auto)
     };
     let mut frame = ctx.begin_frame_with(&small).unwrap();
+    let stage = bind_exact_stage(&ctx, 1.0).unwrap();
     for t in 0..verts.len() / 3 {
         frame
-            .push_triangles(&verts[3 * t..3 * t + 3], &[0, 1, 2])
+            .push_triangles(&stage, &verts[3 * t..3 * t + 3], &[0, 1, 2])
             .unwrap();
     }
     let (many, stats) = frame.finish_with_stats().unwrap();
@@ -390,28 +399,25 @@ fn bad_input_is_an_error_not_a_panic() {
         ctx.begin_frame(1 << 30, 10, AccumFormat::Auto),
         Err(GpuError::BadSize { .. })
     ));
-    let bad_unit = FrameOptions {
-        length_unit: f32::NAN,
-        ..FrameOptions::new(4, 4, AccumFormat::Auto)
-    };
     assert!(matches!(
-        ctx.begin_frame_with(&bad_unit),
+        bind_exact_stage(&ctx, f32::NAN),
         Err(GpuError::BadOption(_))
     ));
     let mut frame = ctx.begin_frame(4, 4, AccumFormat::Auto).unwrap();
+    let stage = bind_exact_stage(&ctx, 1.0).unwrap();
     let v = ExactVertex::new([0.0, 0.0, 0.5, 1.0], 1.0, 1.0, [1.0; 3]);
     assert!(matches!(
-        frame.push_triangles(&[v; 3], &[0, 1]),
+        frame.push_triangles(&stage, &[v; 3], &[0, 1]),
         Err(GpuError::NotTriangles(2))
     ));
     assert!(matches!(
-        frame.push_triangles(&[v; 3], &[0, 1, 3]),
+        frame.push_triangles(&stage, &[v; 3], &[0, 1, 3]),
         Err(GpuError::IndexOutOfRange { index: 3, len: 3 })
     ));
     let mut nan = v;
     nan.tau = f32::NAN;
     assert!(matches!(
-        frame.push_triangles(&[v, v, nan], &[0, 1, 2]),
+        frame.push_triangles(&stage, &[v, v, nan], &[0, 1, 2]),
         Err(GpuError::NonFiniteVertex(2))
     ));
     // Nothing drawn: a cleared, transparent image.
@@ -462,8 +468,9 @@ fn gpu_table_lookup_matches_twin_and_exact() {
             }
         }
         let mut frame = ctx.begin_frame(n, n, AccumFormat::Auto).unwrap();
+        let stage = bind_exact_stage(&ctx, 1.0).unwrap();
         let fmt = frame.format();
-        frame.push_triangles(&verts, &idx).unwrap();
+        frame.push_triangles(&stage, &verts, &idx).unwrap();
         let img = frame.finish().unwrap();
         let (mut vs_twin, mut vs_exact) = (0.0f64, 0.0f64);
         for j in 0..n {

@@ -1,9 +1,20 @@
-//! Every WGSL shader parses and validates with naga, without any GPU, and the
-//! exact stage's vertex inputs match `ExactVertex::ATTRIBUTES` (the Rust
-//! mirror of `VertexIn`); no varying uses `@interpolate(linear)`.
+//! Every WGSL shader parses and validates with naga, without any GPU, and
+//! every stage's vertex inputs match its Rust mirror's attributes (its
+//! `StageDesc::vertex`); no varying uses `@interpolate(linear)`.
 
 use naga::{Binding, Interpolation, ScalarKind, ShaderStage, TypeInner, VectorSize};
-use zoovr::gpu::{ExactVertex, SHADERS};
+use zoovr::gpu::layer::LAYER_STAGE;
+use zoovr::gpu::stage::stage_source;
+use zoovr::gpu::StageDesc;
+use zoovr::render::modes::SHADERS;
+use zoovr::render::Mode;
+
+/// Every stage: the modes' and the layer stage.
+fn stages() -> Vec<&'static StageDesc> {
+    let mut v: Vec<&'static StageDesc> = Mode::ALL.iter().filter_map(|m| m.info().stage).collect();
+    v.push(&LAYER_STAGE);
+    v
+}
 
 fn parse(name: &str, src: &str) -> naga::Module {
     naga::front::wgsl::parse_str(src)
@@ -31,13 +42,14 @@ fn shaders_parse_and_validate() {
             std::fs::read_to_string(dir.join(name)).unwrap(),
             "{name} differs from the embedded copy"
         );
-        let module = parse(name, src);
+        let full = stage_source(src);
+        let module = parse(name, &full);
         let mut validator = naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),
             naga::valid::Capabilities::empty(),
         );
         if let Err(e) = validator.validate(&module) {
-            panic!("{name}: {}", e.emit_to_string(src));
+            panic!("{name}: {}", e.emit_to_string(&full));
         }
     }
 }
@@ -63,9 +75,15 @@ fn format_of(inner: &TypeInner) -> Option<wgpu::VertexFormat> {
 }
 
 #[test]
-fn exact_vertex_inputs_match_rust_layout() {
-    let (name, src) = SHADERS.iter().find(|(n, _)| *n == "exact.wgsl").unwrap();
-    let module = parse(name, src);
+fn vertex_inputs_match_rust_layout() {
+    for stage in stages() {
+        check_stage(stage);
+    }
+}
+
+fn check_stage(stage: &StageDesc) {
+    let name = stage.name;
+    let module = parse(name, &stage_source(stage.wgsl));
     let vs = module
         .entry_points
         .iter()
@@ -89,11 +107,13 @@ fn exact_vertex_inputs_match_rust_layout() {
         }
     }
     inputs.sort_by_key(|x| x.0);
-    let rust: Vec<_> = ExactVertex::ATTRIBUTES
+    let rust: Vec<_> = stage
+        .vertex
+        .attributes
         .iter()
         .map(|a| (a.shader_location, Some(a.format)))
         .collect();
-    assert_eq!(inputs, rust);
+    assert_eq!(inputs, rust, "{name}");
 
     // Varyings: perspective-correct (the Mesa NaN pitfall of `linear`).
     for ep in &module.entry_points {
@@ -104,14 +124,21 @@ fn exact_vertex_inputs_match_rust_layout() {
             if let TypeInner::Struct { members, .. } = &module.types[arg.ty].inner {
                 for m in members {
                     if let Some(Binding::Location { interpolation, .. }) = m.binding {
-                        // Integers (the piece number) are flat.
-                        let want = match module.types[m.ty].inner {
+                        // Integers (the piece number) are flat; other
+                        // varyings perspective-correct, or flat where
+                        // constant over a triangle (the layer's colour).
+                        match module.types[m.ty].inner {
                             TypeInner::Scalar(s) if s.kind == ScalarKind::Uint => {
-                                Interpolation::Flat
+                                assert_eq!(interpolation, Some(Interpolation::Flat), "{name}")
                             }
-                            _ => Interpolation::Perspective,
-                        };
-                        assert_eq!(interpolation, Some(want));
+                            _ => assert!(
+                                matches!(
+                                    interpolation,
+                                    Some(Interpolation::Perspective | Interpolation::Flat)
+                                ),
+                                "{name}: {interpolation:?}"
+                            ),
+                        }
                     }
                 }
             }

@@ -156,7 +156,7 @@ fn cycles_render_like_the_ray_caster() {
             let (reference, _) = r
                 .render_with_camera(&opts(Mode::Raycast), cam, |_, _| {})
                 .unwrap();
-            let e = stats.exact.expect("exact stats");
+            let e = stats.projected().expect("exact stats").clone();
             let covered = reference.pixels.iter().filter(|p| p[3] > 1e-3).count();
             if plane_split {
                 assert_eq!(e.order.cycles_resolved_by_planes, 1);

@@ -51,7 +51,7 @@ fn every_shared_dataset_renders_exact_at_256_without_nan() {
             .unwrap_or_else(|e| panic!("{rel}: {e}"));
         assert_eq!(img.count_non_finite(), 0, "{rel}: non-finite pixels");
         let covered = img.pixels.iter().filter(|p| p[3] > 1e-3).count();
-        let e = stats.exact.as_ref().unwrap();
+        let e = stats.projected().unwrap();
         eprintln!(
             "{rel}: {covered} covered pixels, {} pieces, {} triangles, {:.2} s",
             e.pieces, e.triangles, stats.total_s

@@ -124,7 +124,10 @@ fn random_views_match_the_reference_on_every_pixel() {
                 [0.0; 3],
                 false,
             );
-            let frags = stats.exact.map(|e| e.watched).unwrap_or_default();
+            let frags = stats
+                .projected()
+                .map(|e| e.watched.clone())
+                .unwrap_or_default();
             panic!(
                 "{tag}: pixel ({i}, {j}) differs by {:.3e} > {bound:.3e}: exact {:?}, reference {:?}; \
                  fragments (crops in {}):\n{frags:#?}",

@@ -64,7 +64,7 @@ pub struct ViewArgs {
     pub ortho: bool,
     /// Rendering mode: exact (projection + exact integrals, wgpu) or raycast
     /// (CPU reference).
-    #[arg(long, default_value = "exact")]
+    #[arg(long, value_enum, default_value_t = Mode::Exact)]
     pub mode: Mode,
     /// Field model of the ray caster: faces (default), tets or native. The
     /// exact mode integrates `faces` for whole cells and `tets` with
@@ -105,6 +105,10 @@ pub struct ViewArgs {
     /// Print timings and counts to stderr.
     #[arg(long)]
     pub stats: bool,
+    /// With --stats: print them as one JSON object on stdout instead (the
+    /// mode, times in seconds, the adapter, and the mode's own counters).
+    #[arg(long, requires = "stats")]
+    pub json: bool,
 }
 
 impl ViewArgs {
@@ -209,78 +213,18 @@ pub fn progress_bar(label: &str) -> impl FnMut(usize, usize) {
 /// Prints the stats of a render to stderr.
 pub fn print_stats(stats: &RenderStats, load_s: f64) {
     eprintln!("load+scene   {load_s:.3} s");
-    match &stats.exact {
-        Some(e) => eprintln!(
-            "setup        {:.3} s  (visibility geometry {:.3}, waiting for the GPU device {:.3})",
-            stats.setup_s,
-            stats.setup_s - e.gpu_open_s,
-            e.gpu_open_s
-        ),
-        None => eprintln!("setup        {:.3} s", stats.setup_s),
+    eprintln!("{stats}");
+}
+
+/// Prints the stats of a render as one JSON object on stdout.
+pub fn print_stats_json(stats: &RenderStats, load_s: f64, ghost_cells: usize) -> Result<()> {
+    let mut v = serde_json::to_value(stats)?;
+    if let Some(o) = v.as_object_mut() {
+        o.insert("load_s".into(), load_s.into());
+        o.insert("ghost_cells".into(), ghost_cells.into());
     }
-    if let Some(a) = &stats.gpu_adapter {
-        eprintln!("adapter      {a}");
-    }
-    if let Some(e) = &stats.exact {
-        eprintln!(
-            "sort         {:.3} s  ({} pieces, {} split cells, {} problem cells, {} cycles, {} cut by planes into {} fragments, {} cycle groups of {} pieces over {} pixels)",
-            e.sort_s,
-            e.pieces,
-            e.order.split_cells,
-            e.order.problem_cells,
-            e.order.cycles_found,
-            e.order.cycles_resolved_by_planes,
-            e.order.fragments,
-            e.order.cycle_groups,
-            e.order.pieces_in_groups,
-            e.group_pixels
-        );
-        eprintln!(
-            "             (classify faces {:.3}, non-convex constraints {:.3}, splits {:.3}, topological sort {:.3})",
-            e.order.time_classify.as_secs_f64(),
-            e.order.time_nonconvex.as_secs_f64(),
-            e.order.time_split.as_secs_f64(),
-            e.order.time_sort.as_secs_f64()
-        );
-        eprintln!(
-            "project+draw {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles)",
-            e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles
-        );
-        eprintln!(
-            "gpu finish   {:.3} s  (upload {:.3}, wait {:.3}, readback {:.3}, {} batches)",
-            e.gpu_total_s, e.gpu.upload_s, e.gpu.gpu_wait_s, e.gpu.readback_s, e.gpu.batches
-        );
-    }
-    if let Some(r) = &stats.raycast {
-        eprintln!(
-            "raycast      model {}, traversal {}, early ray termination below transmittance {:e}",
-            r.model.name(),
-            r.traversal.name(),
-            r.termination_transmittance
-        );
-        if r.traversal == Traversal::Brute {
-            let b = &r.brute;
-            eprintln!(
-                "brute        {} cells tested, {} segments, {} of them overlapping another \
-                 piece's in depth",
-                b.cells_tested, b.segments, b.overlapping_segments
-            );
-        }
-        if r.model == FieldModel::Native {
-            let n = &r.native;
-            eprintln!(
-                "native       {} intervals, {} extra cells (bilinear faces), {} Newton failures, \
-                 {} linear fallbacks, {} parity-classified, {} depth-limited brackets",
-                n.intervals,
-                n.extra_cells,
-                n.newton_failures,
-                n.fallback_intervals,
-                n.parity_classified,
-                n.bracket_depth_limited
-            );
-        }
-    }
-    eprintln!("render total {:.3} s", stats.total_s);
+    println!("{}", serde_json::to_string(&v)?);
+    Ok(())
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
@@ -289,7 +233,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let opts = args.view.render_options();
     // The exact mode's GPU device opens while the file is read and sorted.
-    let pending = (opts.mode == Mode::Exact).then(|| zoovr::gpu::Context::spawn(&opts.gpu));
+    let pending = opts
+        .mode
+        .info()
+        .gpu
+        .then(|| zoovr::gpu::Context::spawn(&opts.gpu));
     let t0 = std::time::Instant::now();
     let scene = args.view.load_scene(&args.file)?;
     let load_s = t0.elapsed().as_secs_f64();
@@ -297,21 +245,25 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(p) = pending {
         renderer.set_pending_gpu(p);
     }
-    match opts.mode {
-        Mode::Exact if args.view.model.is_some_and(|m| m != FieldModel::Faces) => eprintln!(
-            "zoovr: note: --model is the ray caster's; the exact mode integrates the `faces` \
-             field of whole cells, or `tets` with --split all"
-        ),
-        Mode::Raycast if opts.split_all => eprintln!(
-            "zoovr: note: --split all is the exact mode's; the ray caster's field is --model \
-             (`--model tets` integrates the consistent tets)"
-        ),
-        _ => {}
-    }
-    if opts.mode == Mode::Exact && args.view.traversal.is_some() {
+    let info = opts.mode.info();
+    if info.gpu && args.view.model.is_some_and(|m| m != FieldModel::Faces) {
         eprintln!(
-            "zoovr: note: --traversal is the ray caster's (--mode raycast); the exact mode \
-             projects every cell"
+            "zoovr: note: --model is the ray caster's; the {} mode integrates the `faces` \
+             field of whole cells, or `tets` with --split all",
+            info.name
+        );
+    }
+    if !info.gpu && opts.split_all {
+        eprintln!(
+            "zoovr: note: --split all is for the projected-cell modes; the ray caster's field \
+             is --model (`--model tets` integrates the consistent tets)"
+        );
+    }
+    if info.gpu && args.view.traversal.is_some() {
+        eprintln!(
+            "zoovr: note: --traversal is the ray caster's (--mode raycast); the {} mode \
+             projects every cell",
+            info.name
         );
     }
     let (image, stats) = renderer
@@ -323,7 +275,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(out) = &args.float {
         image.write_exr(out)?;
     }
-    if args.view.stats {
+    if args.view.json {
+        print_stats_json(&stats, load_s, scene.ghost_cells)?;
+    } else if args.view.stats {
         if scene.ghost_cells > 0 {
             eprintln!(
                 "ghost cells  {} left out (hidden or duplicate in vtkGhostType; --show-hidden draws them)",

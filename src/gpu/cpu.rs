@@ -1,13 +1,15 @@
-//! The CPU twin of the exact stage: rasteriser, `shaders/exact.wgsl` and
-//! the blend unit, pixel by pixel.
+//! The CPU twin of a frame: rasteriser, fragment stage and blend unit,
+//! pixel by pixel.
 //!
-//! [`CpuFrame`] takes the same triangles as [`super::Frame`] and produces
+//! [`CpuFrame`] takes the same triangles as [`super::Frame`], each stage's
+//! fragment shader replaced by its CPU twin ([`CpuStage`], which every
+//! stage has, with the name of the shader function it mirrors), and
+//! produces
 //! the image the GPU would, without a GPU, so the comparison harness runs
 //! everywhere and a wrong pixel can be taken apart ([`CpuFrame::covering`]
 //! lists the fragments that coloured it). Stage by stage, as the hardware
 //! does it:
-//! 1. **Viewport.** Clip positions (`w = 1` in the exact mode; others are
-//!    divided) become framebuffer coordinates in `f32`,
+//! 1. **Viewport.** Clip positions (divided by `w`) become framebuffer coordinates in `f32`,
 //!    `x = ndc_x * S/2 + S/2`, `y = -ndc_y * S/2 + S/2` (row 0 at the top;
 //!    `S` the square viewport's side, [`raster_side`]; the image starts
 //!    [`super::vertex::RASTER_BORDER`] pixels in), then are snapped to
@@ -22,14 +24,14 @@
 //!    (horizontal, the triangle below it) or a *left* edge (the triangle
 //!    to its right): the top-left rule, which is the sample point moved by
 //!    `(+e, +e^2)`. Triangles of either winding are drawn (no culling).
-//! 3. **Interpolation.** Attributes are affine in screen space (the exact
-//!    mode sends `w = 1`), from the barycentric weights of the snapped
-//!    triangle.
-//! 4. **Fragment** (`fs_main`): a fragment with a non-finite attribute is
-//!    discarded; otherwise `alpha` comes from the exponential table
-//!    ([`ExpTable::sample`], the twin of `alpha_of`) and the colour is
-//!    `glow * alpha`. Its depth is its piece's key ([`piece_depth`]); the
-//!    depth test (less, with write) lets each piece colour a pixel once.
+//! 3. **Interpolation.** The barycentric weights of the snapped triangle
+//!    (affine in screen space: the projected-cell modes send `w = 1`) go to
+//!    the stage's twin, which interpolates its own attributes.
+//! 4. **Fragment** ([`CpuStage::shade`], the twin of `fs_main`): the
+//!    premultiplied colour, or `None` to discard. Its depth is its piece's
+//!    key ([`piece_depth`]); the depth test (less, with write) lets each
+//!    piece colour a pixel once. Counting draws ([`DrawKind`]) add 1 to red
+//!    instead, as `fs_count` does.
 //! 5. **Blend:** premultiplied "over" in `f32`, rounded to `f16` after
 //!    each blend when the frame accumulates in `Rgba16Float`.
 //!
@@ -41,24 +43,39 @@
 
 use half::f16;
 
-use super::exptable::ExpTable;
-use super::frame::DrawKind;
-use super::vertex::{piece_depth, raster_side, ClipMapper, ExactVertex};
+use super::frame::{validate, DrawKind};
+use super::raster::{piece_depth, raster_side, ClipMapper, GpuVertex};
 use super::{AccumFormat, GpuError};
 use crate::image::Image;
 
 /// Sub-pixel grid units per pixel.
-const SUBPIXEL: i64 = super::vertex::SUBPIXEL as i64;
+const SUBPIXEL: i64 = super::raster::SUBPIXEL as i64;
+
+/// The CPU twin of a stage's fragment shader (`fs_main`).
+pub trait CpuStage<V>: Sync {
+    /// The premultiplied RGBA the fragment blends at barycentric weights
+    /// `bary` of triangle `tri` (weights of the snapped triangle, in `f64`),
+    /// or `None` where the shader discards.
+    fn shade(&self, tri: [&V; 3], bary: [f64; 3]) -> Option<[f32; 4]>;
+    /// The interpolated values the shader works from, named, for
+    /// diagnostics ([`CpuFrame::covering`]).
+    fn describe(&self, tri: [&V; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)>;
+}
+
+/// The value of attribute `f` at barycentric weights `bary`, interpolated
+/// in `f64` and rounded to `f32`.
+pub fn lerp<V>(tri: [&V; 3], bary: [f64; 3], f: impl Fn(&V) -> f32) -> f32 {
+    (bary[0] * f(tri[0]) as f64 + bary[1] * f(tri[1]) as f64 + bary[2] * f(tri[2]) as f64) as f32
+}
 
 /// One fragment that coloured (or, counting, covered) a pixel.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Fragment {
     /// Index of the triangle in the frame (in submission order).
     pub triangle: u64,
     pub piece: u32,
-    pub thickness: f32,
-    pub tau: f32,
-    pub glow: [f32; 3],
+    /// The interpolated values the stage worked from ([`CpuStage::describe`]).
+    pub values: Vec<(&'static str, f32)>,
     /// Premultiplied colour and opacity the fragment blended.
     pub rgba: [f32; 4],
 }
@@ -69,8 +86,6 @@ pub struct CpuFrame {
     height: u32,
     format: AccumFormat,
     draw: DrawKind,
-    length_unit: f32,
-    table: ExpTable,
     accum: Vec<[f32; 4]>,
     depth: Vec<f32>,
     triangles: u64,
@@ -81,14 +96,12 @@ pub struct CpuFrame {
 
 impl CpuFrame {
     /// A cleared `width x height` frame (`format` F32 or F16; `Auto` means
-    /// F32), drawing `draw`, with the shader's length unit (see
-    /// [`super::FrameOptions::length_unit`]).
+    /// F32), drawing `draw`.
     pub fn new(
         width: u32,
         height: u32,
         format: AccumFormat,
         draw: DrawKind,
-        length_unit: f32,
     ) -> Result<CpuFrame, GpuError> {
         if width == 0 || height == 0 || width > 1 << 14 || height > 1 << 14 {
             return Err(GpuError::BadSize {
@@ -96,11 +109,6 @@ impl CpuFrame {
                 height,
                 max: 1 << 14,
             });
-        }
-        if !(length_unit > 0.0 && length_unit.is_finite()) {
-            return Err(GpuError::BadOption(
-                "length_unit must be positive and finite",
-            ));
         }
         let n = (width as usize) * (height as usize);
         Ok(CpuFrame {
@@ -111,8 +119,6 @@ impl CpuFrame {
                 _ => AccumFormat::F32,
             },
             draw,
-            length_unit,
-            table: ExpTable::new(super::exptable::TABLE_N),
             accum: vec![[0.0; 4]; n],
             depth: vec![1.0; n],
             triangles: 0,
@@ -139,54 +145,44 @@ impl CpuFrame {
         self.triangles
     }
 
-    /// Draws triangles (`indices` into `vertices`, three per triangle) over
-    /// everything drawn before.
-    pub fn push_triangles(
+    /// Draws triangles of a stage (`indices` into `vertices`, three per
+    /// triangle; `stage` the twin of its fragment shader) over everything
+    /// drawn before.
+    pub fn push_triangles<V: GpuVertex>(
         &mut self,
-        vertices: &[ExactVertex],
+        stage: &dyn CpuStage<V>,
+        vertices: &[V],
         indices: &[u32],
     ) -> Result<(), GpuError> {
-        if indices.len() % 3 != 0 {
-            return Err(GpuError::NotTriangles(indices.len()));
-        }
-        if let Some(&index) = indices.iter().find(|&&i| i as usize >= vertices.len()) {
-            return Err(GpuError::IndexOutOfRange {
-                index,
-                len: vertices.len(),
-            });
-        }
-        if let Some(k) = vertices.iter().position(|v| !v.is_finite()) {
-            return Err(GpuError::NonFiniteVertex(k));
-        }
+        validate(vertices, indices)?;
         for t in indices.chunks_exact(3) {
             let tri = [0, 1, 2].map(|k| &vertices[t[k] as usize]);
-            self.triangle(tri);
+            self.triangle(stage, tri);
             self.triangles += 1;
         }
         Ok(())
     }
 
-    fn snap(&self, v: &ExactVertex) -> Option<[i64; 2]> {
+    fn snap<V: GpuVertex>(&self, v: &V) -> Option<[i64; 2]> {
         let half = raster_side(self.width, self.height) as f32 * 0.5;
-        let w = v.pos[3];
-        let (nx, ny) = (v.pos[0] / w, v.pos[1] / w);
-        let b = super::vertex::RASTER_BORDER as f32;
+        let pos = v.clip();
+        let w = pos[3];
+        let (nx, ny) = (pos[0] / w, pos[1] / w);
+        let b = super::raster::RASTER_BORDER as f32;
         let x = nx * half + half - b;
         let y = -ny * half + half - b;
         // Beyond 2^40 sub-pixels (4e9 px) the hardware clips; such
-        // positions never reach here from the exact mode.
+        // positions never reach here from the projected-cell modes.
         Some([ClipMapper::snap(x as f64)?, ClipMapper::snap(y as f64)?])
     }
 
-    fn triangle(&mut self, tri: [&ExactVertex; 3]) {
-        let Some(p) = tri
-            .iter()
-            .map(|v| self.snap(v))
-            .collect::<Option<Vec<[i64; 2]>>>()
+    fn triangle<V: GpuVertex>(&mut self, stage: &dyn CpuStage<V>, tri: [&V; 3]) {
+        let (Some(p0), Some(p1), Some(p2)) =
+            (self.snap(tri[0]), self.snap(tri[1]), self.snap(tri[2]))
         else {
             return;
         };
-        let [a, b, c] = [p[0], p[1], p[2]].map(|q| [q[0] as i128, q[1] as i128]);
+        let [a, b, c] = [p0, p1, p2].map(|q| [q[0] as i128, q[1] as i128]);
         let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
         if area == 0 {
             return;
@@ -225,42 +221,43 @@ impl CpuFrame {
                 }
                 if inside {
                     let bary = w.map(|e| e as f64 / area_abs);
-                    self.fragment(i as u32, j as u32, tri, bary);
+                    self.fragment(stage, i as u32, j as u32, tri, bary);
                 }
             }
         }
     }
 
-    fn fragment(&mut self, i: u32, j: u32, tri: [&ExactVertex; 3], bary: [f64; 3]) {
-        let lerp = |f: &dyn Fn(&ExactVertex) -> f32| -> f32 {
-            (bary[0] * f(tri[0]) as f64 + bary[1] * f(tri[1]) as f64 + bary[2] * f(tri[2]) as f64)
-                as f32
-        };
-        let piece = tri[0].piece;
-        let l = lerp(&|v| v.thickness) / self.length_unit;
-        let tau = lerp(&|v| v.tau) * self.length_unit;
-        let glow = [0, 1, 2].map(|k| lerp(&|v| v.glow[k]));
+    fn fragment<V: GpuVertex>(
+        &mut self,
+        stage: &dyn CpuStage<V>,
+        i: u32,
+        j: u32,
+        tri: [&V; 3],
+        bary: [f64; 3],
+    ) {
+        let piece = tri[0].piece();
         let at = (j as usize) * (self.width as usize) + i as usize;
         let watched = self.watch == Some((i, j));
         let mut record = Fragment {
             triangle: self.triangles,
             piece,
-            thickness: l,
-            tau,
-            glow,
+            values: if watched {
+                stage.describe(tri, bary)
+            } else {
+                Vec::new()
+            },
             rgba: [0.0; 4],
         };
         let src = match self.draw {
-            DrawKind::Composite => {
-                if !(l.is_finite() && tau.is_finite() && glow.iter().all(|g| g.is_finite())) {
+            DrawKind::Composite => match stage.shade(tri, bary) {
+                Some(rgba) => rgba,
+                None => {
                     if watched {
                         self.watched.push(record);
                     }
                     return;
                 }
-                let alpha = self.table.sample(l, tau);
-                [glow[0] * alpha, glow[1] * alpha, glow[2] * alpha, alpha]
-            }
+            },
             DrawKind::CountPieces | DrawKind::CountTriangles => [1.0, 0.0, 0.0, 0.0],
         };
         let key = piece_depth(piece);

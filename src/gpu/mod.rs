@@ -1,62 +1,68 @@
-//! wgpu compositor for the exact (Max-Williams-Silva) mode.
+//! The GPU layer: a device, a render target, a batch stream over any vertex
+//! type, stages and tables. It knows no rendering mode: a mode brings its
+//! stage (a `.wgsl` file under `shaders/`, its vertex type and resources)
+//! and its CPU twin, and draws through the same [`Frame`].
 //!
-//! How it works, stage by stage:
+//! How a frame works, stage by stage:
 //! 1. [`Context::new`] opens a headless wgpu instance (Vulkan, GL, ... as
 //!    `Backends::all().with_env()`, or the one backend asked for), picks an
-//!    adapter (`force_fallback_adapter` for `--cpu-adapter`) and a device with
-//!    the adapter's limits and `FLOAT32_BLENDABLE` where it exists. It uploads
-//!    the exponential table ([`exptable`]) once.
-//! 2. [`Context::begin_frame`] creates the accumulation target (Rgba32Float
-//!    where the adapter can blend it, else Rgba16Float; see [`AccumFormat`]).
-//! 3. [`Frame::push_triangles`] appends [`ExactVertex`] triangles (already in
-//!    back-to-front order) to a CPU batch of bounded size; a full batch is
-//!    uploaded into reused vertex/index buffers and drawn by one command
-//!    encoder, and batches are submitted in order. At most two batches are in
-//!    flight, so memory stays bounded whatever the scene size.
-//! 4. The fragment shader (`shaders/exact.wgsl`) computes
-//!    `alpha = 1 - exp(-l tau)` from the 2D exponential table (manual bilinear
-//!    filtering in f32) and outputs the premultiplied `(glow * alpha, alpha)`;
-//!    the blend unit does premultiplied "over" back to front:
-//!    `dst = src + (1 - src.a) dst` on all four channels, in submission
-//!    order; the fragment's depth is its piece's key, so each piece colours
-//!    a pixel at most once ([`frame`] docs). [`cpu::CpuFrame`] is the CPU
-//!    twin of this stage.
-//! 5. [`Frame::finish`] copies the target into a staging buffer (rows padded to
-//!    256 bytes, in chunks no larger than the adapter allows), maps it, waits
-//!    with a poll loop that tolerates GL's `Timeout`, and converts f16 -> f32.
+//!    adapter (`force_fallback_adapter` for `--cpu-adapter`) and a device
+//!    with the adapter's limits and `FLOAT32_BLENDABLE` where it exists
+//!    ([`device`]). Stages and tables are compiled and uploaded once per
+//!    device and cached there ([`stage`], [`table`], [`Context::resource`]).
+//! 2. [`Context::begin_frame`] creates the target ([`target`]): the
+//!    accumulation texture (Rgba32Float where the adapter can blend it,
+//!    else Rgba16Float; see [`AccumFormat`]) and the piece-key depth
+//!    texture.
+//! 3. [`Frame::push_triangles`] appends triangles of a bound [`Stage`] (any
+//!    [`GpuVertex`], already in back-to-front order) to a CPU batch of
+//!    bounded size; a full batch, or a change of stage, uploads the batch
+//!    into reused vertex/index buffers and draws it with one command
+//!    encoder; batches are submitted in order and at most two are in
+//!    flight, so memory stays bounded whatever the scene size ([`frame`]).
+//! 4. The stage's fragment shader outputs a premultiplied colour and its
+//!    piece's key as depth; the blend unit does premultiplied "over" back to
+//!    front, `dst = src + (1 - src.a) dst` on all four channels, in
+//!    submission order, and the depth test lets each piece colour a pixel
+//!    at most once. [`cpu::CpuFrame`] is the CPU twin of this stage, with
+//!    each stage's twin ([`cpu::CpuStage`]) in place of its shader.
+//! 5. [`Frame::finish`] copies the target into a staging buffer (rows padded
+//!    to 256 bytes, in chunks no larger than the adapter allows), maps it,
+//!    waits with a poll loop that tolerates GL's `Timeout`, and converts
+//!    f16 -> f32 ([`readback`]).
 //!
 //! Conventions (docs/conventions.md): pixel `(i, j)` samples its centre
 //! `(i + 0.5, j + 0.5)`, row 0 at the top; [`ClipMapper`] turns continuous
-//! pixel coordinates into clip space so that the rasteriser samples exactly
-//! those points. Ties (a pixel centre exactly on a shared edge) follow the
-//! rasteriser's top-left fill rule: a centre on an edge belongs to the
-//! triangle for which that edge is a top edge (horizontal, other vertex below)
-//! or a left edge; so two triangles sharing an edge never both cover a centre
-//! on it, and one of them always does. Varyings use perspective-correct
-//! interpolation (never `@interpolate(linear)`: Mesa produces NaN with it on
-//! triangles crossing the viewport edge with different clip w).
+//! pixel coordinates into clip space on the rasteriser's sub-pixel grid so
+//! that the rasteriser samples exactly those points ([`raster`]). Ties (a
+//! pixel centre exactly on a shared edge) follow the rasteriser's top-left
+//! fill rule: a centre on an edge belongs to the triangle for which that
+//! edge is a top edge (horizontal, other vertex below) or a left edge; so
+//! two triangles sharing an edge never both cover a centre on it, and one
+//! of them always does. Varyings use perspective-correct interpolation
+//! (never `@interpolate(linear)`: Mesa produces NaN with it on triangles
+//! crossing the viewport edge with different clip w).
 //!
 //! Errors never panic: wgpu's uncaptured-error and device-lost callbacks are
 //! captured and turned into [`GpuError`] at the next check.
 
-mod context;
 pub mod cpu;
-pub mod exptable;
+mod device;
 mod frame;
+pub mod layer;
+pub mod raster;
 mod readback;
-mod vertex;
+pub mod stage;
+pub mod table;
+mod target;
 
-pub use context::{Context, ContextInfo, PendingContext};
+pub use device::{Context, ContextInfo, PendingContext};
 pub use frame::{DrawKind, Frame, FrameOptions, FrameStats};
-pub use vertex::{piece_depth, ClipMapper, ExactVertex, MAX_PIECES};
+pub use raster::{piece_depth, ClipMapper, GpuVertex, MAX_PIECES};
+pub use stage::{Binding, Resource, Stage, StageDesc};
+pub use table::Table;
 
 use thiserror::Error;
-
-/// WGSL source of the exact-mode compositing stage.
-pub const EXACT_WGSL: &str = include_str!("../../shaders/exact.wgsl");
-
-/// Every shader, by file name (for validation tests and tools).
-pub const SHADERS: &[(&str, &str)] = &[("exact.wgsl", EXACT_WGSL)];
 
 /// The graphics API to run on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -10,7 +10,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::context::Context;
+use super::device::Context;
 use super::{AccumFormat, GpuError};
 use crate::image::Image;
 

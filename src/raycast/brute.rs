@@ -92,7 +92,7 @@ use crate::numeric::predicates::{orient3d, Side};
 use crate::numeric::tolerance::BRUTE_OVERLAP_REPORT_REL;
 
 /// Counts of a brute-force render (summed over every ray traced so far).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct BruteStats {
     /// Candidate cells: those whose own box the ray meets (their points
     /// are projected onto the ray).

@@ -78,7 +78,8 @@ use geometry::RayFrame;
 use walk::{RawSegment, Scratch, WalkMesh};
 
 /// Which scalar field is integrated inside a cell (docs/conventions.md, Conventions).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum FieldModel {
     #[default]
     Faces,
@@ -110,7 +111,8 @@ impl std::str::FromStr for FieldModel {
 }
 
 /// How the ray caster finds the pieces along a ray.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Traversal {
     /// From cell to cell by face adjacency ([`walk`]; [`Raycaster`]).
     #[default]

@@ -186,7 +186,7 @@ const BRACKET_START: usize = 8;
 /// Counters of one ray's (or a whole render's) native work: what had to
 /// fall back from the exact method, so that a reference image says how
 /// reference it is.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct NativeStats {
     /// Cell intervals integrated through the iso-parametric field.
     pub intervals: u64,

@@ -24,12 +24,10 @@
 //!    ([`crate::integrate::segment`], breakpoints inside handled in closed
 //!    form) are composited front to back.
 //!
-//! The layer goes to the GPU through the exact pipeline itself: one quad per
-//! covered pixel, its corners on the pixel's edges (exact in f32), with
-//! constant attributes `l = unit`, `tau = depth / unit` and glow `C / alpha`,
-//! so the shader's `1 - exp(-l tau)` gives back the pixel's opacity (to the
-//! exponential table's accuracy) and `glow * alpha` its colour. Pixel centres
-//! lie strictly inside their quad, so each is covered exactly once.
+//! The layer is the same for every mode: the driver draws it with the layer
+//! stage ([`crate::gpu::layer`]), one quad per covered pixel with the
+//! pixel's premultiplied colour and opacity `1 - exp(-depth)`; pixel
+//! centres lie strictly inside their quad, so each is covered exactly once.
 //!
 //! Pieces that overlap in space (self-intersecting meshes, the only source of
 //! groups seen in real data) have no true order even along one ray; their
@@ -39,20 +37,24 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::camera::Camera;
-use crate::gpu::{ClipMapper, ExactVertex};
 use crate::integrate::segment;
 use crate::projection::Polyhedron;
 use crate::visibility::Piece;
 
-use super::exact::{value_range, ChunkOut, Ctx};
-
-/// Optical depth given to a fully opaque pixel (alpha = 1 - exp(-depth) is 1
-/// in f32 well before this; the exponential table clamps far above it).
-const MAX_LAYER_DEPTH: f64 = 1e3;
+use super::pieces::{value_range, PieceError, PieceSource};
 
 /// A covered pixel of a layer: column, row, premultiplied colour and
-/// optical depth.
-type LayerPixel = (u32, u32, [f64; 3], f64);
+/// opacity.
+pub type LayerPixel = (u32, u32, [f32; 4]);
+
+/// The layer of one cycle group.
+#[derive(Debug, Default)]
+pub struct GroupLayer {
+    /// The pixels it colours, row by row.
+    pub pixels: Vec<LayerPixel>,
+    /// Pieces left out for zero extinction over their range.
+    pub culled: usize,
+}
 
 /// One group piece ready for ray clipping.
 struct GroupPiece {
@@ -73,29 +75,28 @@ struct Hit {
     s_out: f64,
 }
 
-/// Makes the per-pixel layer of one group and appends its quads to `out`;
-/// returns the number of pixels the layer covers.
-pub(super) fn composite_group(ctx: &Ctx, pieces: &[Piece], out: &mut ChunkOut) -> usize {
-    let camera = ctx.camera;
+/// Makes the per-pixel layer of one group.
+pub(super) fn composite_group(
+    src: &PieceSource,
+    pieces: &[Piece],
+) -> Result<GroupLayer, PieceError> {
+    let camera = src.camera;
+    let mut layer = GroupLayer::default();
     let mut prepared = Vec::with_capacity(pieces.len());
     for piece in pieces {
         let mut poly = Polyhedron::default();
-        if let Err(e) = ctx.piece_polyhedron(piece, &mut poly) {
-            out.error = Some(e);
-            return 0;
-        }
+        src.polyhedron(piece, &mut poly)?;
         let (lo, hi) = value_range(poly.scalars.iter().copied());
-        if ctx.invisible(lo, hi) {
-            out.culled += 1;
+        if src.invisible(lo, hi) {
+            layer.culled += 1;
             continue;
         }
         if let Some(gp) = prepare(poly, camera) {
             prepared.push(gp);
         }
     }
-    let mut pixels = 0;
     if prepared.is_empty() {
-        return 0;
+        return Ok(layer);
     }
     let bbox = prepared.iter().fold([u32::MAX, u32::MAX, 0, 0], |b, p| {
         [
@@ -127,46 +128,24 @@ pub(super) fn composite_group(ctx: &Ctx, pieces: &[Piece], out: &mut ChunkOut) -
                 hits.sort_by(|a, b| (a.t_in + a.t_out).total_cmp(&(b.t_in + b.t_out)));
                 let (mut color, mut depth, mut trans) = ([0.0; 3], 0.0, 1.0);
                 for h in &hits {
-                    let seg = segment(ctx.tf, h.t_out - h.t_in, h.s_in, h.s_out);
+                    let seg = segment(src.tf, h.t_out - h.t_in, h.s_in, h.s_out);
                     for (c, sc) in color.iter_mut().zip(seg.color) {
                         *c += trans * sc;
                     }
                     trans *= 1.0 - seg.alpha;
                     depth += seg.depth;
                 }
-                if depth > 0.0 && depth.is_finite() {
-                    row.push((i, j, color, depth.min(MAX_LAYER_DEPTH)));
+                let alpha = -(-depth).exp_m1();
+                if depth > 0.0 && depth.is_finite() && alpha > 0.0 {
+                    let c = color.map(|c| c as f32);
+                    row.push((i, j, [c[0], c[1], c[2], alpha as f32]));
                 }
             }
             row
         })
         .collect();
-    let unit = ctx.length_unit;
-    let mapper = ClipMapper::for_camera(camera);
-    // The group's layer is one piece (its pixel quads do not overlap).
-    let piece = out.pieces;
-    out.pieces += 1;
-    for (i, j, color, depth) in rows.into_iter().flatten() {
-        let alpha = -(-depth).exp_m1();
-        if alpha <= 0.0 {
-            continue;
-        }
-        let glow = color.map(|c| (c / alpha) as f32);
-        let tau = (depth / unit) as f32;
-        let base = out.vertices.len() as u32;
-        for (di, dj) in [(0, 0), (1, 0), (1, 1), (0, 1)] {
-            // Pixel corners are on the grid: always mapped.
-            let ([x, y], _) = mapper
-                .ndc((i + di) as f64, (j + dj) as f64)
-                .unwrap_or(([0.0; 2], [0; 2]));
-            out.vertices
-                .push(ExactVertex::new([x, y, 0.5, 1.0], unit as f32, tau, glow).with_piece(piece));
-        }
-        out.indices
-            .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
-        pixels += 1;
-    }
-    pixels
+    layer.pixels = rows.into_iter().flatten().collect();
+    Ok(layer)
 }
 
 /// The pixel-centre ray through continuous pixel position `(px, py)`

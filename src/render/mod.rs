@@ -3,17 +3,21 @@
 //!
 //! [`Scene`] holds what does not depend on the view; [`Renderer`] holds what
 //! is reused between views of one scene (the visibility sorter with its
-//! planes and subdivisions, the GPU context); [`Renderer::render`] makes one
-//! image. Modes:
-//! - [`Mode::Exact`]: projection of convex pieces with exact vertex integrals,
-//!   composited by wgpu ([`exact`]);
-//! - [`Mode::Raycast`]: the CPU reference ray caster ([`crate::raycast`]),
-//!   walking by adjacency or, with [`Traversal::Brute`], testing every
-//!   piece ([`crate::raycast::brute`]).
+//! planes and subdivisions, the GPU context, the ray caster's structures);
+//! [`Renderer::render`] makes one image with the mode of
+//! [`RenderOptions::mode`]. The modes and their registry are in [`modes`];
+//! every projected-cell mode runs on one driver ([`driver`]), which turns
+//! pieces into polyhedra through [`pieces`] and draws cycle groups
+//! ([`group`]) through the mode-independent layer stage.
 
-pub mod exact;
+pub mod breakpoints;
+pub mod driver;
 mod group;
+pub mod modes;
+pub mod pieces;
 pub mod scene;
+pub mod stats;
+mod workers;
 
 use std::time::Instant;
 
@@ -22,46 +26,15 @@ use thiserror::Error;
 use crate::camera::{Camera, CameraParams};
 use crate::gpu::{AccumFormat, Context, DrawKind, GpuError, GpuOptions, PendingContext};
 use crate::image::Image;
-use crate::raycast::brute::{Brute, BruteStats};
-use crate::raycast::{self, FieldModel, RaycastOptions, Raycaster, Traversal};
+use crate::raycast::brute::Brute;
+use crate::raycast::{self, FieldModel, Raycaster, Traversal};
 use crate::visibility::{Sorter, VisibilityError};
 
-pub use exact::ExactStats;
+pub use breakpoints::split_points;
+pub use modes::{Bounds, Mode, ModeInfo};
+pub use pieces::PieceError;
 pub use scene::{ScalarsRef, Scene, SceneSpec};
-
-/// The rendering modes that exist.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Mode {
-    Exact,
-    Raycast,
-}
-
-impl Mode {
-    /// Names as the CLI spells them.
-    pub const NAMES: &'static [&'static str] = &["exact", "raycast"];
-
-    /// The CLI name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Mode::Exact => "exact",
-            Mode::Raycast => "raycast",
-        }
-    }
-}
-
-impl std::str::FromStr for Mode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Mode, String> {
-        match s {
-            "exact" => Ok(Mode::Exact),
-            "raycast" => Ok(Mode::Raycast),
-            _ => Err(format!(
-                "unknown mode '{s}' (available: {})",
-                Mode::NAMES.join(", ")
-            )),
-        }
-    }
-}
+pub use stats::{ModeStats, ProjectedStats, RaycastStats, RenderStats};
 
 /// Errors of a render.
 #[derive(Debug, Error)]
@@ -81,15 +54,19 @@ pub enum RenderError {
     #[error(transparent)]
     Visibility(#[from] VisibilityError),
     #[error("projection failed: {0}")]
-    Projection(String),
+    Piece(#[from] PieceError),
     #[error("the view draws more than {0} pieces, more than one frame can number")]
     TooManyPieces(u32),
     #[error(transparent)]
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Raycast(#[from] raycast::RaycastError),
-    #[error("the {0} mode cannot represent independent emission (its per-pixel colour is glow x opacity); use --mode raycast")]
-    Unsupported(&'static str),
+    #[error("the {mode} mode cannot draw {model:?} emission (it supports {supported}); use --mode raycast")]
+    Unsupported {
+        mode: &'static str,
+        model: crate::tf::EmissionModel,
+        supported: String,
+    },
 }
 
 /// Per-render options (camera, mode, field model, GPU).
@@ -116,7 +93,7 @@ pub struct RenderOptions {
     /// Exact mode: composite, or count coverage (tests and diagnostics).
     pub draw: DrawKind,
     /// Exact mode on the CPU twin: the pixel whose fragments are listed in
-    /// [`ExactStats::watched`].
+    /// [`ProjectedStats::watched`].
     pub watch: Option<(u32, u32)>,
 }
 
@@ -148,41 +125,14 @@ impl Default for RenderOptions {
     }
 }
 
-/// What one render did (seconds of wall time).
-#[derive(Clone, Debug, Default)]
-pub struct RenderStats {
-    pub mode: Option<Mode>,
-    pub total_s: f64,
-    pub setup_s: f64,
-    pub exact: Option<ExactStats>,
-    pub raycast: Option<RaycastStats>,
-    pub gpu_adapter: Option<String>,
-}
-
-/// What a ray-cast render used.
-#[derive(Clone, Copy, Debug)]
-pub struct RaycastStats {
-    pub model: FieldModel,
-    pub traversal: Traversal,
-    /// Rays stop once their transmittance falls below this (0: never), so
-    /// a pixel's opacity may fall short of the full integral by at most it.
-    pub termination_transmittance: f64,
-    /// Native model: intervals integrated and what fell back from the
-    /// exact method during this render (zero for other models).
-    pub native: crate::raycast::native::NativeStats,
-    /// Brute-force traversal: pieces tested, segments, and segments that
-    /// overlapped another piece's (zero for the walk).
-    pub brute: BruteStats,
-}
-
 /// Reusable state for rendering many views of one scene.
 pub struct Renderer<'s> {
-    scene: &'s Scene,
+    pub(crate) scene: &'s Scene,
     sorter: Option<Sorter>,
     gpu: Option<Context>,
     pending_gpu: Option<PendingContext>,
-    raycaster: Option<(FieldModel, Raycaster<'s>)>,
-    brute: Option<(FieldModel, Brute<'s>)>,
+    pub(crate) raycaster: Option<(FieldModel, Raycaster<'s>)>,
+    pub(crate) brute: Option<(FieldModel, Brute<'s>)>,
 }
 
 impl<'s> Renderer<'s> {
@@ -236,91 +186,63 @@ impl<'s> Renderer<'s> {
     ) -> Result<(Image, RenderStats), RenderError> {
         let t0 = Instant::now();
         let scene = self.scene;
-        let camera = *camera;
-        let mut stats = RenderStats {
-            mode: Some(opts.mode),
-            ..Default::default()
-        };
-        let image = match opts.mode {
-            Mode::Exact => {
-                if scene.tf.model() == crate::tf::EmissionModel::Independent {
-                    return Err(RenderError::Unsupported("exact"));
-                }
-                let mut sorter = self
-                    .sorter
-                    .take()
-                    .unwrap_or_else(|| Sorter::new(&scene.mesh, &scene.topology));
-                let sorter_s = t0.elapsed().as_secs_f64();
-                let result = exact::render_exact(
-                    scene,
-                    &mut sorter,
-                    &mut self.gpu,
-                    &mut self.pending_gpu,
-                    opts,
-                    &camera,
-                    progress,
-                );
-                self.sorter = Some(sorter);
-                stats.gpu_adapter = self.gpu.as_ref().map(|g| g.info().to_string());
-                let (img, es) = result?;
-                stats.setup_s = sorter_s + es.gpu_open_s;
-                stats.exact = Some(es);
-                img
-            }
+        let info = opts.mode.info();
+        let model = scene.tf.model();
+        if !info.emission.contains(&model) {
+            return Err(RenderError::Unsupported {
+                mode: info.name,
+                model,
+                supported: format!("{:?}", info.emission),
+            });
+        }
+        let (image, detail, setup_s) = match opts.mode {
+            Mode::Exact => self.projected(&modes::exact::ExactMode, opts, camera, progress)?,
             Mode::Raycast => {
-                let scalars = match scene.scalars() {
-                    ScalarsRef::Point(v) => raycast::Scalars::Point(v),
-                    ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
-                    ScalarsRef::Constant(c) => raycast::Scalars::Constant(c),
-                };
-                let rs = raycast::Scene {
-                    mesh: &scene.mesh,
-                    topology: &scene.topology,
-                    scalars,
-                };
-                let ro = RaycastOptions {
-                    model: opts.model,
-                    traversal: opts.traversal,
-                    ..Default::default()
-                };
-                let mut rstats = RaycastStats {
-                    model: opts.model,
-                    traversal: opts.traversal,
-                    termination_transmittance: ro.early_termination,
-                    native: Default::default(),
-                    brute: Default::default(),
-                };
-                let img = match opts.traversal {
-                    Traversal::Walk => {
-                        let rc = match self.raycaster.take() {
-                            Some((m, rc)) if m == opts.model => rc,
-                            _ => Raycaster::new(rs, opts.model)?,
-                        };
-                        stats.setup_s = t0.elapsed().as_secs_f64();
-                        let before = rc.native_stats();
-                        let img = rc.render_with_progress(&scene.tf, &camera, &ro, progress);
-                        rstats.native = rc.native_stats().since(&before);
-                        self.raycaster = Some((opts.model, rc));
-                        img
-                    }
-                    Traversal::Brute => {
-                        let b = match self.brute.take() {
-                            Some((m, b)) if m == opts.model => b,
-                            _ => Brute::new(rs, opts.model)?,
-                        };
-                        stats.setup_s = t0.elapsed().as_secs_f64();
-                        let before = b.stats();
-                        let img = b.render_with_progress(&scene.tf, &camera, &ro, progress);
-                        rstats.brute = b.stats().since(&before);
-                        self.brute = Some((opts.model, b));
-                        img
-                    }
-                };
-                stats.raycast = Some(rstats);
-                img
+                let (img, s, setup) = modes::raycast::render(self, opts, camera, progress)?;
+                (img, ModeStats::Raycast(s), setup)
             }
         };
-        stats.total_s = t0.elapsed().as_secs_f64();
+        let stats = RenderStats {
+            mode: opts.mode,
+            total_s: t0.elapsed().as_secs_f64(),
+            setup_s,
+            gpu_adapter: info
+                .gpu
+                .then(|| self.gpu.as_ref().map(|g| g.info().to_string()))
+                .flatten(),
+            detail,
+        };
         Ok((image, stats))
+    }
+
+    /// Renders with a projected-cell mode on the shared driver.
+    fn projected<M: driver::ProjectedMode>(
+        &mut self,
+        mode: &M,
+        opts: &RenderOptions,
+        camera: &Camera,
+        progress: impl FnMut(usize, usize),
+    ) -> Result<(Image, ModeStats, f64), RenderError> {
+        let t0 = Instant::now();
+        let scene = self.scene;
+        let mut sorter = self
+            .sorter
+            .take()
+            .unwrap_or_else(|| Sorter::new(&scene.mesh, &scene.topology));
+        let sorter_s = t0.elapsed().as_secs_f64();
+        let result = driver::render_projected(
+            mode,
+            scene,
+            &mut sorter,
+            &mut self.gpu,
+            &mut self.pending_gpu,
+            opts,
+            camera,
+            progress,
+        );
+        self.sorter = Some(sorter);
+        let (img, stats) = result?;
+        let setup_s = sorter_s + stats.gpu_open_s;
+        Ok((img, ModeStats::Projected(stats), setup_s))
     }
 }

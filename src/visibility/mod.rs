@@ -161,7 +161,7 @@ pub struct SplitPolicy<'a> {
 }
 
 /// What one call of [`Sorter::order`] did.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct OrderStats {
     /// Cells of the mesh.
     pub cells: usize,

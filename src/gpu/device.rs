@@ -1,5 +1,7 @@
-//! The GPU context: instance, adapter, device, the exponential table and the
-//! exact-mode pipelines.
+//! The GPU device: instance, adapter, device and queue, error capture, and
+//! the caches that live as long as the device (compiled stages, tables).
+//! It knows no rendering mode: modes bring their stages ([`super::stage`])
+//! and tables ([`super::table`]).
 //!
 //! Adapter choice: `Backends::all().with_env()` (so `WGPU_BACKEND=vulkan|gl`
 //! narrows it) unless [`GpuOptions::backend`] names one; `cpu_adapter` sets
@@ -13,12 +15,12 @@
 //! message, and [`Context::check`] turns it into a [`GpuError`] at the next
 //! synchronisation point, so no GPU failure panics.
 
-use std::sync::{Arc, Mutex, OnceLock};
+use std::any::Any;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use super::exptable::{ExpTable, TABLE_N};
-use super::frame::{DrawKind, PIECE_DEPTH_FORMAT};
-use super::vertex::ExactVertex;
+use super::stage::StageCache;
 use super::{AccumFormat, GpuError, GpuOptions};
 
 /// How long one wait for the GPU may take before it is reported as a timeout
@@ -46,26 +48,25 @@ impl std::fmt::Display for ContextInfo {
     }
 }
 
-/// An open GPU device with the exact-mode resources.
+/// An open GPU device with its caches.
 pub struct Context {
     pub(crate) device: wgpu::Device,
     pub(crate) queue: wgpu::Queue,
     info: ContextInfo,
     limits: wgpu::Limits,
     f32_blendable: bool,
-    pub(crate) table_view: wgpu::TextureView,
-    pub(crate) bind_layout: wgpu::BindGroupLayout,
-    pipeline_layout: wgpu::PipelineLayout,
-    shader: wgpu::ShaderModule,
-    /// Pipelines by accumulation format (f16, f32) and [`DrawKind`].
-    pipelines: [[OnceLock<wgpu::RenderPipeline>; 3]; 2],
+    /// Compiled stages (shader module, layouts, pipelines) by name
+    /// ([`super::stage`]).
+    pub(crate) stages: Mutex<HashMap<&'static str, Arc<StageCache>>>,
+    /// Resources made once per device and shared by frames (tables), by
+    /// key ([`Context::resource`]).
+    resources: Mutex<HashMap<&'static str, Arc<dyn Any + Send + Sync>>>,
     errors: Arc<Mutex<Vec<String>>>,
     lost: Arc<Mutex<Option<String>>>,
 }
 
 /// A [`Context`] being opened on another thread ([`Context::spawn`]):
-/// opening a device (and compiling the pipeline, which on a software
-/// adapter is LLVM work) takes a few tenths of a second that a caller can
+/// opening a device takes a few tenths of a second that a caller can
 /// overlap with reading and sorting a mesh.
 #[derive(Debug)]
 pub struct PendingContext {
@@ -180,52 +181,14 @@ impl Context {
             },
         };
 
-        let table_view = upload_table(&device, &queue, &ExpTable::new(TABLE_N));
-        let bind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("exact bind group"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("exact"),
-            bind_group_layouts: &[Some(&bind_layout)],
-            immediate_size: 0,
-        });
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("exact.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(super::EXACT_WGSL.into()),
-        });
         let ctx = Context {
             device,
             queue,
             info,
             limits,
             f32_blendable,
-            table_view,
-            bind_layout,
-            pipeline_layout,
-            shader,
-            pipelines: Default::default(),
+            stages: Default::default(),
+            resources: Default::default(),
             errors,
             lost,
         };
@@ -243,6 +206,27 @@ impl Context {
         &self.limits
     }
 
+    /// The resource stored under `key`, made by `make` on first use and
+    /// kept for the device's life (e.g. a mode's lookup table); an error of
+    /// `make` is returned and nothing is kept. A value of another type
+    /// under the same key is replaced.
+    pub fn resource<T: Any + Send + Sync, E>(
+        &self,
+        key: &'static str,
+        make: impl FnOnce(&Context) -> Result<T, E>,
+    ) -> Result<Arc<T>, E> {
+        if let Some(r) = self.resources.lock().ok().and_then(|m| m.get(key).cloned()) {
+            if let Ok(t) = r.downcast::<T>() {
+                return Ok(t);
+            }
+        }
+        let made = Arc::new(make(self)?);
+        if let Ok(mut m) = self.resources.lock() {
+            m.insert(key, made.clone());
+        }
+        Ok(made)
+    }
+
     /// Resolves `Auto` and checks that a forced format works here.
     pub fn resolve_format(&self, format: AccumFormat) -> Result<AccumFormat, GpuError> {
         match format {
@@ -254,78 +238,6 @@ impl Context {
                 reason: "Rgba32Float is not blendable (no FLOAT32_BLENDABLE) or not renderable",
             }),
         }
-    }
-
-    /// The exact pipeline for a resolved format and draw kind (built on
-    /// first use).
-    pub(crate) fn pipeline(&self, format: AccumFormat, kind: DrawKind) -> &wgpu::RenderPipeline {
-        let (row, tf) = match format {
-            AccumFormat::F32 => (1, wgpu::TextureFormat::Rgba32Float),
-            _ => (0, wgpu::TextureFormat::Rgba16Float),
-        };
-        self.pipelines[row][kind as usize].get_or_init(|| self.build_pipeline(tf, kind))
-    }
-
-    fn build_pipeline(&self, format: wgpu::TextureFormat, kind: DrawKind) -> wgpu::RenderPipeline {
-        // Premultiplied "over", back to front: dst = src + (1 - src.a) dst;
-        // counting adds.
-        let (blend, entry) = match kind {
-            DrawKind::Composite => (wgpu::BlendComponent::OVER, "fs_main"),
-            DrawKind::CountPieces | DrawKind::CountTriangles => (
-                wgpu::BlendComponent {
-                    src_factor: wgpu::BlendFactor::One,
-                    dst_factor: wgpu::BlendFactor::One,
-                    operation: wgpu::BlendOperation::Add,
-                },
-                "fs_count",
-            ),
-        };
-        // One colouring per piece and pixel: the fragment's depth is its
-        // piece's key, decreasing in drawing order (`piece_depth`).
-        let once_per_piece = kind != DrawKind::CountTriangles;
-        self.device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("exact"),
-                layout: Some(&self.pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &self.shader,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(ExactVertex::LAYOUT)],
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: PIECE_DEPTH_FORMAT,
-                    depth_write_enabled: Some(once_per_piece),
-                    depth_compare: Some(if once_per_piece {
-                        wgpu::CompareFunction::Less
-                    } else {
-                        wgpu::CompareFunction::Always
-                    }),
-                    stencil: wgpu::StencilState::default(),
-                    bias: wgpu::DepthBiasState::default(),
-                }),
-                multisample: wgpu::MultisampleState::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &self.shader,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format,
-                        blend: Some(wgpu::BlendState {
-                            color: blend,
-                            alpha: blend,
-                        }),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
     }
 
     /// Returns the first error recorded by wgpu's callbacks, if any.
@@ -361,43 +273,9 @@ impl Context {
     }
 }
 
-fn upload_table(device: &wgpu::Device, queue: &wgpu::Queue, table: &ExpTable) -> wgpu::TextureView {
-    let n = table.n();
-    let size = wgpu::Extent3d {
-        width: n,
-        height: n,
-        depth_or_array_layers: 1,
-    };
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("exp table"),
-        size,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    queue.write_texture(
-        wgpu::TexelCopyTextureInfo {
-            texture: &texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        bytemuck::cast_slice(table.data()),
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(4 * n),
-            rows_per_image: Some(n),
-        },
-        size,
-    );
-    texture.create_view(&wgpu::TextureViewDescriptor::default())
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::layer::{LayerVertex, LAYER_STAGE};
     use super::*;
 
     #[test]
@@ -411,10 +289,15 @@ mod tests {
             Err(e) => panic!("{e}"),
         };
         let mut frame = ctx.begin_frame(8, 8, AccumFormat::Auto).unwrap();
-        let v = ExactVertex::new([0.0, 0.0, 0.5, 1.0], 1.0, 1.0, [1.0; 3]);
-        let v2 = ExactVertex::new([1.0, 0.0, 0.5, 1.0], 1.0, 1.0, [1.0; 3]);
-        let v3 = ExactVertex::new([0.0, 1.0, 0.5, 1.0], 1.0, 1.0, [1.0; 3]);
-        frame.push_triangles(&[v, v2, v3], &[0, 1, 2]).unwrap();
+        let stage = ctx.bind_stage(&LAYER_STAGE, &[]).unwrap();
+        let v = |x: f32, y: f32| LayerVertex {
+            pos: [x, y, 0.5, 1.0],
+            rgba: [1.0; 4],
+            piece: 0,
+        };
+        frame
+            .push_triangles(&stage, &[v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)], &[0, 1, 2])
+            .unwrap();
         ctx.device.destroy();
         let r = frame.finish();
         assert!(

@@ -1,7 +1,6 @@
-//! The exact-mode vertex and the pixel -> clip-space mapping.
-//!
-//! [`ExactVertex`] mirrors `VertexIn` in `shaders/exact.wgsl` (keep in sync:
-//! field order, offsets and [`ExactVertex::LAYOUT`]'s formats).
+//! The rasteriser's geometry, common to every stage: the pixel ->
+//! clip-space mapping, the sub-pixel grid, the piece keys, and the
+//! [`GpuVertex`] trait every stage's vertex implements.
 //!
 //! [`ClipMapper`] builds clip-space positions from continuous pixel
 //! coordinates `(px, py)` (row 0 at the top, pixel centres at `i + 0.5`, as in
@@ -18,32 +17,27 @@
 //! affine in screen space. Clip z is `w / 2`: always inside the clip volume
 //! (the depth test compares the piece key the fragment writes).
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Pod;
 
 use crate::camera::Camera;
 
-/// One vertex of the exact mode.
-///
-/// Keep in sync with `VertexIn` in `shaders/exact.wgsl`.
-#[repr(C)]
-#[derive(Pod, Zeroable, Clone, Copy, Debug, Default, PartialEq)]
-pub struct ExactVertex {
+/// A vertex a stage draws: the Rust mirror of a shader's `VertexIn`
+/// (`#[repr(C)]`, [`Pod`]), with what the frame and the CPU twin need to
+/// know of every vertex type.
+pub trait GpuVertex: Pod + Send + Sync {
     /// Clip-space position (x, y, z, w); see [`ClipMapper`].
-    pub pos: [f32; 4],
-    /// `l`, the length of the ray through the piece at this vertex.
-    pub thickness: f32,
-    /// Mean extinction along that ray (optical depth / l).
-    pub tau: f32,
-    /// `C / alpha`: colour of the segment per unit opacity.
-    pub glow: [f32; 3],
-    /// The piece (convex polyhedron) this vertex's triangles belong to,
-    /// numbered in drawing order: the shader colours a pixel at most once
-    /// per piece ([`piece_depth`]).
-    pub piece: u32,
+    fn clip(&self) -> [f32; 4];
+    /// The piece this vertex's triangles belong to, numbered in drawing
+    /// order ([`piece_depth`]).
+    fn piece(&self) -> u32;
+    /// This vertex in piece `piece`.
+    fn with_piece(self, piece: u32) -> Self;
+    /// Whether every value the shader reads is finite.
+    fn is_finite(&self) -> bool;
 }
 
 /// The depth key of piece number `piece` in drawing order (CPU twin of
-/// `piece_depth` in `shaders/exact.wgsl`): the `f32` just below 1 for piece
+/// `piece_depth` in `shaders/common.wgsl`): the `f32` just below 1 for piece
 /// 0 and one representable value lower for each later piece, so that a
 /// strict less-than depth test passes later pieces and stops a second
 /// fragment of the same piece at a pixel. Keys stay in `(0, 1)` for pieces
@@ -55,48 +49,6 @@ pub fn piece_depth(piece: u32) -> f32 {
 /// Pieces one frame can number ([`piece_depth`] stays positive); the frame
 /// refuses more.
 pub const MAX_PIECES: u32 = 0x3F7F_FFFF;
-
-impl ExactVertex {
-    /// Vertex attributes (`@location`s of `VertexIn`).
-    pub const ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
-        0 => Float32x4,
-        1 => Float32,
-        2 => Float32,
-        3 => Float32x3,
-        4 => Uint32,
-    ];
-
-    /// The vertex buffer layout of the exact pipeline.
-    pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
-        array_stride: std::mem::size_of::<ExactVertex>() as wgpu::BufferAddress,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &Self::ATTRIBUTES,
-    };
-
-    /// A vertex of piece 0 from a clip position and its optical values.
-    pub fn new(pos: [f32; 4], thickness: f32, tau: f32, glow: [f32; 3]) -> ExactVertex {
-        ExactVertex {
-            pos,
-            thickness,
-            tau,
-            glow,
-            piece: 0,
-        }
-    }
-
-    /// The same vertex in piece `piece`.
-    pub fn with_piece(self, piece: u32) -> ExactVertex {
-        ExactVertex { piece, ..self }
-    }
-
-    /// Whether every value the shader reads is finite.
-    pub fn is_finite(&self) -> bool {
-        self.pos.iter().all(|v| v.is_finite())
-            && self.thickness.is_finite()
-            && self.tau.is_finite()
-            && self.glow.iter().all(|v| v.is_finite())
-    }
-}
 
 /// Sub-pixel grid of the rasteriser: positions are snapped to 1/`SUBPIXEL`
 /// pixel (8 bits, what lavapipe, llvmpipe and the desktop drivers use).
@@ -222,17 +174,6 @@ impl ClipMapper {
 mod tests {
     use super::*;
     use crate::camera::CameraParams;
-
-    #[test]
-    fn layout_matches_struct() {
-        assert_eq!(std::mem::size_of::<ExactVertex>(), 40);
-        assert_eq!(std::mem::offset_of!(ExactVertex, thickness), 16);
-        assert_eq!(std::mem::offset_of!(ExactVertex, tau), 20);
-        assert_eq!(std::mem::offset_of!(ExactVertex, glow), 24);
-        let offs: Vec<u64> = ExactVertex::ATTRIBUTES.iter().map(|a| a.offset).collect();
-        assert_eq!(std::mem::offset_of!(ExactVertex, piece), 36);
-        assert_eq!(offs, vec![0, 16, 20, 24, 36]);
-    }
 
     #[test]
     fn pixel_centres_round_trip() {

@@ -10,7 +10,7 @@
 //! ```
 //!
 //! (`x` is `l / unit` or `tau * unit` for the frame's length unit, see
-//! [`crate::gpu::FrameOptions::length_unit`]). Texel `i` of `N` sits at
+//! [`super::exact::ExactParams`]). Texel `i` of `N` sits at
 //! `s = i / (N - 1)`, i.e. at `x_i = expm1(s_i ln(1 + X^2)) / X`, and stores
 //! `1 - exp(-x_i x_j)` (computed in f64, stored as f32; the table is symmetric).
 //! The shader reads the four neighbours with `textureLoad` and filters them

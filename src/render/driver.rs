@@ -1,0 +1,754 @@
+//! The projected-cell driver, shared by every mode that draws convex pieces
+//! as screen triangles: visibility order -> pieces -> projection -> the
+//! mode's per-vertex payload -> GPU batches (or the CPU twin).
+//!
+//! Per view:
+//! 1. [`Sorter::order`] gives the drawable pieces back to front, sliced as
+//!    the mode asks ([`ProjectedMode::split_points`]: a cell whose nodal
+//!    scalar range holds one of those values comes as its consistent tets,
+//!    a tet holding one as its slabs; every cell's tets with `--split all`).
+//! 2. Each piece becomes its view-space parts ([`PieceSource::parts`]:
+//!    pieces with zero extinction over their range are skipped), each part
+//!    is projected into regions ([`Projector`]), leaving out pieces and
+//!    triangles that contain no pixel centre
+//!    ([`crate::projection::coverage`],
+//!    [`super::RenderOptions::cull_to_pixels`]).
+//! 3. The mode computes its payload at the region vertices a kept triangle
+//!    uses ([`ProjectedMode::payload`], which may refine the triangles), and
+//!    makes each vertex ([`ProjectedMode::vertex`]).
+//! 4. The driver snaps every corner to the rasteriser's sub-pixel grid
+//!    ([`ClipMapper::ndc`]), drops triangles that are flat or inverted
+//!    there ([`grid_area_positive`]), and numbers the part as one piece
+//!    (each piece colours a pixel at most once, [`crate::gpu::frame`]).
+//!
+//! Pieces are processed in chunks of consecutive pieces by worker threads,
+//! handed to the GPU in order as soon as each chunk and all before it are
+//! done ([`super::workers::run_ordered`]); chunk buffers are reused, so
+//! memory stays bounded whatever the mesh size.
+//!
+//! Interpolation: region vertices are sent with `w = 1` (positions already
+//! divided), so the GPU interpolates linearly in screen space, which is the
+//! model the projection's perspective refinement bounds (projection docs).
+//!
+//! Unresolved visibility cycles ([`crate::visibility::Order::groups`]) are
+//! composited per pixel on the CPU into one layer each ([`super::group`])
+//! and drawn at the group's place in the order by the layer stage
+//! ([`crate::gpu::layer`]), whatever the mode.
+
+use std::sync::Mutex;
+use std::time::Instant;
+
+use crate::camera::Camera;
+use crate::gpu::cpu::{CpuFrame, CpuStage};
+use crate::gpu::layer::{LayerTwin, LayerVertex, LAYER_STAGE};
+use crate::gpu::{
+    ClipMapper, Context, Frame, FrameOptions, FrameStats, GpuError, GpuVertex, PendingContext,
+    Stage, MAX_PIECES,
+};
+use crate::image::Image;
+use crate::projection::coverage::PixelGrid;
+use crate::projection::{Polyhedron, Projected, Projector};
+use crate::tf::TransferFunction;
+use crate::visibility::{Piece, Sorter, SplitPolicy};
+
+use super::group::composite_group;
+use super::pieces::{PartScratch, PieceError, PieceSource};
+use super::scene::{ScalarsRef, Scene};
+use super::stats::ProjectedStats;
+use super::workers::run_ordered;
+use super::{Compositor, RenderError, RenderOptions};
+
+/// Pieces processed per chunk (one worker's unit of work).
+const CHUNK: usize = 2048;
+
+/// Chunks a worker may run ahead of the GPU hand-over, per worker: bounds
+/// the memory in flight (about 0.4 MB per chunk on a fine mesh) while
+/// keeping every worker busy when chunk costs vary.
+const AHEAD_PER_WORKER: usize = 4;
+
+/// What a projected-cell mode adds to the shared driver: its split policy,
+/// its per-vertex payload, its stage (shader) and the stage's CPU twin.
+pub trait ProjectedMode: Sync {
+    /// The Rust mirror of the stage's `VertexIn`.
+    type Vertex: GpuVertex;
+    /// Per-worker scratch holding the payload of the piece being drawn.
+    type Payload: Default + Send;
+
+    /// TF values at which pieces are sliced (empty: never sliced).
+    fn split_points(&self, tf: &TransferFunction) -> Vec<f64>;
+
+    /// Binds the mode's stage for one frame (uniforms, tables).
+    fn bind(&self, gpu: &Context, length_unit: f32) -> Result<Stage, GpuError>;
+
+    /// The CPU twin of the stage's fragment shader, for one frame.
+    fn twin(&self, length_unit: f32) -> Box<dyn CpuStage<Self::Vertex>>;
+
+    /// Computes the payload of `part`'s projection at every vertex
+    /// `used[i]` marks (a kept triangle uses it). It may refine
+    /// `proj.triangles` (adding vertices, then marking them used) and must
+    /// then cull them again when `src.cull`; `refined` counts the triangles
+    /// it added.
+    fn payload(
+        &self,
+        src: &PieceSource,
+        part: &Polyhedron,
+        proj: &mut Projected,
+        used: &mut Vec<bool>,
+        payload: &mut Self::Payload,
+        refined: &mut usize,
+    );
+
+    /// Vertex `i` of `proj` at normalised device coordinates `ndc` (on the
+    /// sub-pixel grid), in piece 0 (the driver numbers the pieces).
+    fn vertex(
+        &self,
+        payload: &Self::Payload,
+        proj: &Projected,
+        i: usize,
+        ndc: [f32; 2],
+    ) -> Self::Vertex;
+}
+
+/// Output of one chunk: vertices and triangles ready for the GPU.
+pub(super) struct ChunkOut<V> {
+    pub(super) vertices: Vec<V>,
+    pub(super) indices: Vec<u32>,
+    pub(super) culled: usize,
+    /// Pieces drawn, numbered from 0 in this chunk; [`push_out`] makes the
+    /// numbers frame-wide (the shader colours a pixel once per piece).
+    pub(super) pieces: u32,
+    slabs: usize,
+    refined: usize,
+    /// Triangles dropped as degenerate on the sub-pixel grid
+    /// ([`grid_area_positive`]).
+    degenerate: usize,
+    pub(super) error: Option<PieceError>,
+}
+
+impl<V> Default for ChunkOut<V> {
+    fn default() -> Self {
+        ChunkOut {
+            vertices: Vec::new(),
+            indices: Vec::new(),
+            culled: 0,
+            pieces: 0,
+            slabs: 0,
+            refined: 0,
+            degenerate: 0,
+            error: None,
+        }
+    }
+}
+
+impl<V> ChunkOut<V> {
+    /// Empties everything, keeping the buffers.
+    fn clear(&mut self) {
+        self.vertices.clear();
+        self.indices.clear();
+        self.culled = 0;
+        self.pieces = 0;
+        self.slabs = 0;
+        self.refined = 0;
+        self.degenerate = 0;
+        self.error = None;
+    }
+}
+
+/// Scratch of one worker, reused from piece to piece.
+struct Worker<P> {
+    projector: Projector,
+    parts: PartScratch,
+    proj: Projected,
+    payload: P,
+    /// Vertices used by a kept triangle, their index in the output, and
+    /// their snapped grid position.
+    used: Vec<bool>,
+    remap: Vec<u32>,
+    grid: Vec<[i64; 2]>,
+}
+
+impl<P: Default> Worker<P> {
+    fn new(src: &PieceSource) -> Self {
+        let mut projector = Projector::new();
+        // Pieces cut by the near plane reach ~1e9 pixels off screen: clip
+        // their regions to the image so that screen-space interpolation
+        // stays exact up to the perspective refinement's bound.
+        projector.clip_to_image = true;
+        projector.cull_to_pixels = src.cull;
+        Worker {
+            projector,
+            parts: PartScratch::default(),
+            proj: Projected::default(),
+            payload: P::default(),
+            used: Vec::new(),
+            remap: Vec::new(),
+            grid: Vec::new(),
+        }
+    }
+}
+
+/// Projects one part, and appends its triangles with the mode's payload
+/// to `out` as one piece.
+fn draw_part<M: ProjectedMode>(
+    mode: &M,
+    src: &PieceSource,
+    part: &Polyhedron,
+    w: &mut Worker<M::Payload>,
+    out: &mut ChunkOut<M::Vertex>,
+) -> Result<(), crate::projection::ProjectionError> {
+    w.projector.project(part, src.camera, &mut w.proj)?;
+    let proj = &mut w.proj;
+    if proj.triangles.is_empty() {
+        return Ok(());
+    }
+    // Values only where a triangle uses the vertex (coverage culling leaves
+    // vertices of dropped triangles behind).
+    let used = &mut w.used;
+    used.clear();
+    used.resize(proj.vertices.len(), false);
+    for t in &proj.triangles {
+        for &i in t {
+            used[i as usize] = true;
+        }
+    }
+    mode.payload(src, part, proj, used, &mut w.payload, &mut out.refined);
+    let mapper = ClipMapper::for_camera(src.camera);
+    let piece = out.pieces;
+    out.pieces += 1;
+    // Index of each used vertex in `out.vertices` (u32::MAX: not emitted),
+    // and its snapped grid position (from `first` on).
+    let first = out.vertices.len() as u32;
+    w.grid.clear();
+    w.remap.clear();
+    for (i, v) in proj.vertices.iter().enumerate() {
+        if !used[i] {
+            w.remap.push(u32::MAX);
+            continue;
+        }
+        // Region positions are finite and on screen or clipped near it
+        // (`clip_to_image`); one that is not cannot be drawn exactly.
+        let Some((ndc, g)) = mapper.ndc(v.px, v.py) else {
+            w.remap.push(u32::MAX);
+            continue;
+        };
+        w.remap.push(out.vertices.len() as u32);
+        w.grid.push(g);
+        out.vertices
+            .push(mode.vertex(&w.payload, proj, i, ndc).with_piece(piece));
+    }
+    for t in &proj.triangles {
+        let idx = t.map(|i| w.remap[i as usize]);
+        if idx.contains(&u32::MAX) {
+            out.degenerate += 1;
+            continue;
+        }
+        let [a, b, c] = idx.map(|i| w.grid[(i - first) as usize]);
+        if grid_area_positive(a, b, c) {
+            out.indices.extend_from_slice(&idx);
+        } else {
+            out.degenerate += 1;
+        }
+    }
+    Ok(())
+}
+
+/// Whether the GPU sees the triangle `a, b, c` (region triangles are CCW in
+/// pixel coordinates, see [`crate::projection`]) with positive area: the
+/// exact orientation of its corners on the rasteriser's sub-pixel grid
+/// (which the GPU receives exactly, [`ClipMapper::ndc`]).
+///
+/// The projection keeps every triangle whose f64 pixel positions have a
+/// positive exact orientation; a sliver region (e.g. next to a face seen
+/// exactly edge-on) can become collinear or inverted once its corners are
+/// snapped. A triangle of zero area covers nothing (and Mesa's rasteriser
+/// gives NaN colour on pixel centres along such a triangle), so dropping it
+/// loses nothing. An inverted one overlaps its neighbours, which cover
+/// every centre it holds already: the snapped triangles still wind once
+/// around every point of the snapped silhouette, so the positive ones
+/// alone cover each centre at least once, and the depth test
+/// (`shaders/common.wgsl` `piece_depth`) makes it exactly once.
+pub(super) fn grid_area_positive(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> bool {
+    // Integer coordinates below 2^40: the cross product is exact in i128.
+    let [a, b, c] = [a, b, c].map(|p| [p[0] as i128, p[1] as i128]);
+    // Pixel y points down, as in the region triangles.
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0
+}
+
+/// Projects `pieces` into `out` (empty, its buffers possibly reused).
+fn process_chunk<M: ProjectedMode>(
+    mode: &M,
+    src: &PieceSource,
+    pieces: &[Piece],
+    mut out: ChunkOut<M::Vertex>,
+) -> ChunkOut<M::Vertex> {
+    let mut w = Worker::<M::Payload>::new(src);
+    for piece in pieces {
+        let mut parts = std::mem::take(&mut w.parts);
+        let done = src.parts(piece, &mut parts, |part| {
+            draw_part(mode, src, part, &mut w, &mut out).map_err(|source| PieceError::Projection {
+                cell: piece.cell(),
+                source,
+            })
+        });
+        w.parts = parts;
+        match done {
+            Ok(d) => {
+                out.culled += d.invisible as usize;
+                out.slabs += d.slabs;
+            }
+            Err(e) => {
+                out.error = Some(e);
+                return out;
+            }
+        }
+    }
+    out
+}
+
+/// Chunk buffers of drawn chunks, reused: fresh multi-megabyte vectors
+/// would be new pages for the kernel to fault in and zero, chunk after
+/// chunk.
+struct BufferPool<V>(Mutex<Vec<ChunkOut<V>>>);
+
+impl<V> Default for BufferPool<V> {
+    fn default() -> Self {
+        BufferPool(Mutex::new(Vec::new()))
+    }
+}
+
+impl<V> BufferPool<V> {
+    fn take(&self) -> ChunkOut<V> {
+        self.0
+            .lock()
+            .ok()
+            .and_then(|mut p| p.pop())
+            .unwrap_or_default()
+    }
+
+    fn put(&self, mut out: ChunkOut<V>) {
+        out.clear();
+        if let Ok(mut p) = self.0.lock() {
+            p.push(out);
+        }
+    }
+}
+
+/// Projects `pieces` in chunks of `chunk` pieces on `workers` threads and
+/// hands each chunk's output to `sink` on this thread, in order
+/// ([`run_ordered`]).
+fn pipeline<M: ProjectedMode>(
+    mode: &M,
+    src: &PieceSource,
+    pieces: &[Piece],
+    chunk: usize,
+    workers: usize,
+    pool: &BufferPool<M::Vertex>,
+    sink: impl FnMut(ChunkOut<M::Vertex>) -> Result<(), RenderError>,
+) -> Result<(), RenderError> {
+    let chunks: Vec<&[Piece]> = pieces.chunks(chunk.max(1)).collect();
+    run_ordered(
+        chunks.len(),
+        workers,
+        workers * AHEAD_PER_WORKER,
+        |i| process_chunk(mode, src, chunks[i], pool.take()),
+        sink,
+    )
+}
+
+/// Where a frame's triangles go: the GPU, or its CPU twin; with the mode's
+/// stage and the layer stage.
+enum Sink<'c, V> {
+    Gpu {
+        frame: Box<Frame<'c>>,
+        stage: Stage,
+        layer: Stage,
+    },
+    Cpu {
+        frame: Box<CpuFrame>,
+        twin: Box<dyn CpuStage<V>>,
+    },
+}
+
+impl<V: GpuVertex> Sink<'_, V> {
+    fn push(&mut self, vertices: &[V], indices: &[u32]) -> Result<(), GpuError> {
+        match self {
+            Sink::Gpu { frame, stage, .. } => frame.push_triangles(stage, vertices, indices),
+            Sink::Cpu { frame, twin } => frame.push_triangles(twin.as_ref(), vertices, indices),
+        }
+    }
+
+    fn push_layer(&mut self, vertices: &[LayerVertex], indices: &[u32]) -> Result<(), GpuError> {
+        match self {
+            Sink::Gpu { frame, layer, .. } => frame.push_triangles(layer, vertices, indices),
+            Sink::Cpu { frame, .. } => frame.push_triangles(&LayerTwin, vertices, indices),
+        }
+    }
+}
+
+/// Frame-wide piece numbers: the next one, and the rebasing of a chunk's.
+fn take_pieces(next_piece: &mut u32, count: u32) -> Result<u32, RenderError> {
+    let base = *next_piece;
+    *next_piece = base
+        .checked_add(count)
+        .filter(|&n| n <= MAX_PIECES)
+        .ok_or(RenderError::TooManyPieces(MAX_PIECES))?;
+    Ok(base)
+}
+
+/// Sends one chunk's triangles to the frame and adds up its counts; its
+/// pieces are numbered on from `next_piece` (drawing order).
+fn push_out<V: GpuVertex>(
+    sink: &mut Sink<V>,
+    out: &mut ChunkOut<V>,
+    stats: &mut ProjectedStats,
+    next_piece: &mut u32,
+) -> Result<(), RenderError> {
+    if let Some(e) = out.error.take() {
+        return Err(e.into());
+    }
+    let base = take_pieces(next_piece, out.pieces)?;
+    if base > 0 {
+        for v in &mut out.vertices {
+            *v = v.with_piece(v.piece() + base);
+        }
+    }
+    stats.culled_pieces += out.culled;
+    stats.slabs += out.slabs;
+    stats.refined_triangles += out.refined;
+    stats.triangles += out.indices.len() / 3;
+    sink.push(&out.vertices, &out.indices)?;
+    Ok(())
+}
+
+/// Renders the scene with a projected-cell mode. The GPU context is `gpu`,
+/// or, when that is empty, `pending` (a context opening on another thread,
+/// waited for after the sort, which it overlaps) or a new one opened with
+/// `opts.gpu`; it is left in `gpu`.
+#[allow(clippy::too_many_arguments)]
+pub fn render_projected<M: ProjectedMode>(
+    mode: &M,
+    scene: &Scene,
+    sorter: &mut Sorter,
+    gpu: &mut Option<Context>,
+    pending: &mut Option<PendingContext>,
+    opts: &RenderOptions,
+    camera: &Camera,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<(Image, ProjectedStats), RenderError> {
+    let mut stats = ProjectedStats::default();
+    let breakpoints = mode.split_points(&scene.tf);
+    let point_scalars = match scene.scalars() {
+        ScalarsRef::Point(v) => Some(v),
+        _ => None,
+    };
+    let t0 = Instant::now();
+    let policy = SplitPolicy {
+        all: opts.split_all,
+        breakpoints: &breakpoints,
+        point_scalars,
+    };
+    let order = sorter.order(camera, &policy)?;
+    stats.sort_s = t0.elapsed().as_secs_f64();
+    stats.pieces = order.pieces.len();
+    stats.order = order.stats.clone();
+
+    let src = PieceSource {
+        mesh: &scene.mesh,
+        scalars: scene.scalars(),
+        tf: &scene.tf,
+        camera,
+        breakpoints: &breakpoints,
+        levels: &order.levels,
+        fragments: &order.fragments,
+        length_unit: scene.unit_distance as f32 as f64,
+        cull: opts.cull_to_pixels,
+        grid: PixelGrid::new(camera.width, camera.height),
+    };
+    let t_open = Instant::now();
+    let length_unit = scene.unit_distance as f32;
+    let mut sink = match opts.compositor {
+        Compositor::Gpu => {
+            if gpu.is_none() {
+                *gpu = Some(match pending.take() {
+                    Some(p) if p.options() == &opts.gpu => p.wait()?,
+                    _ => Context::new(&opts.gpu)?,
+                });
+            }
+            let Some(gpu) = gpu.as_ref() else {
+                unreachable!("opened above")
+            };
+            let mut fopts = FrameOptions::new(camera.width, camera.height, opts.accum);
+            fopts.draw = opts.draw;
+            Sink::Gpu {
+                frame: Box::new(gpu.begin_frame_with(&fopts)?),
+                stage: mode.bind(gpu, length_unit)?,
+                layer: gpu.bind_stage(&LAYER_STAGE, &[])?,
+            }
+        }
+        Compositor::Cpu => {
+            let mut f = CpuFrame::new(camera.width, camera.height, opts.accum, opts.draw)?;
+            if let Some((i, j)) = opts.watch {
+                f.watch(i, j);
+            }
+            Sink::Cpu {
+                frame: Box::new(f),
+                twin: mode.twin(length_unit),
+            }
+        }
+    };
+    stats.gpu_open_s = t_open.elapsed().as_secs_f64();
+    let t_gpu = Instant::now();
+    let total = order.pieces.len();
+    let mut done = 0;
+    // Stretches of ordinary pieces, each followed by at most one group.
+    let mut stretches: Vec<(std::ops::Range<usize>, Option<std::ops::Range<usize>>)> = Vec::new();
+    let mut start = 0;
+    for g in &order.groups {
+        stretches.push((start..g.start, Some(g.clone())));
+        start = g.end;
+    }
+    stretches.push((start..total, None));
+    let tp = Instant::now();
+    let pool = BufferPool::default();
+    let workers = rayon::current_num_threads().max(1);
+    let mut next_piece = 0u32;
+    let mapper = ClipMapper::for_camera(camera);
+    for (plain, group) in stretches {
+        let pieces = &order.pieces[plain];
+        let mut handed = 0;
+        pipeline(mode, &src, pieces, CHUNK, workers, &pool, |mut out| {
+            push_out(&mut sink, &mut out, &mut stats, &mut next_piece)?;
+            pool.put(out);
+            handed += CHUNK;
+            progress(done + handed.min(pieces.len()), total);
+            Ok(())
+        })?;
+        done += pieces.len();
+        if let Some(g) = group {
+            let layer = composite_group(&src, &order.pieces[g.clone()])?;
+            stats.culled_pieces += layer.culled;
+            stats.group_pixels += layer.pixels.len();
+            // The group's layer is one piece (its pixel quads do not
+            // overlap).
+            let piece = take_pieces(&mut next_piece, 1)?;
+            let (mut vertices, mut indices) = (Vec::new(), Vec::new());
+            for &(i, j, rgba) in &layer.pixels {
+                LayerVertex::pixel_quad(&mapper, i, j, rgba, piece, &mut vertices, &mut indices);
+            }
+            stats.triangles += indices.len() / 3;
+            sink.push_layer(&vertices, &indices)?;
+            done += g.len();
+            progress(done, total);
+        }
+    }
+    let project_s = tp.elapsed().as_secs_f64();
+    let (image, fstats) = match sink {
+        Sink::Gpu { frame, .. } => frame.finish_with_stats()?,
+        Sink::Cpu { frame, .. } => {
+            stats.watched = frame.covering().to_vec();
+            let fs = FrameStats {
+                triangles: frame.triangles(),
+                ..Default::default()
+            };
+            (frame.finish(), fs)
+        }
+    };
+    stats.gpu = fstats;
+    stats.project_s = project_s;
+    stats.gpu_total_s = t_gpu.elapsed().as_secs_f64() - project_s;
+    Ok((image, stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::CameraParams;
+    use crate::generate::{warped_hex_grid, Warp};
+    use crate::render::breakpoints::split_points;
+    use crate::render::modes::exact::{ExactMode, ExactVertex};
+    use crate::render::SceneSpec;
+    use crate::tf::EmissionModel;
+    use crate::visibility::Order;
+
+    /// The context of `order` for `scene` seen by `camera`.
+    fn test_ctx<'a>(
+        scene: &'a Scene,
+        camera: &'a Camera,
+        breakpoints: &'a [f64],
+        order: &'a Order,
+        cull: bool,
+    ) -> PieceSource<'a> {
+        PieceSource {
+            mesh: &scene.mesh,
+            scalars: scene.scalars(),
+            tf: &scene.tf,
+            camera,
+            breakpoints,
+            levels: &order.levels,
+            fragments: &order.fragments,
+            length_unit: scene.unit_distance,
+            cull,
+            grid: PixelGrid::new(camera.width, camera.height),
+        }
+    }
+
+    /// An unwarped grid seen in perspective straight down an axis, every
+    /// cell split into tets: the diagonal faces of the tets in the planes
+    /// through the eye are seen exactly edge-on, and rounding the pixel
+    /// positions leaves sliver regions that are collinear in f32 (Mesa gave
+    /// NaN pixels on them, tests/stress_scenes.rs `edge_on_...`). None may
+    /// reach the GPU.
+    #[test]
+    fn no_triangle_degenerate_in_f32_reaches_the_gpu() {
+        let mesh = warped_hex_grid(
+            2,
+            &Warp {
+                amplitude: 0.0,
+                seed: 7,
+            },
+        );
+        let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        scene.tf = TransferFunction::from_channels(
+            &[(0.0, [0.0]), (0.5, [6.0]), (1.0, [10.0])],
+            &[(0.0, [0.1, 0.2, 0.9]), (1.0, [1.0, 0.5, 0.1])],
+            None,
+            EmissionModel::Glow,
+        )
+        .unwrap();
+        let params = CameraParams {
+            width: 96,
+            height: 96,
+            azimuth: 0.0,
+            elevation: 0.0,
+            ortho: false,
+            ..Default::default()
+        };
+        let camera = Camera::fit(scene.mesh.bounds(), &params);
+        let breakpoints = split_points(&scene.tf);
+        let point_scalars = match scene.scalars() {
+            ScalarsRef::Point(v) => Some(v),
+            _ => None,
+        };
+        let policy = SplitPolicy {
+            all: true,
+            breakpoints: &breakpoints,
+            point_scalars,
+        };
+        let mut sorter = Sorter::new(&scene.mesh, &scene.topology);
+        let order = sorter.order(&camera, &policy).unwrap();
+        let ctx = test_ctx(&scene, &camera, &breakpoints, &order, false);
+        // Piece by piece, up to the first one that makes such a sliver (the
+        // whole view refines into ~1e5 triangles).
+        let mut degenerate = 0;
+        for piece in &order.pieces {
+            let out = process_chunk(
+                &ExactMode,
+                &ctx,
+                std::slice::from_ref(piece),
+                ChunkOut::default(),
+            );
+            assert_eq!(out.error, None);
+            let mapper = ClipMapper::for_camera(&camera);
+            let half = mapper.side as f32 * 0.5;
+            for t in out.indices.chunks(3) {
+                // The grid positions the rasteriser recovers from the NDC.
+                let [a, b, c] = [0, 1, 2].map(|k| {
+                    let p = out.vertices[t[k] as usize].pos;
+                    let (x, y) = (p[0] * half + half, -p[1] * half + half);
+                    [x, y].map(|v| ClipMapper::snap(v as f64).unwrap())
+                });
+                assert!(grid_area_positive(a, b, c), "{piece:?}: {a:?} {b:?} {c:?}");
+            }
+            degenerate += out.degenerate;
+            if degenerate > 0 {
+                break;
+            }
+        }
+        // The view still makes the case this guards against.
+        assert!(degenerate > 0, "no f32-degenerate sliver in this view");
+    }
+
+    /// The pipeline hands every chunk over in order, exactly as projecting
+    /// the chunks one after another gives them, with whatever number of
+    /// workers; an error of the hand-over stops it and is returned.
+    #[test]
+    fn pipeline_hands_chunks_over_in_order_and_stops_on_error() {
+        let mesh = warped_hex_grid(
+            12,
+            &Warp {
+                amplitude: 0.2,
+                seed: 3,
+            },
+        );
+        let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        let camera = Camera::fit(
+            scene.mesh.bounds(),
+            &CameraParams {
+                width: 64,
+                height: 64,
+                azimuth: 30.0,
+                elevation: 20.0,
+                ..Default::default()
+            },
+        );
+        let breakpoints = split_points(&scene.tf);
+        let policy = SplitPolicy {
+            all: true,
+            breakpoints: &breakpoints,
+            point_scalars: None,
+        };
+        let mut sorter = Sorter::new(&scene.mesh, &scene.topology);
+        let order = sorter.order(&camera, &policy).unwrap();
+        let ctx = test_ctx(&scene, &camera, &breakpoints, &order, true);
+        let chunk = 64;
+        let chunks = order.pieces.chunks(chunk).count();
+        assert!(chunks > 4 * 3 * AHEAD_PER_WORKER, "{chunks} chunks");
+        let serial: Vec<(Vec<ExactVertex>, Vec<u32>)> = order
+            .pieces
+            .chunks(chunk)
+            .map(|c| {
+                let out = process_chunk(&ExactMode, &ctx, c, ChunkOut::default());
+                (out.vertices, out.indices)
+            })
+            .collect();
+        assert!(serial.iter().filter(|c| !c.1.is_empty()).count() > chunks / 2);
+        let pool = BufferPool::default();
+        for workers in [1, 2, 3] {
+            let mut got = Vec::new();
+            pipeline(
+                &ExactMode,
+                &ctx,
+                &order.pieces,
+                chunk,
+                workers,
+                &pool,
+                |out| {
+                    got.push((out.vertices.clone(), out.indices.clone()));
+                    pool.put(out);
+                    Ok(())
+                },
+            )
+            .unwrap();
+            assert!(got == serial, "{workers} workers");
+            let mut calls = 0;
+            let r = pipeline(
+                &ExactMode,
+                &ctx,
+                &order.pieces,
+                chunk,
+                workers,
+                &pool,
+                |_| {
+                    calls += 1;
+                    if calls == 3 {
+                        Err(RenderError::NoCells)
+                    } else {
+                        Ok(())
+                    }
+                },
+            );
+            assert!(matches!(r, Err(RenderError::NoCells)));
+            assert_eq!(calls, 3);
+        }
+    }
+}

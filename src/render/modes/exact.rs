@@ -1,0 +1,427 @@
+//! The exact mode (Max, Williams and Silva, "Area and Volume Coherence for
+//! Efficient Visualization of 3D Scalar Functions", MWS): exact ray
+//! integrals at region vertices, composited by the GPU.
+//!
+//! On the shared projected-cell driver ([`crate::render::driver`]) it
+//! supplies:
+//! - **split policy**: pieces are sliced at every kink or jump of the
+//!   extinction and every jump of the colour
+//!   ([`crate::render::breakpoints::split_points`]), so the extinction is
+//!   linear along every ray through a piece and the per-pixel opacity
+//!   below is exact;
+//! - **payload** ([`ExactMode::payload`]): at every region vertex a kept
+//!   triangle uses, the closed-form integral
+//!   ([`crate::integrate::vertex_values`]) gives the glow colour `C/alpha`
+//!   and the mean extinction `tau` along the vertex's ray of length `l`.
+//!   Region triangles whose vertices differ much in optical depth and glow
+//!   colour are refined (math README 8.1: `C/alpha` is interpolated inside a
+//!   region), see [`COLOR_REFINE_TOL`]. Each piece's `l` and `tau` are
+//!   balanced for the table's axes ([`depth_balance`]);
+//! - **stage** (`shaders/exact.wgsl`, [`EXACT_STAGE`]): per fragment,
+//!   `alpha = 1 - exp(-l tau)` from the 2D exponential table
+//!   ([`super::exptable`], manual bilinear filtering in `f32`) and colour
+//!   `glow * alpha`, premultiplied; [`ExactTwin`] is its CPU twin.
+//!
+//! The glow colour per unit opacity is all a vertex carries, so the mode
+//! cannot represent independent emission (the registry says so).
+
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+
+use crate::gpu::cpu::{lerp, CpuStage};
+use crate::gpu::{Binding, Context, GpuError, GpuVertex, Resource, Stage, StageDesc, Table};
+use crate::integrate::{vertex_values, VertexValues};
+use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL};
+use crate::projection::{refine, Polyhedron, Projected};
+use crate::render::breakpoints::split_points;
+use crate::render::driver::ProjectedMode;
+use crate::render::pieces::{value_range, PieceSource};
+use crate::tf::TransferFunction;
+
+use super::exptable::{shader_params, ExpTable, TABLE_N};
+use super::{Bounds, ModeInfo};
+use crate::raycast::FieldModel;
+use crate::tf::EmissionModel;
+
+/// The registry entry of the exact mode.
+pub static INFO: ModeInfo = ModeInfo {
+    name: "exact",
+    summary: "projection of convex pieces with exact vertex integrals, composited by wgpu",
+    gpu: true,
+    emission: &[EmissionModel::Glow],
+    slices_at_breakpoints: true,
+    stage: Some(&EXACT_STAGE),
+    bounds: Some(Bounds {
+        reference: FieldModel::Faces,
+        max_abs: 2.0 / 255.0,
+    }),
+};
+
+/// One vertex of the exact mode.
+///
+/// Keep in sync with `VertexIn` in `shaders/exact.wgsl`.
+#[repr(C)]
+#[derive(Pod, Zeroable, Clone, Copy, Debug, Default, PartialEq)]
+pub struct ExactVertex {
+    /// Clip-space position (x, y, z, w); see [`crate::gpu::ClipMapper`].
+    pub pos: [f32; 4],
+    /// `l`, the length of the ray through the piece at this vertex.
+    pub thickness: f32,
+    /// Mean extinction along that ray (optical depth / l).
+    pub tau: f32,
+    /// `C / alpha`: colour of the segment per unit opacity.
+    pub glow: [f32; 3],
+    /// The piece (convex polyhedron) this vertex's triangles belong to,
+    /// numbered in drawing order: the shader colours a pixel at most once
+    /// per piece ([`crate::gpu::piece_depth`]).
+    pub piece: u32,
+}
+
+impl ExactVertex {
+    /// Vertex attributes (`@location`s of `VertexIn`).
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
+        0 => Float32x4,
+        1 => Float32,
+        2 => Float32,
+        3 => Float32x3,
+        4 => Uint32,
+    ];
+
+    /// A vertex of piece 0 from a clip position and its optical values.
+    pub fn new(pos: [f32; 4], thickness: f32, tau: f32, glow: [f32; 3]) -> ExactVertex {
+        ExactVertex {
+            pos,
+            thickness,
+            tau,
+            glow,
+            piece: 0,
+        }
+    }
+}
+
+impl GpuVertex for ExactVertex {
+    fn clip(&self) -> [f32; 4] {
+        self.pos
+    }
+    fn piece(&self) -> u32 {
+        self.piece
+    }
+    fn with_piece(self, piece: u32) -> Self {
+        ExactVertex { piece, ..self }
+    }
+    fn is_finite(&self) -> bool {
+        self.pos.iter().all(|v| v.is_finite())
+            && self.thickness.is_finite()
+            && self.tau.is_finite()
+            && self.glow.iter().all(|v| v.is_finite())
+    }
+}
+
+/// Uniforms of the exact stage. Keep in sync with `Params` in
+/// `shaders/exact.wgsl`.
+///
+/// The length unit addresses the table: the shader uses `l / unit` and
+/// `tau * unit` (their product, the optical depth, is unchanged); the scene's
+/// unit distance keeps both within the table's per-axis range `[0, 1e6]`.
+#[repr(C)]
+#[derive(Pod, Zeroable, Clone, Copy, Debug)]
+pub struct ExactParams {
+    pub inv_unit: f32,
+    pub unit: f32,
+    pub scale: f32,
+    pub inv_log_range: f32,
+    pub n: u32,
+    pub _pad: [u32; 3],
+}
+
+/// The exact stage.
+pub static EXACT_STAGE: StageDesc = StageDesc {
+    name: "exact.wgsl",
+    wgsl: include_str!("../../../shaders/exact.wgsl"),
+    vertex: wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<ExactVertex>() as wgpu::BufferAddress,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &ExactVertex::ATTRIBUTES,
+    },
+    bindings: &[Binding::Uniform, Binding::Table2d],
+};
+
+fn check_unit(length_unit: f32) -> Result<(), GpuError> {
+    if length_unit > 0.0 && length_unit.is_finite() {
+        Ok(())
+    } else {
+        Err(GpuError::BadOption(
+            "length_unit must be positive and finite",
+        ))
+    }
+}
+
+/// Binds the exact stage for a frame with length unit `length_unit` (the
+/// exponential table is uploaded once per device).
+pub fn bind_exact_stage(gpu: &Context, length_unit: f32) -> Result<Stage, GpuError> {
+    check_unit(length_unit)?;
+    let table = gpu.resource("exact: exponential table", |g| {
+        Table::upload(
+            g,
+            "exp table",
+            [TABLE_N, TABLE_N, 1],
+            ExpTable::new(TABLE_N).data(),
+        )
+    })?;
+    let (scale, inv_log_range) = shader_params();
+    let params = ExactParams {
+        inv_unit: 1.0 / length_unit,
+        unit: length_unit,
+        scale,
+        inv_log_range,
+        n: TABLE_N,
+        _pad: [0; 3],
+    };
+    gpu.bind_stage(
+        &EXACT_STAGE,
+        &[
+            Resource::Uniform(bytemuck::bytes_of(&params)),
+            Resource::Table(&table),
+        ],
+    )
+}
+
+/// The CPU twin of `fs_main` in `shaders/exact.wgsl`: a fragment with a
+/// non-finite attribute is discarded; otherwise `alpha` comes from the
+/// exponential table ([`ExpTable::sample`], the twin of `alpha_of`) and
+/// the colour is `glow * alpha`.
+pub struct ExactTwin {
+    length_unit: f32,
+    table: ExpTable,
+}
+
+impl ExactTwin {
+    /// The twin for length unit `length_unit`.
+    pub fn new(length_unit: f32) -> Result<ExactTwin, GpuError> {
+        check_unit(length_unit)?;
+        Ok(ExactTwin {
+            length_unit,
+            table: ExpTable::new(TABLE_N),
+        })
+    }
+
+    /// `l`, `tau` and glow as the shader interpolates and scales them.
+    fn values(&self, tri: [&ExactVertex; 3], bary: [f64; 3]) -> (f32, f32, [f32; 3]) {
+        let l = lerp(tri, bary, |v| v.thickness) / self.length_unit;
+        let tau = lerp(tri, bary, |v| v.tau) * self.length_unit;
+        let glow = [0, 1, 2].map(|k| lerp(tri, bary, |v| v.glow[k]));
+        (l, tau, glow)
+    }
+}
+
+impl CpuStage<ExactVertex> for ExactTwin {
+    fn shade(&self, tri: [&ExactVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
+        let (l, tau, glow) = self.values(tri, bary);
+        if !(l.is_finite() && tau.is_finite() && glow.iter().all(|g| g.is_finite())) {
+            return None;
+        }
+        let alpha = self.table.sample(l, tau);
+        Some([glow[0] * alpha, glow[1] * alpha, glow[2] * alpha, alpha])
+    }
+
+    fn describe(&self, tri: [&ExactVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {
+        let (l, tau, glow) = self.values(tri, bary);
+        vec![
+            ("l", l),
+            ("tau", tau),
+            ("glow.r", glow[0]),
+            ("glow.g", glow[1]),
+            ("glow.b", glow[2]),
+        ]
+    }
+}
+
+/// The exact mode on the projected-cell driver.
+pub struct ExactMode;
+
+/// The exact payload of one piece: the vertex integrals and the piece's
+/// depth balance.
+#[derive(Default)]
+pub struct ExactPayload {
+    values: Vec<VertexValues>,
+    balance: f64,
+}
+
+impl ProjectedMode for ExactMode {
+    type Vertex = ExactVertex;
+    type Payload = ExactPayload;
+
+    fn split_points(&self, tf: &TransferFunction) -> Vec<f64> {
+        split_points(tf)
+    }
+
+    fn bind(&self, gpu: &Context, length_unit: f32) -> Result<Stage, GpuError> {
+        bind_exact_stage(gpu, length_unit)
+    }
+
+    fn twin(&self, length_unit: f32) -> Box<dyn CpuStage<ExactVertex>> {
+        // The driver's unit is the scene's (positive, finite) unit distance.
+        Box::new(ExactTwin::new(length_unit).unwrap_or(ExactTwin {
+            length_unit: 1.0,
+            table: ExpTable::new(TABLE_N),
+        }))
+    }
+
+    fn payload(
+        &self,
+        src: &PieceSource,
+        part: &Polyhedron,
+        proj: &mut Projected,
+        used: &mut Vec<bool>,
+        payload: &mut ExactPayload,
+        refined: &mut usize,
+    ) {
+        payload.balance = depth_balance(src, part);
+        let tf = src.tf;
+        let vals = &mut payload.values;
+        vals.clear();
+        vals.extend(proj.vertices.iter().zip(used.iter()).map(|(v, &u)| {
+            if u {
+                vertex_values(tf, v.l, v.s_front, v.s_back)
+            } else {
+                VertexValues::default()
+            }
+        }));
+        // Refine only pieces whose optical depth and glow spread could make
+        // the interpolated C/alpha err (the common thin or uniform piece
+        // skips it).
+        let depth = vals.iter().map(|v| v.depth).fold(0.0, f64::max).min(1.0);
+        let spread = (0..3)
+            .map(|k| {
+                let (lo, hi) = value_range(
+                    vals.iter()
+                        .zip(used.iter())
+                        .filter(|(_, &u)| u)
+                        .map(|(v, _)| v.glow[k]),
+                );
+                hi - lo
+            })
+            .fold(0.0, f64::max);
+        if depth * spread > COLOR_REFINE_TOL {
+            let before = proj.triangles.len();
+            refine(proj, COLOR_REFINE_MAX_DEPTH, |a, b| {
+                let va = vertex_values(tf, a.l, a.s_front, a.s_back);
+                let vb = vertex_values(tf, b.l, b.s_front, b.s_back);
+                let depth = va.depth.max(vb.depth).min(1.0);
+                let spread = (0..3)
+                    .map(|k| (va.glow[k] - vb.glow[k]).abs())
+                    .fold(0.0, f64::max);
+                depth * spread > COLOR_REFINE_TOL
+            });
+            if src.cull {
+                proj.cull_to_pixels(&src.grid);
+            }
+            *refined += proj.triangles.len().saturating_sub(before);
+            let n = vals.len();
+            used.resize(proj.vertices.len(), true);
+            vals.extend(
+                proj.vertices[n..]
+                    .iter()
+                    .map(|v| vertex_values(tf, v.l, v.s_front, v.s_back)),
+            );
+        }
+    }
+
+    fn vertex(
+        &self,
+        payload: &ExactPayload,
+        proj: &Projected,
+        i: usize,
+        ndc: [f32; 2],
+    ) -> ExactVertex {
+        let (v, vv, k) = (&proj.vertices[i], &payload.values[i], payload.balance);
+        ExactVertex::new(
+            [ndc[0], ndc[1], 0.5, 1.0],
+            (v.l * k) as f32,
+            (vv.tau_mean / k) as f32,
+            [vv.glow[0] as f32, vv.glow[1] as f32, vv.glow[2] as f32],
+        )
+    }
+}
+
+/// Per-piece scale `k` sending `l k` and `tau / k` to the shader (their
+/// product, the optical depth, is unchanged): it brings the piece's
+/// diameter (a bound on `l`) and the largest extinction of the TF over its
+/// scalar range to the same size, so neither table axis clamps. It depends
+/// on the piece alone, not on which regions and triangles coverage culling
+/// keeps, so culling changes no pixel.
+fn depth_balance(src: &PieceSource, piece: &Polyhedron) -> f64 {
+    let (s_lo, s_hi) = value_range(piece.scalars.iter().copied());
+    let (lo, hi) = piece.points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let l_max = (hi - lo).length();
+    let tf = src.tf;
+    let mut tau_max = tf.tau_at(s_lo).max(tf.tau_at(s_hi));
+    for &b in src.breakpoints {
+        if b > s_lo && b < s_hi {
+            tau_max = tau_max.max(tf.tau_at(b));
+        }
+    }
+    let (l_max, tau_max) = (l_max / src.length_unit, tau_max * src.length_unit);
+    let k = (tau_max / l_max).sqrt();
+    if l_max > 0.0 && tau_max > 0.0 && k.is_finite() && k > 0.0 {
+        k
+    } else {
+        1.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layout_matches_struct() {
+        assert_eq!(std::mem::size_of::<ExactVertex>(), 40);
+        assert_eq!(std::mem::offset_of!(ExactVertex, thickness), 16);
+        assert_eq!(std::mem::offset_of!(ExactVertex, tau), 20);
+        assert_eq!(std::mem::offset_of!(ExactVertex, glow), 24);
+        let offs: Vec<u64> = ExactVertex::ATTRIBUTES.iter().map(|a| a.offset).collect();
+        assert_eq!(std::mem::offset_of!(ExactVertex, piece), 36);
+        assert_eq!(offs, vec![0, 16, 20, 24, 36]);
+    }
+
+    #[test]
+    fn uniforms_match_wgsl_params() {
+        let src = crate::gpu::stage::stage_source(EXACT_STAGE.wgsl);
+        let module = naga::front::wgsl::parse_str(&src).unwrap();
+        let (members, span) = module
+            .types
+            .iter()
+            .find_map(|(_, t)| match (&t.name, &t.inner) {
+                (Some(n), naga::TypeInner::Struct { members, span }) if n == "Params" => {
+                    Some((members.clone(), *span))
+                }
+                _ => None,
+            })
+            .expect("struct Params");
+        assert_eq!(span as usize, std::mem::size_of::<ExactParams>());
+        let offs: Vec<(String, u32)> = members
+            .iter()
+            .take(5)
+            .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+            .collect();
+        let want = [
+            ("inv_unit", std::mem::offset_of!(ExactParams, inv_unit)),
+            ("unit", std::mem::offset_of!(ExactParams, unit)),
+            ("scale", std::mem::offset_of!(ExactParams, scale)),
+            (
+                "inv_log_range",
+                std::mem::offset_of!(ExactParams, inv_log_range),
+            ),
+            ("n", std::mem::offset_of!(ExactParams, n)),
+        ];
+        let want: Vec<(String, u32)> = want
+            .iter()
+            .map(|(n, o)| (n.to_string(), *o as u32))
+            .collect();
+        assert_eq!(offs, want);
+    }
+}

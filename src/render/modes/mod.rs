@@ -1,0 +1,125 @@
+//! The rendering modes and their registry.
+//!
+//! [`Mode`] is what `--mode` takes; [`Mode::info`] is the registry: for each
+//! mode, what it needs (a GPU or not), which emission models it can draw,
+//! whether it slices pieces at TF breakpoints, its stage (shader) and the
+//! bounds the comparison harness holds it to against the reference ray
+//! caster. [`render`] dispatches a render to the mode.
+//!
+//! How to add a projected-cell mode:
+//! 1. `shaders/NAME.wgsl` with `vs_main`, `fs_main` and `fs_count` (the
+//!    functions of `shaders/common.wgsl` are in scope);
+//! 2. `src/render/modes/NAME.rs`: the vertex type (a
+//!    [`crate::gpu::GpuVertex`] mirroring `VertexIn`), its `StageDesc`,
+//!    the CPU twin of `fs_main` ([`crate::gpu::cpu::CpuStage`]) and an
+//!    implementation of [`super::driver::ProjectedMode`] (split points,
+//!    payload, vertex, binding the stage);
+//! 3. a variant of [`Mode`], its [`ModeInfo`] in [`Mode::info`], and its arm
+//!    in [`render`];
+//! 4. its file in [`SHADERS`]. `tests/modes.rs` then compares it with the
+//!    reference at its bounds, on the CPU twin and on the GPU.
+
+pub mod exact;
+pub mod exptable;
+pub mod raycast;
+
+use clap::ValueEnum;
+use serde::Serialize;
+
+use crate::gpu::layer::LAYER_STAGE;
+use crate::gpu::StageDesc;
+use crate::raycast::FieldModel;
+use crate::tf::EmissionModel;
+
+/// The rendering modes that exist (`--mode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Mode {
+    /// Projection of convex pieces with exact vertex integrals, composited
+    /// by wgpu.
+    Exact,
+    /// The CPU reference ray caster.
+    Raycast,
+}
+
+/// How closely a mode must match the reference ray caster over every pixel
+/// of the comparison harness's scenes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    /// The ray caster's field model this mode integrates.
+    pub reference: FieldModel,
+    /// Largest difference of any channel of any pixel (f32 accumulation).
+    pub max_abs: f64,
+}
+
+/// What the registry knows of a mode.
+#[derive(Debug)]
+pub struct ModeInfo {
+    pub name: &'static str,
+    /// One line for `--help`.
+    pub summary: &'static str,
+    /// Whether it draws with wgpu (else it runs on the CPU alone).
+    pub gpu: bool,
+    /// The emission models it can draw.
+    pub emission: &'static [EmissionModel],
+    /// Whether pieces are sliced at TF breakpoints.
+    pub slices_at_breakpoints: bool,
+    /// Its stage (shader), for a GPU mode.
+    pub stage: Option<&'static StageDesc>,
+    /// Its bounds against the reference (`None`: it is the reference).
+    pub bounds: Option<Bounds>,
+}
+
+impl Mode {
+    /// Every mode.
+    pub const ALL: &'static [Mode] = &[Mode::Exact, Mode::Raycast];
+
+    /// The registry entry of the mode.
+    pub fn info(self) -> &'static ModeInfo {
+        match self {
+            Mode::Exact => &exact::INFO,
+            Mode::Raycast => &raycast::INFO,
+        }
+    }
+
+    /// The CLI name.
+    pub fn name(self) -> &'static str {
+        self.info().name
+    }
+
+    /// The names `--mode` takes.
+    pub fn names() -> Vec<&'static str> {
+        Mode::ALL.iter().map(|m| m.name()).collect()
+    }
+}
+
+impl std::fmt::Display for Mode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Mode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Mode, String> {
+        Mode::ALL
+            .iter()
+            .copied()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                format!(
+                    "unknown mode '{s}' (available: {})",
+                    Mode::names().join(", ")
+                )
+            })
+    }
+}
+
+/// Every shader file under `shaders/`, by name, with its source (without
+/// `shaders/common.wgsl`, which [`crate::gpu::stage::stage_source`] puts in
+/// front of each).
+pub const SHADERS: &[(&str, &str)] = &[
+    ("common.wgsl", crate::gpu::stage::COMMON_WGSL),
+    ("exact.wgsl", exact::EXACT_STAGE.wgsl),
+    ("layer.wgsl", LAYER_STAGE.wgsl),
+];

@@ -1,0 +1,314 @@
+//! From the visibility order's pieces to view-space polyhedra: the one place
+//! that turns a [`Piece`] into what a mode projects or a cycle group clips.
+//!
+//! A [`PieceSource`] holds what a view needs for that (mesh, scalars, TF,
+//! camera, the order's slab levels and fragments). Per piece:
+//! - [`PieceSource::polyhedron`]: the whole piece (a slab: its tet clipped
+//!   to its band; a fragment of a plane cut: its tetrahedra-free polyhedron),
+//!   used by cycle groups, which integrate breakpoints exactly along rays;
+//! - [`PieceSource::parts`]: the parts a projected-cell mode draws, in
+//!   back-to-front order: the piece itself, or for a fragment holding
+//!   breakpoints its slabs (bands back to front along the tet's gradient,
+//!   [`slab_order`]). Pieces whose scalar range maps to zero extinction
+//!   everywhere are left out ([`PieceSource::invisible`]): they neither emit
+//!   nor absorb in the glow model. The tet of consecutive slabs is built
+//!   once ([`PartScratch`]).
+
+use glam::DVec3;
+
+use crate::camera::Camera;
+use crate::mesh::Mesh;
+use crate::projection::coverage::PixelGrid;
+use crate::projection::{ClipValue, Clipper, Polyhedron, ProjectionError};
+use crate::tf::TransferFunction;
+use crate::visibility::bsp::Fragment;
+use crate::visibility::slabs::{bands as slab_bands, inner_levels, slab_order};
+use crate::visibility::{Piece, NO_LEVEL};
+
+use super::scene::ScalarsRef;
+
+/// A piece that cannot be made into a polyhedron.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PieceError {
+    #[error("cell {cell}: {source}")]
+    Projection {
+        cell: u32,
+        #[source]
+        source: ProjectionError,
+    },
+    #[error("cell {cell}: the order has no fragment {fragment}")]
+    NoFragment { cell: u32, fragment: u32 },
+}
+
+/// The smallest and largest of `values` (`(inf, -inf)` when empty).
+pub fn value_range(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
+    values
+        .into_iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
+/// What a view needs to turn pieces into polyhedra; see the module docs.
+pub struct PieceSource<'a> {
+    pub mesh: &'a Mesh,
+    pub scalars: ScalarsRef<'a>,
+    pub tf: &'a TransferFunction,
+    pub camera: &'a Camera,
+    /// TF values where extinction kinks or jumps, or colour jumps
+    /// ([`super::breakpoints::split_points`]).
+    pub breakpoints: &'a [f64],
+    /// The order's slab bounds ([`crate::visibility::Order::levels`]).
+    pub levels: &'a [f64],
+    /// The order's fragments ([`crate::visibility::Order::fragments`]).
+    pub fragments: &'a [Fragment],
+    /// The frame's length unit (the scene's unit distance, in `f32`).
+    pub length_unit: f64,
+    /// Leave out triangles that colour no pixel centre of `grid`
+    /// ([`crate::projection::coverage`]).
+    pub cull: bool,
+    pub grid: PixelGrid,
+}
+
+/// Scratch of [`PieceSource::parts`], reused from piece to piece.
+#[derive(Default)]
+pub struct PartScratch {
+    poly: Polyhedron,
+    whole: Polyhedron,
+    /// The (cell, tet) `whole` holds for slab pieces (fragments reuse
+    /// `whole` and reset this).
+    whole_of: Option<(u32, [u32; 4])>,
+    clipper: Clipper,
+}
+
+/// What [`PieceSource::parts`] did with a piece.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Parts {
+    /// Left out: zero extinction over its scalar range.
+    pub invisible: bool,
+    /// Slab pieces drawn.
+    pub slabs: usize,
+}
+
+impl PieceSource<'_> {
+    /// The scalar of `point` in `cell`.
+    #[inline]
+    pub fn scalar(&self, cell: u32, point: u32) -> f64 {
+        match self.scalars {
+            ScalarsRef::Point(v) => v.get(point as usize).copied().unwrap_or(0.0),
+            ScalarsRef::Cell(v) => v.get(cell as usize).copied().unwrap_or(0.0),
+            ScalarsRef::Constant(c) => c,
+        }
+    }
+
+    fn projection(cell: u32) -> impl Fn(ProjectionError) -> PieceError {
+        move |source| PieceError::Projection { cell, source }
+    }
+
+    /// The view-space polyhedron of a piece (whole, not sliced into its
+    /// bands); an empty one when a slab has no volume.
+    pub fn polyhedron(&self, piece: &Piece, poly: &mut Polyhedron) -> Result<(), PieceError> {
+        let cell = piece.cell();
+        match *piece {
+            Piece::Cell(c) => self.cell(c, poly),
+            Piece::Tet { tet, .. } => {
+                let (p, s) = self.tet_view(cell, tet);
+                poly.set_tet(p, s);
+                Ok(())
+            }
+            Piece::Slab { tet, lo, hi, .. } => {
+                let mut whole = Polyhedron::default();
+                let mut clipper = Clipper::default();
+                let (p, s) = self.tet_view(cell, tet);
+                whole.set_tet(p, s);
+                if !self.clip_band(cell, lo, hi, &mut clipper, &whole, poly)? {
+                    poly.clear();
+                }
+                Ok(())
+            }
+            Piece::Frag { tet, frag, .. } => self.fragment(cell, tet, frag, poly),
+        }
+    }
+
+    /// Calls `draw` with each part of `piece` a projected-cell mode draws,
+    /// back to front (see the module docs).
+    pub fn parts(
+        &self,
+        piece: &Piece,
+        scratch: &mut PartScratch,
+        mut draw: impl FnMut(&Polyhedron) -> Result<(), PieceError>,
+    ) -> Result<Parts, PieceError> {
+        let cell = piece.cell();
+        let mut done = Parts::default();
+        let PartScratch {
+            poly,
+            whole,
+            whole_of,
+            clipper,
+        } = scratch;
+        match *piece {
+            Piece::Cell(c) => {
+                let nodes = self.mesh.cells.nodes(c as usize);
+                let (lo, hi) = value_range(nodes.iter().map(|&n| self.scalar(c, n)));
+                if self.invisible(lo, hi) {
+                    done.invisible = true;
+                    return Ok(done);
+                }
+                self.cell(c, poly)?;
+                draw(poly)?;
+            }
+            Piece::Tet { tet, .. } => {
+                let (p, s) = self.tet_view(cell, tet);
+                let (lo, hi) = value_range(s);
+                if self.invisible(lo, hi) {
+                    done.invisible = true;
+                    return Ok(done);
+                }
+                // A tet holding a breakpoint comes as its slabs
+                // (`Piece::Slab`): the TF is linear on this one.
+                poly.set_tet(p, s);
+                draw(poly)?;
+            }
+            Piece::Frag { tet, frag, .. } => {
+                *whole_of = None;
+                self.fragment(cell, tet, frag, whole)?;
+                let (lo, hi) = value_range(whole.scalars.iter().copied());
+                if self.invisible(lo, hi) {
+                    done.invisible = true;
+                    return Ok(done);
+                }
+                // Breakpoints inside: the fragment's bands, back to front
+                // along the tet's gradient.
+                let bands = slab_bands(&self.levels[inner_levels(&whole.scalars, self.levels)]);
+                let (p, s) = self.tet_view(cell, tet);
+                for i in slab_order(&p, &s, &bands, self.camera.ortho) {
+                    let (blo, bhi) = bands[i];
+                    if bands.len() == 1 {
+                        draw(whole)?;
+                        continue;
+                    }
+                    if clipper
+                        .clip(whole, ClipValue::Scalar, blo, bhi, poly)
+                        .map_err(Self::projection(cell))?
+                    {
+                        draw(poly)?;
+                    }
+                }
+            }
+            Piece::Slab { tet, lo, hi, .. } => {
+                let (blo, bhi) = self.band(lo, hi);
+                let (smin, smax) = value_range(tet.map(|n| self.scalar(cell, n)));
+                if self.invisible(smin.max(blo), smax.min(bhi)) {
+                    done.invisible = true;
+                    return Ok(done);
+                }
+                // The slabs of a tet come one after another: its view-space
+                // piece is built once for them all.
+                if *whole_of != Some((cell, tet)) {
+                    let (p, s) = self.tet_view(cell, tet);
+                    whole.set_tet(p, s);
+                    *whole_of = Some((cell, tet));
+                }
+                if self.clip_band(cell, lo, hi, clipper, whole, poly)? {
+                    done.slabs += 1;
+                    draw(poly)?;
+                }
+            }
+        }
+        Ok(done)
+    }
+
+    /// The view-space polyhedron of whole cell `c`.
+    fn cell(&self, c: u32, poly: &mut Polyhedron) -> Result<(), PieceError> {
+        poly.set_cell(
+            &self.mesh.cells,
+            c as usize,
+            &self.mesh.points,
+            |n| self.scalar(c, n),
+            self.camera,
+        )
+        .map_err(Self::projection(c))
+    }
+
+    /// Clips `whole` (the view-space tet of `cell`) to band `lo..hi` of
+    /// the order's levels; `Ok(false)` when nothing of positive volume is
+    /// left.
+    fn clip_band(
+        &self,
+        cell: u32,
+        lo: u32,
+        hi: u32,
+        clipper: &mut Clipper,
+        whole: &Polyhedron,
+        poly: &mut Polyhedron,
+    ) -> Result<bool, PieceError> {
+        let (lo, hi) = self.band(lo, hi);
+        clipper
+            .clip(whole, ClipValue::Scalar, lo, hi, poly)
+            .map_err(Self::projection(cell))
+    }
+
+    /// The view-space polyhedron of fragment `frag` of a tet.
+    fn fragment(
+        &self,
+        cell: u32,
+        tet: [u32; 4],
+        frag: u32,
+        poly: &mut Polyhedron,
+    ) -> Result<(), PieceError> {
+        let f = self
+            .fragments
+            .get(frag as usize)
+            .ok_or(PieceError::NoFragment {
+                cell,
+                fragment: frag,
+            })?;
+        let (p, s) = self.tet_view(cell, tet);
+        poly.clear();
+        poly.points = f.positions(&p);
+        poly.scalars = f.values(&s);
+        poly.triangles.extend_from_slice(&f.triangles);
+        poly.orient_outward();
+        Ok(())
+    }
+
+    /// View-space corners and scalars of a tet of cell `cell`.
+    fn tet_view(&self, cell: u32, tet: [u32; 4]) -> ([DVec3; 4], [f64; 4]) {
+        let pts = &self.mesh.points;
+        (
+            tet.map(|n| self.camera.to_view(pts[n as usize])),
+            tet.map(|n| self.scalar(cell, n)),
+        )
+    }
+
+    /// The scalar bounds of a slab ([`Piece::Slab`]).
+    fn band(&self, lo: u32, hi: u32) -> (f64, f64) {
+        let level = |k: u32, open: f64| {
+            if k == NO_LEVEL {
+                open
+            } else {
+                self.levels.get(k as usize).copied().unwrap_or(open)
+            }
+        };
+        (level(lo, f64::NEG_INFINITY), level(hi, f64::INFINITY))
+    }
+
+    /// Whether extinction is zero over the whole scalar interval.
+    pub fn invisible(&self, lo: f64, hi: f64) -> bool {
+        if !(lo.is_finite() && hi.is_finite()) {
+            return false;
+        }
+        if self.tf.tau_at(lo) > 0.0 || self.tf.tau_at(hi) > 0.0 {
+            return false;
+        }
+        for &b in self.breakpoints {
+            if b >= lo && b <= hi {
+                let left = self.tf.tau_at(b - b.abs().max(1e-300) * 1e-15);
+                if self.tf.tau_at(b) > 0.0 || left > 0.0 {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+}

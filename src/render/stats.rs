@@ -1,0 +1,205 @@
+//! What a render did: the typed statistics of each kind of mode, printable
+//! (`Display`, the lines of `zoovr render --stats`) and machine-readable
+//! (serde, `--stats --json` and `bench`).
+
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::gpu::FrameStats;
+use crate::raycast::brute::BruteStats;
+use crate::raycast::native::NativeStats;
+use crate::raycast::{FieldModel, Traversal};
+use crate::visibility::OrderStats;
+
+use super::Mode;
+
+/// What a projected-cell mode did ([`super::driver`]), with times in
+/// seconds.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ProjectedStats {
+    pub pieces: usize,
+    pub culled_pieces: usize,
+    pub slabs: usize,
+    pub triangles: usize,
+    pub refined_triangles: usize,
+    /// Pixels of the per-pixel layers of cycle groups
+    /// ([`super::group`]).
+    pub group_pixels: usize,
+    pub sort_s: f64,
+    /// Time spent opening (or waiting for) the GPU context.
+    pub gpu_open_s: f64,
+    /// Projection, payloads and the draw calls, which overlap (workers
+    /// project later chunks while this thread uploads and draws finished
+    /// ones).
+    pub project_s: f64,
+    pub gpu: FrameStats,
+    /// What the GPU had left after the last draw call: finishing and
+    /// reading the image back.
+    pub gpu_total_s: f64,
+    pub order: OrderStats,
+    /// CPU twin with [`super::RenderOptions::watch`]: the fragments drawn
+    /// at the watched pixel, in drawing order.
+    #[serde(skip)]
+    pub watched: Vec<crate::gpu::cpu::Fragment>,
+}
+
+impl fmt::Display for ProjectedStats {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (e, o) = (self, &self.order);
+        writeln!(
+            f,
+            "sort         {:.3} s  ({} pieces, {} split cells, {} problem cells, {} cycles, {} cut by planes into {} fragments, {} cycle groups of {} pieces over {} pixels)",
+            e.sort_s,
+            e.pieces,
+            o.split_cells,
+            o.problem_cells,
+            o.cycles_found,
+            o.cycles_resolved_by_planes,
+            o.fragments,
+            o.cycle_groups,
+            o.pieces_in_groups,
+            e.group_pixels
+        )?;
+        writeln!(
+            f,
+            "             (classify faces {:.3}, non-convex constraints {:.3}, splits {:.3}, topological sort {:.3})",
+            o.time_classify.as_secs_f64(),
+            o.time_nonconvex.as_secs_f64(),
+            o.time_split.as_secs_f64(),
+            o.time_sort.as_secs_f64()
+        )?;
+        writeln!(
+            f,
+            "project+draw {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles)",
+            e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles
+        )?;
+        write!(
+            f,
+            "gpu finish   {:.3} s  (upload {:.3}, wait {:.3}, readback {:.3}, {} batches)",
+            e.gpu_total_s, e.gpu.upload_s, e.gpu.gpu_wait_s, e.gpu.readback_s, e.gpu.batches
+        )
+    }
+}
+
+/// What a ray-cast render used.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct RaycastStats {
+    pub model: FieldModel,
+    pub traversal: Traversal,
+    /// Rays stop once their transmittance falls below this (0: never), so
+    /// a pixel's opacity may fall short of the full integral by at most it.
+    pub termination_transmittance: f64,
+    /// Native model: intervals integrated and what fell back from the
+    /// exact method during this render (zero for other models).
+    pub native: NativeStats,
+    /// Brute-force traversal: pieces tested, segments, and segments that
+    /// overlapped another piece's (zero for the walk).
+    pub brute: BruteStats,
+}
+
+impl fmt::Display for RaycastStats {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let r = self;
+        write!(
+            f,
+            "raycast      model {}, traversal {}, early ray termination below transmittance {:e}",
+            r.model.name(),
+            r.traversal.name(),
+            r.termination_transmittance
+        )?;
+        if r.traversal == Traversal::Brute {
+            let b = &r.brute;
+            write!(
+                f,
+                "\nbrute        {} cells tested, {} segments, {} of them overlapping another \
+                 piece's in depth",
+                b.cells_tested, b.segments, b.overlapping_segments
+            )?;
+        }
+        if r.model == FieldModel::Native {
+            let n = &r.native;
+            write!(
+                f,
+                "\nnative       {} intervals, {} extra cells (bilinear faces), {} Newton failures, \
+                 {} linear fallbacks, {} parity-classified, {} depth-limited brackets",
+                n.intervals,
+                n.extra_cells,
+                n.newton_failures,
+                n.fallback_intervals,
+                n.parity_classified,
+                n.bracket_depth_limited
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// The statistics of the mode that rendered.
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum ModeStats {
+    /// A projected-cell mode ([`super::driver`]).
+    Projected(ProjectedStats),
+    /// The reference ray caster.
+    Raycast(RaycastStats),
+}
+
+impl fmt::Display for ModeStats {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ModeStats::Projected(s) => s.fmt(f),
+            ModeStats::Raycast(s) => s.fmt(f),
+        }
+    }
+}
+
+/// What one render did (seconds of wall time).
+#[derive(Clone, Debug, Serialize)]
+pub struct RenderStats {
+    pub mode: Mode,
+    pub total_s: f64,
+    /// Building what the mode reuses between views (the sorter's geometry,
+    /// the ray caster's acceleration structures) and opening the GPU.
+    pub setup_s: f64,
+    pub gpu_adapter: Option<String>,
+    pub detail: ModeStats,
+}
+
+impl RenderStats {
+    /// The projected-cell statistics, when a projected-cell mode rendered.
+    pub fn projected(&self) -> Option<&ProjectedStats> {
+        match &self.detail {
+            ModeStats::Projected(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The ray caster's statistics, when it rendered.
+    pub fn raycast(&self) -> Option<&RaycastStats> {
+        match &self.detail {
+            ModeStats::Raycast(s) => Some(s),
+            _ => None,
+        }
+    }
+}
+
+impl fmt::Display for RenderStats {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.detail {
+            ModeStats::Projected(e) => writeln!(
+                f,
+                "setup        {:.3} s  (visibility geometry {:.3}, waiting for the GPU device {:.3})",
+                self.setup_s,
+                self.setup_s - e.gpu_open_s,
+                e.gpu_open_s
+            )?,
+            _ => writeln!(f, "setup        {:.3} s", self.setup_s)?,
+        }
+        if let Some(a) = &self.gpu_adapter {
+            writeln!(f, "adapter      {a}")?;
+        }
+        writeln!(f, "{}", self.detail)?;
+        write!(f, "render total {:.3} s", self.total_s)
+    }
+}

@@ -1,0 +1,159 @@
+//! The mode registry and the one comparison harness: every mode of
+//! `Mode::ALL` against the reference ray caster, at the bounds its registry
+//! entry gives, over every pixel.
+//!
+//! A GPU mode is compared through its CPU twin (no adapter needed, so this
+//! runs everywhere) and, where an adapter exists, on the GPU too: whole
+//! cells against the ray caster's `faces` model and `--split all` against
+//! `tets`, in perspective and orthographic views, on the project's own
+//! meshes with the default transfer function. The registry test fails when
+//! a mode lacks its stage (shader), its CPU twin or its bounds.
+
+use zoovr::camera::CameraParams;
+use zoovr::gpu::{Context, GpuOptions};
+use zoovr::image::{compare_display, Image};
+use zoovr::io::{self, ReadOptions};
+use zoovr::raycast::FieldModel;
+use zoovr::render::modes::SHADERS;
+use zoovr::render::{Compositor, Mode, RenderOptions, Renderer, Scene, SceneSpec};
+use zoovr::testdata::mesh_file;
+
+fn scene(name: &str) -> Scene {
+    let mesh = io::read(&mesh_file(name), &ReadOptions::default()).unwrap();
+    Scene::build(mesh, &SceneSpec::default()).unwrap()
+}
+
+fn options(mode: Mode, ortho: bool) -> RenderOptions {
+    RenderOptions {
+        camera: CameraParams {
+            width: 96,
+            height: 80,
+            azimuth: 25.0,
+            elevation: 30.0,
+            zoom: 1.2,
+            ortho,
+            ..Default::default()
+        },
+        mode,
+        ..Default::default()
+    }
+}
+
+fn render(scene: &Scene, opts: &RenderOptions) -> Image {
+    let (img, _) = Renderer::new(scene)
+        .render(opts, |_, _| {})
+        .unwrap_or_else(|e| panic!("{:?}: {e}", opts.mode));
+    assert_eq!(img.count_non_finite(), 0);
+    img
+}
+
+#[test]
+fn registry_is_complete() {
+    let names = Mode::names();
+    for &mode in Mode::ALL {
+        let info = mode.info();
+        assert_eq!(info.name.parse::<Mode>(), Ok(mode));
+        assert_eq!(
+            names.iter().filter(|n| **n == info.name).count(),
+            1,
+            "{} named twice",
+            info.name
+        );
+        assert!(
+            !info.emission.is_empty(),
+            "{}: no emission model",
+            info.name
+        );
+        if info.gpu {
+            let stage = info
+                .stage
+                .unwrap_or_else(|| panic!("{}: a GPU mode without a stage", info.name));
+            assert!(
+                SHADERS
+                    .iter()
+                    .any(|(n, s)| *n == stage.name && *s == stage.wgsl),
+                "{}: its shader {} is not in SHADERS",
+                info.name,
+                stage.name
+            );
+            assert!(info.bounds.is_some(), "{}: no comparison bounds", info.name);
+            // The CPU twin exists and draws: a render through it.
+            let s = scene("tetra.vtu");
+            let opts = RenderOptions {
+                compositor: Compositor::Cpu,
+                ..options(mode, false)
+            };
+            let img = render(&s, &opts);
+            assert!(
+                img.pixels.iter().any(|p| p[3] > 0.0),
+                "{}: empty",
+                info.name
+            );
+        } else {
+            assert!(info.stage.is_none(), "{}", info.name);
+        }
+    }
+    // The reference exists.
+    assert!(Mode::ALL.iter().any(|m| m.info().bounds.is_none()));
+}
+
+fn gpu_available() -> bool {
+    match Context::new(&GpuOptions::default()) {
+        Ok(_) => true,
+        Err(e) => {
+            eprintln!("GPU comparisons skipped: no adapter ({e})");
+            false
+        }
+    }
+}
+
+#[test]
+fn every_mode_matches_the_reference() {
+    let gpu = gpu_available();
+    for name in ["zoo_3x3x3.vtu", "curvilinear_4x4x4.vtu", "ring_hole.vtu"] {
+        let s = scene(name);
+        for ortho in [false, true] {
+            for split in [false, true] {
+                let reference = RenderOptions {
+                    model: if split {
+                        FieldModel::Tets
+                    } else {
+                        FieldModel::Faces
+                    },
+                    ..options(Mode::Raycast, ortho)
+                };
+                let expected = render(&s, &reference);
+                for &mode in Mode::ALL {
+                    let Some(bounds) = mode.info().bounds else {
+                        continue;
+                    };
+                    assert_eq!(bounds.reference, FieldModel::Faces);
+                    let mut compositors = vec![Compositor::Cpu];
+                    if gpu {
+                        compositors.push(Compositor::Gpu);
+                    }
+                    for compositor in compositors {
+                        let opts = RenderOptions {
+                            split_all: split,
+                            compositor,
+                            ..options(mode, ortho)
+                        };
+                        let got = render(&s, &opts);
+                        let (d, _) = compare_display(&got, &expected, [0.0; 3]).unwrap();
+                        eprintln!(
+                            "{mode} {name} ortho={ortho} split={split} {compositor:?}: max {:.2e} at {:?}",
+                            d.max_abs, d.worst
+                        );
+                        assert!(
+                            d.max_abs <= bounds.max_abs,
+                            "{mode} {name} ortho={ortho} split={split} {compositor:?}: max {:.3e} at {:?} > {:.3e}",
+                            d.max_abs,
+                            d.worst,
+                            bounds.max_abs
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
