@@ -198,7 +198,47 @@ fn raycast_stats_and_other_mode_flags() {
         e.contains("model tets") && e.contains("transmittance 1e-6"),
         "{e}"
     );
-    assert!(e.contains("--split all is the exact mode's"), "{e}");
+    assert!(
+        e.contains("--split all is for the projected-cell modes"),
+        "{e}"
+    );
+}
+
+/// `--stats --json`: one JSON object on stdout with the mode, the times and
+/// the mode's own counters (machine-readable for scripts and `bench`).
+#[test]
+fn stats_as_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("j.png");
+    let mesh = mesh_file("hexahedron.vtk");
+    let o = zoovr(&[
+        "render",
+        mesh.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--size",
+        "24x24",
+        "--mode",
+        "raycast",
+        "--stats",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["mode"], "raycast");
+    assert_eq!(v["detail"]["kind"], "raycast");
+    assert_eq!(v["detail"]["model"], "faces");
+    assert!(v["total_s"].as_f64().unwrap() >= 0.0);
+    assert!(v["load_s"].as_f64().unwrap() >= 0.0);
+    // --json needs --stats.
+    let o = zoovr(&[
+        "render",
+        mesh.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
 
 /// A full disk (simulated with a file-size limit: writes fail with EFBIG, the

@@ -43,13 +43,19 @@ pub enum Mode {
 }
 
 /// How closely a mode must match the reference ray caster over every pixel
-/// of the comparison harness's scenes.
+/// of the comparison harness's scenes (display values, f32 accumulation).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {
-    /// The ray caster's field model this mode integrates.
+    /// The ray caster's field model the mode integrates for whole cells.
     pub reference: FieldModel,
-    /// Largest difference of any channel of any pixel (f32 accumulation).
-    pub max_abs: f64,
+    /// `--split all` against `--model tets` (the same field): the largest
+    /// difference of any channel of any pixel.
+    pub split_max: f64,
+    /// Whole cells against `reference`: the largest difference, which may
+    /// hold the model difference inside cells the mode splits into tets
+    /// (problem cells, cells holding a breakpoint), where it integrates the
+    /// `tets` field.
+    pub whole_max: f64,
 }
 
 /// What the registry knows of a mode.
