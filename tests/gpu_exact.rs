@@ -188,7 +188,7 @@ fn thin_layers_on(ctx: &Context, backend: Backend) {
         let mut frame = ctx
             .begin_frame_with(&FrameOptions::new(w, h, format))
             .unwrap();
-        let stage = bind_exact_stage(&ctx, 1.0).unwrap();
+        let stage = bind_exact_stage(ctx, 1.0).unwrap();
         // Each layer is a piece of its own (one piece colours a pixel once).
         for layer in 0..n {
             let q: Vec<ExactVertex> = quad

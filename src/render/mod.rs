@@ -243,6 +243,6 @@ impl<'s> Renderer<'s> {
         self.sorter = Some(sorter);
         let (img, stats) = result?;
         let setup_s = sorter_s + stats.gpu_open_s;
-        Ok((img, ModeStats::Projected(stats), setup_s))
+        Ok((img, ModeStats::Projected(Box::new(stats)), setup_s))
     }
 }

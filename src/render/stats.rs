@@ -140,7 +140,7 @@ impl fmt::Display for RaycastStats {
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum ModeStats {
     /// A projected-cell mode ([`super::driver`]).
-    Projected(ProjectedStats),
+    Projected(Box<ProjectedStats>),
     /// The reference ray caster.
     Raycast(RaycastStats),
 }
@@ -170,7 +170,7 @@ impl RenderStats {
     /// The projected-cell statistics, when a projected-cell mode rendered.
     pub fn projected(&self) -> Option<&ProjectedStats> {
         match &self.detail {
-            ModeStats::Projected(s) => Some(s),
+            ModeStats::Projected(s) => Some(s.as_ref()),
             _ => None,
         }
     }
