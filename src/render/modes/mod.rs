@@ -4,7 +4,8 @@
 //! mode, what it needs (a GPU or not), which emission models it can draw,
 //! whether it slices pieces at TF breakpoints, its stage (shader) and the
 //! bounds the comparison harness holds it to against the reference ray
-//! caster. [`render`] dispatches a render to the mode.
+//! caster. [`crate::render::Renderer::render`] dispatches a render to the
+//! mode.
 //!
 //! How to add a projected-cell mode:
 //! 1. `shaders/NAME.wgsl` with `vs_main`, `fs_main` and `fs_count` (the
@@ -15,7 +16,7 @@
 //!    implementation of [`super::driver::ProjectedMode`] (split points,
 //!    payload, vertex, binding the stage);
 //! 3. a variant of [`Mode`], its [`ModeInfo`] in [`Mode::info`], and its arm
-//!    in [`render`];
+//!    in `Renderer::render_with_camera` (src/render/mod.rs);
 //! 4. its file in [`SHADERS`]. `tests/modes.rs` then compares it with the
 //!    reference at its bounds, on the CPU twin and on the GPU.
 
