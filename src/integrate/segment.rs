@@ -14,6 +14,7 @@
 
 use super::weights::weights;
 use super::{RayAccumulator, SegmentValue};
+use crate::numeric::tolerance::GLOW_LIMIT_DEPTH;
 use crate::tf::{EmissionModel, TransferFunction};
 
 const MAX_LENGTH: f64 = 1e150;
@@ -161,15 +162,10 @@ pub struct VertexValues {
     pub tau_mean: f64,
 }
 
-/// Below this optical depth `C / alpha` is replaced by its `l -> 0` limit
-/// (both are equal to ~1e-16 relative there, and the quotient of two
-/// subnormal numbers would lose precision).
-const GLOW_LIMIT_DEPTH: f64 = 1e-200;
-
 /// Exact per-vertex values (segment colour, opacity, depth), the glow colour
 /// `g = C / alpha` and the mean extinction.
 ///
-/// The `l -> 0` limit of `g` (used when the depth is below 1e-200, e.g. at
+/// The `l -> 0` limit of `g` (used when the depth is below [`GLOW_LIMIT_DEPTH`], e.g. at
 /// silhouette vertices with `l = 0`):
 /// * glow model: the extinction-weighted mean colour over the scalar interval,
 ///   per piece `(c_f (2 tau_f + tau_b) + c_b (tau_f + 2 tau_b)) / 3` weighted

@@ -4,7 +4,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::tolerance::PLANE_FILTER_EPS;
+use super::tolerance::{FILTER_UNDERFLOW_BOUND, PLANE_FILTER_EPS};
 
 /// The side of an oriented line or plane a point lies on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -108,7 +108,7 @@ impl Plane3 {
         let s = self.n.dot(x);
         let bound = self.scale * x.abs().max_element();
         // Far from underflow, a value beyond the bound has the exact sign.
-        if bound > 1e-250 && s.abs() > bound {
+        if bound > FILTER_UNDERFLOW_BOUND && s.abs() > bound {
             Side::of(s)
         } else {
             orient3d(self.a, self.b, self.c, d)

@@ -36,6 +36,7 @@ use glam::DVec2;
 use super::exact;
 use super::subdivision::{Subdivision, TopologyError, NIL};
 use crate::numeric::predicates::{orient2d, Side};
+use crate::numeric::tolerance::{ARRANGEMENT_AREA_REL, OUTER_CYCLE_AREA_REL};
 
 /// A segment between two original points, with the triangles on its sides:
 /// `side = [front_left, front_right, back_left, back_right]` (triangle ids or
@@ -589,7 +590,7 @@ impl Arrangement {
         if n_outer != 1 || a_outer >= 0.0 {
             return Err(TopologyError::Geometry("not exactly one outer boundary"));
         }
-        if (inside + a_outer).abs() > 1e-9 * -a_outer {
+        if (inside + a_outer).abs() > ARRANGEMENT_AREA_REL * -a_outer {
             return Err(TopologyError::Geometry(
                 "regions do not partition the silhouette",
             ));
@@ -711,7 +712,7 @@ pub(super) fn segment_crossing(p0: DVec2, p1: DVec2, q0: DVec2, q1: DVec2) -> DV
 /// cycle. Only a fallback for a second component: the outer cycle itself is
 /// found exactly ([`Arrangement::outer_half_edge`]).
 pub fn is_outer(a: f64, amin: f64) -> bool {
-    a < 0.0 && -a > 1e-9 * -amin
+    a < 0.0 && -a > OUTER_CYCLE_AREA_REL * -amin
 }
 
 #[cfg(test)]

@@ -65,6 +65,7 @@ use super::{
 };
 use crate::camera::Camera;
 use crate::numeric::predicates::{orient2d, Side};
+use crate::numeric::tolerance::CONSTANT_SCALAR_REL;
 use crate::numeric::tolerance::{IMAGE_CLIP_MARGIN_PX, NEAR_CLIP_SCALE};
 
 /// Reusable projection state (see module docs).
@@ -330,7 +331,7 @@ impl Projector {
             // has no scalar interpolation error: rounding noise in the
             // interpolated values must not drive the refinement.
             let srange = smax - smin;
-            let srange = if srange <= 1e-12 * smax.abs().max(smin.abs()) {
+            let srange = if srange <= CONSTANT_SCALAR_REL * smax.abs().max(smin.abs()) {
                 f64::INFINITY
             } else {
                 srange

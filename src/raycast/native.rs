@@ -12,10 +12,10 @@
 //! sharing a face compute bit-identical roots: the exit of one is the entry
 //! of the other, with no gap and no double count. Between two consecutive
 //! roots the ray is inside the cell iff the midpoint's inverted parametric
-//! coordinates lie in the reference element (`PARAM_TOL` = 1e-9 widened);
+//! coordinates lie in the reference element ([`NATIVE_PARAM_TOL`] widened);
 //! duplicated roots at edges give empty or zero-length intervals, and a
 //! root missed at an edge by one face is found by the other (both accept
-//! `PARAM_TOL` outside `[0, 1]`). Where the midpoint cannot be inverted the
+//! `NATIVE_PARAM_TOL` outside `[0, 1]`). Where the midpoint cannot be inverted the
 //! root parity decides (counted in [`NativeStats::parity_classified`]).
 //! Which cells are visited is described in `super` (the walk's cells plus
 //! the neighbours across crossed bilinear faces).
@@ -30,7 +30,7 @@
 //!    the transfer function ([`breakpoint_crossings`]): from 8 equal
 //!    subintervals, each is refined adaptively until the cubic Hermite
 //!    interpolant of its end values and slopes reproduces `s` and `s'` at
-//!    the midpoint (to 1e-3 relative) and shows at most one extremum, which
+//!    the midpoint (to [`NATIVE_HERMITE_REL`] relative) and shows at most one extremum, which
 //!    is then bisected on `s'`; then `s(t) - S_k` is bisected for every
 //!    breakpoint `S_k` crossed on each monotone part. The precise guarantee
 //!    and assumption are stated at [`monotone_nodes`]: exact for cubic
@@ -57,7 +57,11 @@ use super::{Scalars, Scene};
 use crate::camera::Ray;
 use crate::integrate::{RayMaterial, SegmentValue};
 use crate::mesh::CellKind;
-use crate::numeric::tolerance::{NATIVE_INTEGRAL_TOL, NATIVE_NEWTON_TOL};
+use crate::numeric::tolerance::{
+    BILINEAR_DISC_REL, BILINEAR_LINEAR_REL, BILINEAR_ROOT_WINDOW, GAUSS_LEGENDRE_NODE_TOL,
+    HERMITE_QUADRATIC_REL, NATIVE_HERMITE_ABS, NATIVE_HERMITE_REL, NATIVE_INTEGRAL_TOL,
+    NATIVE_NEWTON_ACCEPT, NATIVE_NEWTON_DIVERGED, NATIVE_NEWTON_TOL, NATIVE_PARAM_TOL,
+};
 
 const GL_N: usize = 8;
 const MAX_LEVEL: u32 = 24;
@@ -91,7 +95,7 @@ fn quadrature() -> &'static Quadrature {
                 let (p, dp) = legendre(GL_N, z);
                 let dz = p / dp;
                 z -= dz;
-                if dz.abs() < 1e-16 {
+                if dz.abs() < GAUSS_LEGENDRE_NODE_TOL {
                     break;
                 }
             }
@@ -175,9 +179,6 @@ fn shape(kind: CellKind, p: DVec3, n: &mut [f64; 8], dn: &mut [DVec3; 8]) -> usi
     }
 }
 
-/// Parametric tolerance of "inside the reference element" and of "inside a
-/// face" for ray / face roots.
-const PARAM_TOL: f64 = 1e-9;
 /// Subdivision depth limit of the monotone-piece search.
 const BRACKET_DEPTH: u32 = 30;
 /// Initial samples of `s(t)` per interval before the adaptive refinement.
@@ -255,11 +256,11 @@ fn centre_of(kind: CellKind) -> DVec3 {
     }
 }
 
-/// Whether parametric point `xi` is in the (closed, `PARAM_TOL`-widened)
+/// Whether parametric point `xi` is in the (closed, `NATIVE_PARAM_TOL`-widened)
 /// reference element of `kind`.
 pub fn in_reference(kind: CellKind, xi: DVec3) -> bool {
-    let lo = -PARAM_TOL;
-    let hi = 1.0 + PARAM_TOL;
+    let lo = -NATIVE_PARAM_TOL;
+    let hi = 1.0 + NATIVE_PARAM_TOL;
     let box01 = |v: f64| v >= lo && v <= hi;
     match kind {
         CellKind::Wedge => xi.x >= lo && xi.y >= lo && xi.x + xi.y <= hi && box01(xi.z),
@@ -330,11 +331,11 @@ impl IsoRay {
             let inv = jac.inverse();
             let step = inv * (target - pos);
             xi += step;
-            if !xi.is_finite() || xi.abs().max_element() > 1e3 {
+            if !xi.is_finite() || xi.abs().max_element() > NATIVE_NEWTON_DIVERGED {
                 return None;
             }
             if step.length() < NATIVE_NEWTON_TOL || it == 39 {
-                if step.length() > 1e-8 {
+                if step.length() > NATIVE_NEWTON_ACCEPT {
                     return None;
                 }
                 return Some((xi, inv));
@@ -414,7 +415,7 @@ fn hermite_has_critical(a: Sample, b: Sample) -> bool {
     let c1 = 6.0 * m - 4.0 * a.2 - 2.0 * b.2;
     let c2 = 3.0 * (a.2 + b.2) - 6.0 * m;
     let has_root = |x: f64| x > 0.0 && x < 1.0;
-    if c2.abs() <= 1e-14 * (c0.abs() + c1.abs()) {
+    if c2.abs() <= HERMITE_QUADRATIC_REL * (c0.abs() + c1.abs()) {
         return c1 != 0.0 && has_root(-c0 / c1);
     }
     let disc = c1 * c1 - 4.0 * c2 * c0;
@@ -443,8 +444,8 @@ fn hermite_mid(a: Sample, b: Sample) -> f64 {
 /// An interval `[a, b]` (with midpoint `m` evaluated) is accepted as
 /// monotone when the slopes at `a`, `m`, `b` are non-zero with one sign,
 /// the cubic Hermite interpolant of the end values and slopes has no
-/// critical point inside, and it predicts `s(m)` to within 1e-3 of
-/// `|s(b) - s(a)|` (plus 1e-12 absolute). An interval with opposite end
+/// critical point inside, and it predicts `s(m)` to within [`NATIVE_HERMITE_REL`] of
+/// `|s(b) - s(a)|` (plus [`NATIVE_HERMITE_ABS`] absolute). An interval with opposite end
 /// slopes whose Hermite interpolant has exactly one critical point and
 /// predicts `s(m)` so is taken to hold exactly one extremum, found by
 /// bisection on the slope. Anything else is halved (depth limit
@@ -493,10 +494,11 @@ fn split_monotone(
     }
     let m = field.eval(tm).map(|(s, d)| (tm, s, d))?;
     let scale = 1.0 + a.1.abs().max(b.1.abs());
-    let tol = 1e-3 * (b.1 - a.1).abs() + 1e-12 * scale;
+    let tol = NATIVE_HERMITE_REL * (b.1 - a.1).abs() + NATIVE_HERMITE_ABS * scale;
     let h = b.0 - a.0;
     let secant = (b.1 - a.1) / h;
-    let dtol = 1e-3 * (a.2.abs() + b.2.abs() + secant.abs()) + 1e-12 * scale / h;
+    let dtol = NATIVE_HERMITE_REL * (a.2.abs() + b.2.abs() + secant.abs())
+        + NATIVE_HERMITE_ABS * scale / h;
     let cubic_ok =
         (hermite_mid(a, b) - m.1).abs() <= tol && (hermite_mid_slope(a, b) - m.2).abs() <= dtol;
     let pos = a.2 > 0.0 || m.2 > 0.0 || b.2 > 0.0;
@@ -659,7 +661,7 @@ fn ray_plane_axes(d: DVec3) -> (DVec3, DVec3) {
 /// Roots `(t, u, v)` of the ray line `o + t d` (unit `d`, `e1`, `e2` its
 /// perpendicular axes) with the bilinear patch
 /// `P(u, v) = (1-u)(1-v) q0 + u(1-v) q1 + u v q2 + (1-u) v q3`, with `u`,
-/// `v` in `[0, 1]` (widened by `PARAM_TOL`).
+/// `v` in `[0, 1]` (widened by `NATIVE_PARAM_TOL`).
 ///
 /// Projected onto the two planes through the ray, `P(u, v) = o` is two
 /// bilinear equations `A_k + B_k u + C_k v + D_k u v = 0`; eliminating `v`
@@ -692,14 +694,14 @@ pub fn ray_bilinear(
         return;
     }
     let mut us = [f64::NAN; 2];
-    if qa.abs() <= 1e-13 * scale {
+    if qa.abs() <= BILINEAR_LINEAR_REL * scale {
         if qb != 0.0 {
             us[0] = -qc / qb;
         }
     } else {
         let disc = qb * qb - 4.0 * qa * qc;
         let disc = if disc < 0.0 {
-            if disc > -1e-12 * qb * qb {
+            if disc > -BILINEAR_DISC_REL * qb * qb {
                 0.0
             } else {
                 return;
@@ -723,12 +725,12 @@ pub fn ray_bilinear(
         let pv = (q[3] - q[0]) * (1.0 - u) + (q[2] - q[1]) * u;
         (p, pu, pv)
     };
-    let in01 = |x: f64| (-PARAM_TOL..=1.0 + PARAM_TOL).contains(&x);
+    let in01 = |x: f64| (-NATIVE_PARAM_TOL..=1.0 + NATIVE_PARAM_TOL).contains(&x);
     for (k, &u) in us.iter().enumerate() {
         if !u.is_finite() || (k == 1 && (us[0] - u).abs() == 0.0) {
             continue;
         }
-        if !(-1e-3..=1.0 + 1e-3).contains(&u) {
+        if !(-BILINEAR_ROOT_WINDOW..=1.0 + BILINEAR_ROOT_WINDOW).contains(&u) {
             continue;
         }
         let den1 = c1 + d1 * u;
@@ -741,7 +743,7 @@ pub fn ray_bilinear(
         } else {
             -(a2 + b2 * u) / den2
         };
-        if !v.is_finite() || !(-1e-3..=1.0 + 1e-3).contains(&v) {
+        if !v.is_finite() || !(-BILINEAR_ROOT_WINDOW..=1.0 + BILINEAR_ROOT_WINDOW).contains(&v) {
             continue;
         }
         let (mut u, mut v) = (u, v);
@@ -769,7 +771,7 @@ pub fn ray_bilinear(
 }
 
 /// The root `(t, b1, b2)` of the ray line with triangle `p` (barycentric
-/// weights of `p[1]`, `p[2]`, widened by `PARAM_TOL`), Möller-Trumbore.
+/// weights of `p[1]`, `p[2]`, widened by `NATIVE_PARAM_TOL`), Möller-Trumbore.
 pub fn ray_triangle(o: DVec3, d: DVec3, p: [DVec3; 3]) -> Option<(f64, f64, f64)> {
     let e1 = p[1] - p[0];
     let e2 = p[2] - p[0];
@@ -784,7 +786,8 @@ pub fn ray_triangle(o: DVec3, d: DVec3, p: [DVec3; 3]) -> Option<(f64, f64, f64)
     let qv = tv.cross(e1);
     let b2 = d.dot(qv) * inv;
     let t = e2.dot(qv) * inv;
-    let ok = b1 >= -PARAM_TOL && b2 >= -PARAM_TOL && b1 + b2 <= 1.0 + PARAM_TOL;
+    let ok =
+        b1 >= -NATIVE_PARAM_TOL && b2 >= -NATIVE_PARAM_TOL && b1 + b2 <= 1.0 + NATIVE_PARAM_TOL;
     (ok && t.is_finite()).then_some((t, b1, b2))
 }
 

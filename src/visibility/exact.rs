@@ -22,6 +22,7 @@ use glam::DVec3;
 
 use crate::numeric::expansion::Expansion;
 use crate::numeric::predicates::{orient3d, Side};
+use crate::numeric::tolerance::ORIENT_DIR_FILTER_EPS;
 
 /// Exact sign of `((b - a) x (c - a)) . d`.
 pub fn orient_dir(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Side {
@@ -29,13 +30,11 @@ pub fn orient_dir(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Side {
     let u = b - a;
     let v = c - a;
     let det = u.cross(v).dot(d);
-    // Shewchuk's orient3d bound uses 7.000001 eps times this permanent; the
-    // factor 16 leaves ample room.
     let (ua, va, da) = (u.abs(), v.abs(), d.abs());
     let perm = (ua.y * va.z + ua.z * va.y) * da.x
         + (ua.z * va.x + ua.x * va.z) * da.y
         + (ua.x * va.y + ua.y * va.x) * da.z;
-    let bound = 16.0 * f64::EPSILON * perm;
+    let bound = ORIENT_DIR_FILTER_EPS * perm;
     if det > bound {
         return Side::Positive;
     }

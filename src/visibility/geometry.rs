@@ -12,6 +12,7 @@ use crate::mesh::tetra::triangulate_face;
 use crate::mesh::topology::Topology;
 use crate::mesh::{Mesh, NONE};
 use crate::numeric::predicates::{orient3d, Plane3, Side};
+use crate::numeric::tolerance::F32_ROUND_UP_REL;
 
 /// Face flag: the stored winding of the face points *into* its first cell
 /// (the first cell has negative volume).
@@ -85,7 +86,7 @@ fn cell_nonconvex(mesh: &Mesh, c: usize, negative: bool) -> bool {
 fn round_up(x: f64) -> f32 {
     let y = x as f32;
     if (y as f64) < x {
-        y * (1.0 + 1e-6)
+        y * (1.0 + F32_ROUND_UP_REL)
     } else {
         y
     }
