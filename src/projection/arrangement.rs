@@ -26,16 +26,16 @@
 //! rounded pixel positions classify their triangles front or back by
 //! rounding noise, so front edges may cross front edges. Their order is
 //! decided exactly too, by the side of the third crossing (a degree-4
-//! polynomial evaluated with exact expansions, `exact`), with a symbolic
+//! polynomial evaluated with exact expansions,
+//! [`crossing_side_times_turn`]), with a symbolic
 //! perturbation when the three lines meet in one point. Crossing positions
 //! are never used for a decision: those of nearly parallel pieces may be
 //! far from the exact point (they are clamped to both bounding boxes).
 
 use glam::DVec2;
 
-use super::exact;
 use super::subdivision::{Subdivision, TopologyError, NIL};
-use crate::numeric::predicates::{orient2d, Side};
+use crate::numeric::predicates::{crossing_side_times_turn, orient2d, Side};
 use crate::numeric::tolerance::{ARRANGEMENT_AREA_REL, OUTER_CYCLE_AREA_REL};
 
 /// A segment between two original points, with the triangles on its sides:
@@ -346,7 +346,7 @@ impl Arrangement {
     /// `q_i`: then `X1` comes first iff `sigma cross(u1, u2) > 0`. As
     /// `u1 x u2 = s1 s2 (e1 x e2)`, this is the sign of
     /// `sigma (e1 x e2) s1 s2`, and `sigma (e1 x e2)` is one exact polynomial
-    /// ([`exact::crossing_side_times_turn`]).
+    /// ([`crossing_side_times_turn`]).
     ///
     /// When the three lines meet in one point, the piece `r` with the largest
     /// id among the three is taken as translated by an infinitesimal amount
@@ -365,7 +365,7 @@ impl Arrangement {
             Side::Negative => -1,
             Side::On => 0,
         };
-        let mut st = sign(exact::crossing_side_times_turn(sp, s1, s2));
+        let mut st = sign(crossing_side_times_turn(sp, s1, s2));
         if st == 0 {
             // Y on the line of p exactly: perturb the largest id.
             // turn = sign(e1 x e2) = side of q2.b from q1 (q2 straddles q1).

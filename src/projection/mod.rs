@@ -42,7 +42,6 @@
 mod arrangement;
 mod clip;
 pub mod coverage;
-mod exact;
 mod overlay;
 mod polyhedron;
 mod project;

@@ -315,3 +315,38 @@ fn boundary_convex(p: &[DVec3], tris: &[BoundaryTri]) -> bool {
     let root = find(&mut parent, 0);
     (0..tris.len() as u32).all(|i| find(&mut parent, i) == root)
 }
+
+/// Parameter `t` (in units of `q - o`) where the line `o + t (q - o)` meets
+/// the plane of `a, b, c`. The vertices are sorted first so the result does
+/// not depend on their order (coincident triangles give identical `t`).
+/// Returns `None` for a line parallel to the plane.
+pub fn line_plane_t(o: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<f64> {
+    let mut p = [a, b, c];
+    p.sort_by(|x, y| {
+        x.x.total_cmp(&y.x)
+            .then(x.y.total_cmp(&y.y))
+            .then(x.z.total_cmp(&y.z))
+    });
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    let den = n.dot(q - o);
+    if den == 0.0 || !den.is_finite() {
+        return None;
+    }
+    Some(n.dot(p[0] - o) / den)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_plane_parameter() {
+        let a = DVec3::new(0.0, 0.0, 0.0);
+        let b = DVec3::new(1.0, 0.0, 0.0);
+        let c = DVec3::new(0.0, 1.0, 0.0);
+        let o = DVec3::new(0.25, 0.25, 5.0);
+        let t = line_plane_t(o, o - DVec3::Z, a, b, c).unwrap();
+        assert!((t - 5.0).abs() < 1e-15);
+        assert_eq!(line_plane_t(o, o + DVec3::X, a, b, c), None);
+    }
+}

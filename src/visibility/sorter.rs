@@ -21,7 +21,6 @@ use std::time::Instant;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::exact::orient_dir;
 use super::geometry::{Geometry, BOUNDARY, CONCAVE, FLIP, PLANAR};
 use super::raster::{exit_entry_pairs, rasterize};
 use super::scc::tarjan;
@@ -31,6 +30,7 @@ use super::{Order, OrderStats, Piece, SplitPolicy, VisibilityError, MAX_SPLIT_RO
 use crate::camera::Camera;
 use crate::mesh::topology::Topology;
 use crate::mesh::{Cells, Mesh, NONE};
+use crate::numeric::predicates::orient_dir;
 use crate::numeric::predicates::{orient3d, Side};
 use crate::numeric::tolerance::PLANE_FILTER_EPS;
 
