@@ -49,6 +49,7 @@ mod refine;
 mod slabs;
 pub mod subdivision;
 mod tet;
+mod window;
 
 use glam::DVec2;
 use thiserror::Error;
