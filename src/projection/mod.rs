@@ -54,7 +54,7 @@ mod window;
 use glam::DVec2;
 use thiserror::Error;
 
-pub use arrangement::{Arrangement, Piece};
+pub use arrangement::{Arrangement, Segment};
 pub use clip::{ClipValue, Clipper};
 pub use polyhedron::Polyhedron;
 pub use project::Projector;

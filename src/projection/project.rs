@@ -54,7 +54,7 @@
 
 use glam::DVec2;
 
-use super::arrangement::{is_outer, Arrangement, Piece};
+use super::arrangement::{is_outer, Arrangement, Segment};
 use super::clip::{ClipValue, Clipper};
 use super::coverage::PixelGrid;
 use super::overlay::Overlay;
@@ -112,7 +112,7 @@ pub struct Projector {
     pix: Vec<DVec2>,
     canon: Vec<u32>,
     facing: Vec<Facing>,
-    segs: Vec<Piece>,
+    segs: Vec<Segment>,
     mark: Vec<bool>,
     /// Half-edges of the unbounded face's cycle.
     outer: Vec<bool>,
@@ -381,9 +381,9 @@ impl Projector {
                     _ => side[2] = ti as u32,
                 }
                 let piece = if u < v {
-                    Piece { a: u, b: v, side }
+                    Segment { a: u, b: v, side }
                 } else {
-                    Piece {
+                    Segment {
                         a: v,
                         b: u,
                         side: [side[1], side[0], side[3], side[2]],
