@@ -17,6 +17,7 @@
 //! a layer's stride: on the 1M-hex grid this took the sort from 123 ms to
 //! 25 ms per view (benches/visibility.rs).
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use glam::DVec3;
@@ -93,8 +94,10 @@ pub enum NonConvex {
 /// Built once per geometry; call [`Sorter::order`] per view.
 #[derive(Clone, Debug)]
 pub struct Sorter {
-    pub(super) mesh: Mesh,
-    pub(super) topo: Topology,
+    /// The mesh and its topology, shared with the caller (never copied by
+    /// [`Sorter::shared`]).
+    pub(super) mesh: Arc<Mesh>,
+    pub(super) topo: Arc<Topology>,
     pub(super) geom: Geometry,
     pub(super) pool: SplitPool,
     pub(super) invalid: Option<VisibilityError>,
@@ -137,25 +140,38 @@ struct RoundGraph {
 
 impl Sorter {
     /// Prepares the plane equations and adjacency of `mesh` (whose topology
-    /// is `topo`). Invalid input (point ids out of range, non-finite points,
-    /// a topology of another mesh) is reported by [`Sorter::order`].
+    /// is `topo`), copying the mesh's points and cells and the topology into
+    /// the sorter; [`Sorter::shared`] shares them instead. Invalid input
+    /// (point ids out of range, non-finite points, a topology of another
+    /// mesh) is reported by [`Sorter::order`].
     pub fn new(mesh: &Mesh, topo: &Topology) -> Sorter {
-        let n = mesh.cells.len();
-        let invalid = super::input::check_input(mesh, topo);
         let geo_mesh = Mesh {
             points: mesh.points.clone(),
             cells: mesh.cells.clone(),
             ..Default::default()
         };
+        Sorter::shared(Arc::new(geo_mesh), Arc::new(topo.clone()))
+    }
+
+    /// [`Sorter::new`] for a mesh and topology the caller shares: nothing is
+    /// copied, the sorter keeps the two `Arc`s for its lifetime (the
+    /// geometry must not change while it is in use; values may).
+    pub fn shared(mesh: Arc<Mesh>, topo: Arc<Topology>) -> Sorter {
+        let n = mesh.cells.len();
+        let invalid = super::input::check_input(&mesh, &topo);
         let (topo, geom) = if invalid.is_some() {
-            (Topology::build(&Cells::default()), Geometry::default())
+            (
+                Arc::new(Topology::build(&Cells::default())),
+                Geometry::default(),
+            )
         } else {
-            (topo.clone(), Geometry::build(mesh, topo))
+            let geom = Geometry::build(&mesh, &topo);
+            (topo, geom)
         };
         let nf = topo.face_count();
         let nt = geom.planes.len();
         Sorter {
-            mesh: geo_mesh,
+            mesh,
             pool: SplitPool::new(if invalid.is_some() { 0 } else { n }),
             invalid,
             nonconvex: NonConvex::PixelConstraints,
