@@ -13,7 +13,7 @@
 //! or infinity; a NaN scalar gives the empty segment.
 
 use super::weights::weights;
-use super::{RayAccumulator, SegmentValue};
+use super::{Material, RayAccumulator, RayMaterial, SegmentValue};
 use crate::numeric::tolerance::GLOW_LIMIT_DEPTH;
 use crate::tf::{EmissionModel, TransferFunction};
 
@@ -223,5 +223,28 @@ pub fn vertex_values(tf: &TransferFunction, l: f64, s_f: f64, s_b: f64) -> Verte
         depth: seg.depth,
         glow,
         tau_mean,
+    }
+}
+
+/// A transfer function as the renderers see it: exact segment integrals
+/// ([`segment`]), its breakpoints, and point evaluation (right-continuous
+/// at jumps; the source is `tau * colour` for glow, `E` for independent
+/// emission).
+impl RayMaterial for TransferFunction {
+    fn segment(&self, l: f64, s_f: f64, s_b: f64) -> SegmentValue {
+        segment(self, l, s_f, s_b)
+    }
+
+    fn breakpoints(&self) -> &[f64] {
+        &self.breaks
+    }
+
+    fn material(&self, s: f64) -> Material {
+        let (tau, c) = self.eval_piece(self.piece_index(s), s);
+        let source = match self.model {
+            EmissionModel::Glow => [tau * c[0], tau * c[1], tau * c[2]],
+            EmissionModel::Independent => c,
+        };
+        Material { tau, source }
     }
 }
