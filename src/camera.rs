@@ -17,6 +17,7 @@
 //! (x right, y up, z = distance along the view direction) before any `f32`
 //! conversion.
 
+use crate::numeric::tolerance::{CAMERA_NEAR_REL, CAMERA_UP_PARALLEL_SQ};
 use glam::{DMat3, DVec3};
 
 /// User-facing camera parameters (the CLI flags).
@@ -160,7 +161,7 @@ impl Camera {
             ortho: p.ortho,
             width: p.width,
             height: p.height,
-            near: distance * 1e-9,
+            near: distance * CAMERA_NEAR_REL,
         }
     }
 
@@ -251,7 +252,7 @@ impl Camera {
 
 fn orthogonalise(up: DVec3, forward: DVec3, right_hint: DVec3) -> DVec3 {
     let u = up - forward * up.dot(forward);
-    if u.length_squared() > 1e-24 {
+    if u.length_squared() > CAMERA_UP_PARALLEL_SQ {
         u.normalize()
     } else {
         // View-up parallel to the view direction: fall back to the old right axis.

@@ -310,7 +310,7 @@ pub fn cycles(data: &[u8]) {
     impl EyeSide for Eye {
         fn side(&self, a: DVec3, b: DVec3, c: DVec3) -> Side {
             if self.1 {
-                crate::visibility::exact::orient_dir(a, b, c, -self.0)
+                crate::numeric::predicates::orient_dir(a, b, c, -self.0)
             } else {
                 crate::numeric::predicates::orient3d(a, b, c, self.0)
             }

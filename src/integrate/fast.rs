@@ -21,6 +21,7 @@
 //! times the table's scalar range, the difference quotients lose their digits
 //! and the values at the midpoint scalar are used instead.
 
+use crate::numeric::tolerance::ONE_MINUS_EXP_SERIES_X;
 use crate::tf::{EmissionModel, TransferFunction};
 
 /// Colour rule of the integral-function approximation.
@@ -139,7 +140,7 @@ fn piece_integral(
 /// `(1 - exp(-x)) / x`, stable at 0.
 #[inline]
 pub(crate) fn one_minus_exp_over(x: f64) -> f64 {
-    if x < 1e-10 {
+    if x < ONE_MINUS_EXP_SERIES_X {
         1.0 - 0.5 * x
     } else {
         -(-x).exp_m1() / x

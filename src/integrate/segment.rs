@@ -13,7 +13,8 @@
 //! or infinity; a NaN scalar gives the empty segment.
 
 use super::weights::weights;
-use super::{RayAccumulator, SegmentValue};
+use super::{Material, RayAccumulator, RayMaterial, SegmentValue};
+use crate::numeric::tolerance::GLOW_LIMIT_DEPTH;
 use crate::tf::{EmissionModel, TransferFunction};
 
 const MAX_LENGTH: f64 = 1e150;
@@ -161,15 +162,10 @@ pub struct VertexValues {
     pub tau_mean: f64,
 }
 
-/// Below this optical depth `C / alpha` is replaced by its `l -> 0` limit
-/// (both are equal to ~1e-16 relative there, and the quotient of two
-/// subnormal numbers would lose precision).
-const GLOW_LIMIT_DEPTH: f64 = 1e-200;
-
 /// Exact per-vertex values (segment colour, opacity, depth), the glow colour
 /// `g = C / alpha` and the mean extinction.
 ///
-/// The `l -> 0` limit of `g` (used when the depth is below 1e-200, e.g. at
+/// The `l -> 0` limit of `g` (used when the depth is below [`GLOW_LIMIT_DEPTH`], e.g. at
 /// silhouette vertices with `l = 0`):
 /// * glow model: the extinction-weighted mean colour over the scalar interval,
 ///   per piece `(c_f (2 tau_f + tau_b) + c_b (tau_f + 2 tau_b)) / 3` weighted
@@ -227,5 +223,28 @@ pub fn vertex_values(tf: &TransferFunction, l: f64, s_f: f64, s_b: f64) -> Verte
         depth: seg.depth,
         glow,
         tau_mean,
+    }
+}
+
+/// A transfer function as the renderers see it: exact segment integrals
+/// ([`segment`]), its breakpoints, and point evaluation (right-continuous
+/// at jumps; the source is `tau * colour` for glow, `E` for independent
+/// emission).
+impl RayMaterial for TransferFunction {
+    fn segment(&self, l: f64, s_f: f64, s_b: f64) -> SegmentValue {
+        segment(self, l, s_f, s_b)
+    }
+
+    fn breakpoints(&self) -> &[f64] {
+        &self.breaks
+    }
+
+    fn material(&self, s: f64) -> Material {
+        let (tau, c) = self.eval_piece(self.piece_index(s), s);
+        let source = match self.model {
+            EmissionModel::Glow => [tau * c[0], tau * c[1], tau * c[2]],
+            EmissionModel::Independent => c,
+        };
+        Material { tau, source }
     }
 }

@@ -25,6 +25,7 @@
 //!   never overflow (so `tau_f ~ tau_b` and depths of 1e6 are harmless).
 
 use super::tables_sf::{GL12, GL8, SF_TABLE};
+use crate::numeric::tolerance::{SERIES_SUM_FLOOR, SERIES_TRUNCATION_REL};
 
 /// Segments with `max(a, b)` at or below this use the Gauss-Legendre rule.
 const SMALL_DEPTH: f64 = 2.0;
@@ -102,7 +103,9 @@ fn taylor_pq(x: f64) -> (f64, f64) {
         pm1 = p;
         p = pn1;
         n += 1;
-        if tp.abs() <= 1e-18 * sp.abs() && tq.abs() <= 1e-18 * sq.abs() {
+        if tp.abs() <= SERIES_TRUNCATION_REL * sp.abs()
+            && tq.abs() <= SERIES_TRUNCATION_REL * sq.abs()
+        {
             break;
         }
     }
@@ -131,7 +134,9 @@ fn taylor_bg(x: f64) -> (f64, f64) {
         bm1 = b;
         b = bn1;
         n += 1;
-        if tb.abs() <= 1e-18 * sb.abs() && tg.abs() <= 1e-18 * sg.abs().max(1e-300) {
+        if tb.abs() <= SERIES_TRUNCATION_REL * sb.abs()
+            && tg.abs() <= SERIES_TRUNCATION_REL * sg.abs().max(SERIES_SUM_FLOOR)
+        {
             break;
         }
     }
@@ -154,7 +159,7 @@ fn asym(t: f64, sign: f64) -> (f64, f64) {
             qterm *= sign * (2.0 * kf - 1.0) * t;
             q += qterm;
         }
-        if term.abs() < 1e-18 && qterm.abs() < 1e-18 {
+        if term.abs() < SERIES_TRUNCATION_REL && qterm.abs() < SERIES_TRUNCATION_REL {
             break;
         }
     }

@@ -31,9 +31,9 @@
 
 use thiserror::Error;
 
+use super::data::DataArray;
 use super::subset::keep_cells;
 use super::Mesh;
-use crate::field::DataArray;
 
 /// Name of VTK's ghost arrays (cell data for cells, point data for points).
 pub const GHOST_ARRAY: &str = "vtkGhostType";
@@ -133,8 +133,8 @@ pub fn remove_ghost_cells(mesh: &mut Mesh) -> Result<usize, GhostError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::field::ArrayData;
     use crate::generate::{ghost_grid, ghost_grid_flags, warped_hex_grid, Warp};
+    use crate::mesh::data::ArrayData;
 
     fn with_ghosts(data: ArrayData, components: usize) -> Mesh {
         let mut m = warped_hex_grid(2, &Warp::default());

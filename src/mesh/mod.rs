@@ -16,6 +16,7 @@
 
 pub mod cell;
 pub mod components;
+pub mod data;
 pub mod ghost;
 pub mod hull;
 pub mod merge;
@@ -32,7 +33,7 @@ use glam::DVec3;
 
 pub use cell::CellKind;
 
-use crate::field::DataArray;
+use data::DataArray;
 
 /// Sentinel for "no cell" / "no face".
 pub const NONE: u32 = u32::MAX;

@@ -15,7 +15,7 @@
 
 use std::collections::BTreeMap;
 
-use crate::field::{ArrayData, DataArray};
+use super::data::{ArrayData, DataArray};
 
 use super::{Cells, Mesh};
 

@@ -59,8 +59,57 @@ pub struct Topology {
 
 /// A broken invariant found by [`Topology::sanity_check`].
 #[derive(Debug, Error, PartialEq, Eq)]
-#[error("topology invariant broken: {0}")]
-pub struct TopologyError(pub String);
+pub enum TopologyError {
+    /// The per-cell face offsets do not cover the cells.
+    #[error("topology invariant broken: {offsets} cell face offsets for {cells} cells")]
+    CellOffsets { offsets: usize, cells: usize },
+    /// The per-face arrays have different lengths.
+    #[error("topology invariant broken: face array lengths disagree")]
+    FaceArrays,
+    /// The face offsets do not end at the length of the face vertex list.
+    #[error("topology invariant broken: face offsets do not end at face_verts.len()")]
+    FaceOffsets,
+    /// The cell-to-face list does not match its offsets.
+    #[error("topology invariant broken: cell_faces length disagrees with its offsets")]
+    CellFaces,
+    /// A cell has another number of faces than its kind.
+    #[error("topology invariant broken: cell {cell}: {recorded} faces recorded")]
+    FaceCount { cell: usize, recorded: usize },
+    /// A cell's face id is not a face.
+    #[error("topology invariant broken: cell {cell} face {local}: id {face} out of range")]
+    FaceId {
+        cell: usize,
+        local: usize,
+        face: usize,
+    },
+    /// A face does not record the cell (at that local index) that uses it.
+    #[error(
+        "topology invariant broken: cell {cell} face {local}: face {face} has cells {cells:?}"
+    )]
+    FaceCells {
+        cell: usize,
+        local: usize,
+        face: usize,
+        cells: [u32; 2],
+    },
+    /// A cell's local face and its unique face have different vertices.
+    #[error("topology invariant broken: cell {cell} face {local}: vertices {cell_verts:?} vs {face_verts:?}")]
+    FaceVertices {
+        cell: usize,
+        local: usize,
+        cell_verts: Vec<u32>,
+        face_verts: Vec<u32>,
+    },
+    /// A face joins a cell to itself.
+    #[error("topology invariant broken: face {face}: both sides are cell {cell}")]
+    SelfAdjacent { face: usize, cell: u32 },
+    /// A face is used by another number of cells than it records.
+    #[error("topology invariant broken: face {face}: used {used} times, want {want}")]
+    FaceUses { face: usize, used: u8, want: u8 },
+    /// Repeated vertex sets that are not the counted non-manifold faces.
+    #[error("topology invariant broken: {repeated} repeated face vertex sets but {counted} non-manifold faces counted")]
+    RepeatedFaces { repeated: usize, counted: usize },
+}
 
 /// Cells per parallel work item.
 const CHUNK: usize = 1 << 14;
@@ -335,29 +384,31 @@ impl Topology {
     /// cells; no two unique faces of two cells have the same vertex set unless
     /// they are counted as non-manifold.
     pub fn sanity_check(&self, cells: &Cells) -> Result<(), TopologyError> {
-        let err = |s: String| Err(TopologyError(s));
         let n = cells.len();
         if self.cell_face_offsets.len() != n + 1 {
-            return err(format!(
-                "{} cell face offsets for {n} cells",
-                self.cell_face_offsets.len()
-            ));
+            return Err(TopologyError::CellOffsets {
+                offsets: self.cell_face_offsets.len(),
+                cells: n,
+            });
         }
         let nf = self.face_count();
         if self.face_offsets.len() != nf + 1 || self.face_local.len() != nf {
-            return err("face array lengths disagree".into());
+            return Err(TopologyError::FaceArrays);
         }
         if self.face_offsets.last().copied() != Some(self.face_verts.len() as u32) {
-            return err("face offsets do not end at face_verts.len()".into());
+            return Err(TopologyError::FaceOffsets);
         }
         if self.cell_faces.len() != *self.cell_face_offsets.last().unwrap_or(&0) as usize {
-            return err("cell_faces length disagrees with its offsets".into());
+            return Err(TopologyError::CellFaces);
         }
         let mut uses = vec![0u8; nf];
         for c in 0..n {
             let faces = self.faces_of(c);
             if faces.len() != cells.face_count(c) {
-                return err(format!("cell {c}: {} faces recorded", faces.len()));
+                return Err(TopologyError::FaceCount {
+                    cell: c,
+                    recorded: faces.len(),
+                });
             }
             let mut bad = None;
             cells.for_each_face(c, |local, verts| {
@@ -366,14 +417,23 @@ impl Topology {
                 }
                 let f = faces[local] as usize;
                 if f >= nf {
-                    bad = Some(format!("cell {c} face {local}: id {f} out of range"));
+                    bad = Some(TopologyError::FaceId {
+                        cell: c,
+                        local,
+                        face: f,
+                    });
                     return;
                 }
                 let side = match self.face_cells[f] {
                     [a, _] if a == c as u32 && self.face_local[f][0] as usize == local % 256 => 0,
                     [_, b] if b == c as u32 && self.face_local[f][1] as usize == local % 256 => 1,
                     fc => {
-                        bad = Some(format!("cell {c} face {local}: face {f} has cells {fc:?}"));
+                        bad = Some(TopologyError::FaceCells {
+                            cell: c,
+                            local,
+                            face: f,
+                            cells: fc,
+                        });
                         return;
                     }
                 };
@@ -384,20 +444,29 @@ impl Topology {
                 a.sort_unstable();
                 b.sort_unstable();
                 if a != b {
-                    bad = Some(format!("cell {c} face {local}: vertices {a:?} vs {b:?}"));
+                    bad = Some(TopologyError::FaceVertices {
+                        cell: c,
+                        local,
+                        cell_verts: a,
+                        face_verts: b,
+                    });
                 }
             });
             if let Some(b) = bad {
-                return err(b);
+                return Err(b);
             }
         }
         for (f, (&[a, b], &used)) in self.face_cells.iter().zip(&uses).enumerate() {
             let want = if b == NONE { 1 } else { 2 };
             if a == b {
-                return err(format!("face {f}: both sides are cell {a}"));
+                return Err(TopologyError::SelfAdjacent { face: f, cell: a });
             }
             if used != want {
-                return err(format!("face {f}: used {used} times, want {want}"));
+                return Err(TopologyError::FaceUses {
+                    face: f,
+                    used,
+                    want,
+                });
             }
         }
         // Unique vertex sets, except for the counted non-manifold extras.
@@ -411,10 +480,10 @@ impl Topology {
         sets.sort_unstable();
         let dups = sets.windows(2).filter(|w| w[0] == w[1]).count();
         if dups != self.nonmanifold_faces {
-            return err(format!(
-                "{dups} repeated face vertex sets but {} non-manifold faces counted",
-                self.nonmanifold_faces
-            ));
+            return Err(TopologyError::RepeatedFaces {
+                repeated: dups,
+                counted: self.nonmanifold_faces,
+            });
         }
         Ok(())
     }

@@ -4,7 +4,7 @@
 //! are exact and the sign is that of the largest component. Exact as long as
 //! no intermediate product underflows or overflows (the same assumption as
 //! the `robust` predicates). Used by the predicates that are not a single
-//! `orient2d`/`orient3d`: [`crate::visibility::exact::orient_dir`] and the
+//! `orient2d`/`orient3d`: [`super::predicates::orient_dir`] and the
 //! crossing order of the projection's arrangement. These are rare fallbacks
 //! behind float filters, so the simple allocating form is enough.
 

@@ -178,3 +178,142 @@ pub const BSP_ON_PLANE_REL: f64 = 1e-10;
 /// overlap by that much without overlapping in space. Only the count uses
 /// this; the compositing splits every overlap exactly.
 pub const BRUTE_OVERLAP_REPORT_REL: f64 = 1e-9;
+
+/// Camera: the near plane lies at this fraction of the eye's distance from
+/// the focal point. Rays start at the eye, so the near plane only keeps
+/// projected points finite; a slab this thin in front of the eye holds no
+/// geometry visible at any image resolution.
+pub const CAMERA_NEAR_REL: f64 = 1e-9;
+
+/// Camera: when the view-up vector's component orthogonal to the view
+/// direction has a squared length below this (length below 1e-12 for a unit
+/// view-up), view-up is taken as parallel to the view direction and the
+/// previous right axis defines the new view-up instead (normalising such a
+/// remainder would amplify rounding into an arbitrary direction).
+pub const CAMERA_UP_PARALLEL_SQ: f64 = 1e-24;
+
+/// `(1 - exp(-x)) / x` (`integrate::fast`): below this `x` the two-term
+/// series `1 - x / 2` is used. Its first omitted term, `x^2 / 6`, is then
+/// below 2e-21, far under the rounding of 1, while `exp_m1(-x) / x` would
+/// still be accurate but needlessly slow near 0 (and undefined at 0).
+pub const ONE_MINUS_EXP_SERIES_X: f64 = 1e-10;
+
+/// Power series of the segment weights (`integrate::weights`): summation
+/// stops when the newest term is below this fraction of the partial sum (of
+/// 1, the leading term, for the asymptotic series). 1e-18 is below half an
+/// ulp of the sum, so further terms cannot change the rounded result.
+pub const SERIES_TRUNCATION_REL: f64 = 1e-18;
+
+/// Power series of the segment weights: floor of `|partial sum|` in the
+/// relative stopping test of a series whose sum may be exactly zero, so the
+/// test compares against a positive number instead of requiring a zero term.
+pub const SERIES_SUM_FLOOR: f64 = 1e-300;
+
+/// Below this optical depth `C / alpha` is replaced by its `l -> 0` limit
+/// (`integrate::segment`): both are equal to ~1e-16 relative there, and the
+/// quotient of two subnormal numbers would lose precision.
+pub const GLOW_LIMIT_DEPTH: f64 = 1e-200;
+
+/// Native field model: parametric tolerance of "inside the reference
+/// element" and of "inside a face" for ray / face roots. Roots of the two
+/// faces meeting at an edge carry rounding of ~1e-15 in parametric units;
+/// accepting 1e-9 beyond `[0, 1]` lets both faces find a root at the edge
+/// (a duplicate then gives an empty interval) instead of neither.
+pub const NATIVE_PARAM_TOL: f64 = 1e-9;
+
+/// Native field model: Newton's method for the Gauss-Legendre nodes stops
+/// when its step is below this; nodes lie in `[-1, 1]`, so this is below an
+/// ulp of every node and the iteration has converged to rounding.
+pub const GAUSS_LEGENDRE_NODE_TOL: f64 = 1e-16;
+
+/// Native field model: a Newton inversion of the iso-parametric map that
+/// stops at its iteration limit (or with a step below
+/// [`NATIVE_NEWTON_TOL`]) is accepted only when its last parametric step is
+/// below this. A larger last step means the iteration did not converge
+/// (point outside a curved cell's valid map, nearly singular Jacobian); the
+/// evaluation then counts as failed.
+pub const NATIVE_NEWTON_ACCEPT: f64 = 1e-8;
+
+/// Native field model: a Newton iterate with a parametric coordinate beyond
+/// this magnitude has diverged (the reference element is `[0, 1]^3`) and the
+/// inversion is abandoned before it overflows.
+pub const NATIVE_NEWTON_DIVERGED: f64 = 1e3;
+
+/// Native field model, monotone-piece search: the slope of the cubic Hermite
+/// interpolant, `c0 + c1 x + c2 x^2`, is treated as linear when `|c2|` is
+/// below this fraction of `|c0| + |c1|` (its quadratic term is rounding
+/// noise of the end slopes, and dividing by it would invent critical points).
+pub const HERMITE_QUADRATIC_REL: f64 = 1e-14;
+
+/// Native field model, monotone-piece search: an interval is accepted as
+/// cubic when its Hermite interpolant predicts `s` and `s'` at the midpoint
+/// to this fraction of the interval's range of `s` (of its slopes, for `s'`).
+/// The stated accuracy assumption of the breakpoint search (see
+/// `raycast::native`): tight enough that a cubic that matches this well
+/// hides no pair of extrema, loose enough that smooth cells split rarely.
+pub const NATIVE_HERMITE_REL: f64 = 1e-3;
+
+/// Native field model, monotone-piece search: absolute part of the midpoint
+/// test, relative to `1 + max |s|` at the interval ends, so an interval on
+/// which `s` is constant up to rounding is accepted instead of halved to the
+/// depth limit.
+pub const NATIVE_HERMITE_ABS: f64 = 1e-12;
+
+/// Ray / bilinear patch (`raycast::native`): the patch's quadratic in `u` is
+/// solved as linear when its leading coefficient is below this fraction of
+/// the largest coefficient (a planar or nearly planar patch, where the
+/// second root would be a huge rounding artefact).
+pub const BILINEAR_LINEAR_REL: f64 = 1e-13;
+
+/// Ray / bilinear patch: a discriminant negative by less than this fraction
+/// of `b^2` is rounding of a double root (a ray grazing the patch) and is
+/// taken as zero.
+pub const BILINEAR_DISC_REL: f64 = 1e-12;
+
+/// Ray / bilinear patch: roots `(u, v)` up to this far outside `[0, 1]` are
+/// kept as candidates for the Newton polish on the 3D system, which moves
+/// them by up to the quadratic's rounding; only after the polish is the
+/// root tested against [`NATIVE_PARAM_TOL`].
+pub const BILINEAR_ROOT_WINDOW: f64 = 1e-3;
+
+/// Perspective refinement (`projection::project`): a piece whose scalar
+/// range is below this fraction of its largest `|scalar|` has constant
+/// scalars up to rounding (cell data), hence no scalar interpolation error:
+/// its rounding noise must not drive the refinement.
+pub const CONSTANT_SCALAR_REL: f64 = 1e-12;
+
+/// Arrangement check (`projection::arrangement`): the bounded regions'
+/// areas must sum to the outer boundary's area to this fraction of it.
+/// Crossing points are rounded to f64, so areas carry relative rounding of
+/// ~1e-15 per region; a real gap or overlap is a whole region.
+pub const ARRANGEMENT_AREA_REL: f64 = 1e-9;
+
+/// Arrangement (`projection::arrangement`): a face cycle of negative area
+/// counts as an outer boundary (of a second component) only when its area
+/// exceeds this fraction of the largest outer area. Sliver regions whose
+/// rounded crossing points make their area zero or slightly negative stay
+/// bounded faces.
+pub const OUTER_CYCLE_AREA_REL: f64 = 1e-9;
+
+/// ParaView colour maps (`tf::paraview`): midpoints of opacity nodes are
+/// clamped to `[this, 1 - this]`, as `vtkPiecewiseFunction` does, so the
+/// midpoint/sharpness curve never divides by zero.
+pub const PARAVIEW_MIDPOINT_CLAMP: f64 = 1e-5;
+
+/// Visibility geometry (`visibility::geometry`): per-face float error
+/// bounds are stored as f32 rounded up; when the cast rounds down the value
+/// is raised by this relative amount (over 8 f32 ulps, 1.19e-7 each), so
+/// the stored bound is never below the f64 one.
+pub const F32_ROUND_UP_REL: f32 = 1e-6;
+
+/// Floating-point filters of the exact predicates: below this bound the
+/// filter's error estimate could itself be a rounded subnormal, so the
+/// exact predicate decides instead.
+pub const FILTER_UNDERFLOW_BOUND: f64 = 1e-250;
+
+/// Error bound factor of the float filter in front of the exact
+/// `((b - a) x (c - a)) . d` sign: the float value is trusted when it
+/// exceeds this times the determinant's permanent. Shewchuk's orient3d bound
+/// is 7.000001 eps times the permanent; 16 eps leaves ample room. Not a
+/// tolerance on the answer: only a larger number of exact evaluations.
+pub const ORIENT_DIR_FILTER_EPS: f64 = 16.0 * f64::EPSILON;

@@ -42,7 +42,6 @@
 mod arrangement;
 mod clip;
 pub mod coverage;
-mod exact;
 mod overlay;
 mod polyhedron;
 mod project;
@@ -50,11 +49,12 @@ mod refine;
 mod slabs;
 pub mod subdivision;
 mod tet;
+mod window;
 
 use glam::DVec2;
 use thiserror::Error;
 
-pub use arrangement::{Arrangement, Piece};
+pub use arrangement::{Arrangement, Segment};
 pub use clip::{ClipValue, Clipper};
 pub use polyhedron::Polyhedron;
 pub use project::Projector;

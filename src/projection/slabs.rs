@@ -7,19 +7,19 @@
 //! from the tet's own corners and carry the breakpoint scalar exactly, and
 //! the two slabs sharing an iso-plane compute its points identically.
 //!
-//! Order: back to front along the gradient
-//! ([`crate::visibility::slabs::slab_order`], the order the sorter lists
-//! [`crate::visibility::Piece::Slab`]s in).
+//! Which slabs, and their order: [`crate::visibility::slabs::tet_slabs`],
+//! the expansion the sorter lists [`crate::visibility::Piece::Slab`]s from.
 
 use glam::DVec3;
 
 use super::clip::{ClipValue, Clipper};
 use super::polyhedron::Polyhedron;
 use crate::camera::Camera;
-use crate::visibility::slabs::{bands, inner_levels, slab_order};
+use crate::visibility::slabs::{band_values, order_levels, tet_slabs, SlabScratch};
 
 /// Cuts the view-space tet `points` by the breakpoints strictly inside its
-/// scalar range and returns the slabs in back-to-front order for `camera`.
+/// scalar range and returns the slabs in back-to-front order for `camera`
+/// (the slabs [`tet_slabs`] lists, the ones the sorter orders).
 /// Without such breakpoints the result is the whole tet.
 pub fn slice_tet(
     points: [DVec3; 4],
@@ -28,22 +28,23 @@ pub fn slice_tet(
     camera: &Camera,
 ) -> Vec<Polyhedron> {
     let tet = Polyhedron::from_tet(points, scalars);
-    let mut levels: Vec<f64> = breakpoints
-        .iter()
-        .copied()
-        .filter(|b| b.is_finite())
-        .collect();
-    levels.sort_by(f64::total_cmp);
-    levels.dedup();
-    let inner = &levels[inner_levels(&scalars, &levels)];
-    if inner.is_empty() {
+    let levels = order_levels(breakpoints);
+    let mut scratch = SlabScratch::default();
+    let slabs = tet_slabs(
+        &scalars,
+        &scalars,
+        || points,
+        &levels,
+        camera.ortho,
+        &mut scratch,
+    );
+    if slabs.is_empty() {
         return vec![tet];
     }
-    let bands = bands(inner);
     let mut clipper = Clipper::default();
-    let mut out = Vec::with_capacity(bands.len());
-    for i in slab_order(&points, &scalars, &bands, camera.ortho) {
-        let (lo, hi) = bands[i];
+    let mut out = Vec::with_capacity(slabs.len());
+    for &(lo, hi) in slabs {
+        let (lo, hi) = band_values(&levels, lo, hi);
         let mut slab = Polyhedron::default();
         if let Ok(true) = clipper.clip(&tet, ClipValue::Scalar, lo, hi, &mut slab) {
             out.push(slab);

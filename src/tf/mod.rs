@@ -13,10 +13,10 @@
 //!
 //! The source term along a ray is `tau * c` for [`EmissionModel::Glow`] (the
 //! Williams-Max volume density model, the default) and `E` for independent
-//! emission. Point evaluation ([`TransferFunction::material`]) is
-//! right-continuous at jumps. The exact integrals live in
-//! [`crate::integrate`]; `TransferFunction` implements
-//! [`crate::integrate::RayMaterial`] with them.
+//! emission. Point evaluation is right-continuous at jumps. This module
+//! holds the data only: the exact integrals live in [`crate::integrate`],
+//! which also implements its `RayMaterial` (what the renderers need of a
+//! material) for `TransferFunction`.
 //!
 //! Channels given as separate point lists (VTK style: opacity points and
 //! colour points) are merged onto the union of their scalars by
@@ -34,8 +34,6 @@ pub mod presets;
 
 pub use error::TfError;
 pub use presets::{preset, preset_names, Opacity};
-
-use crate::integrate::{Material, RayMaterial, SegmentValue};
 
 /// How a material emits light.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -69,7 +67,7 @@ pub struct TransferFunction {
     /// Glow colour (kept for both models: display, glow limits).
     pub(crate) color: Vec<[f64; 3]>,
     pub(crate) model: EmissionModel,
-    breaks: Vec<f64>,
+    pub(crate) breaks: Vec<f64>,
     /// The field the file names (`scalar` key), if any.
     pub scalar: Option<String>,
     /// Opacity unit distance the file used, if any (informational).
@@ -280,25 +278,6 @@ impl TransferFunction {
     /// Extinction at `s` (right-continuous).
     pub fn tau_at(&self, s: f64) -> f64 {
         self.eval_piece(self.piece_index(s), s).0
-    }
-}
-
-impl RayMaterial for TransferFunction {
-    fn segment(&self, l: f64, s_f: f64, s_b: f64) -> SegmentValue {
-        crate::integrate::segment(self, l, s_f, s_b)
-    }
-
-    fn breakpoints(&self) -> &[f64] {
-        &self.breaks
-    }
-
-    fn material(&self, s: f64) -> Material {
-        let (tau, c) = self.eval_piece(self.piece_index(s), s);
-        let source = match self.model {
-            EmissionModel::Glow => [tau * c[0], tau * c[1], tau * c[2]],
-            EmissionModel::Independent => c,
-        };
-        Material { tau, source }
     }
 }
 

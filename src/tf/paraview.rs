@@ -23,6 +23,7 @@
 use serde::Deserialize;
 
 use super::{EmissionModel, TfError, TransferFunction};
+use crate::numeric::tolerance::PARAVIEW_MIDPOINT_CLAMP;
 
 /// Linear pieces per interval when a non-linear interpolation is resampled.
 pub const PIECES_PER_INTERVAL: usize = 32;
@@ -230,7 +231,7 @@ fn interpolate(c0: [f64; 3], c1: [f64; 3], t: f64, space: ColorSpace) -> [f64; 3
 /// VTK's midpoint/sharpness curve between opacities `v1` and `v2`
 /// (`vtkPiecewiseFunction`), `x in [0, 1]`.
 fn midpoint_sharpness(v1: f64, v2: f64, x: f64, mid: f64, sharp: f64) -> f64 {
-    let mid = mid.clamp(1e-5, 1.0 - 1e-5);
+    let mid = mid.clamp(PARAVIEW_MIDPOINT_CLAMP, 1.0 - PARAVIEW_MIDPOINT_CLAMP);
     let x = if x < mid {
         0.5 * x / mid
     } else {

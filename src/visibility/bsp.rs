@@ -489,7 +489,7 @@ mod tests {
     struct Dir(DVec3);
     impl EyeSide for Dir {
         fn side(&self, a: DVec3, b: DVec3, c: DVec3) -> Side {
-            crate::visibility::exact::orient_dir(a, b, c, -self.0)
+            crate::numeric::predicates::orient_dir(a, b, c, -self.0)
         }
     }
 

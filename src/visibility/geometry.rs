@@ -12,6 +12,7 @@ use crate::mesh::tetra::triangulate_face;
 use crate::mesh::topology::Topology;
 use crate::mesh::{Mesh, NONE};
 use crate::numeric::predicates::{orient3d, Plane3, Side};
+use crate::numeric::tolerance::F32_ROUND_UP_REL;
 
 /// Face flag: the stored winding of the face points *into* its first cell
 /// (the first cell has negative volume).
@@ -85,7 +86,7 @@ fn cell_nonconvex(mesh: &Mesh, c: usize, negative: bool) -> bool {
 fn round_up(x: f64) -> f32 {
     let y = x as f32;
     if (y as f64) < x {
-        y * (1.0 + 1e-6)
+        y * (1.0 + F32_ROUND_UP_REL)
     } else {
         y
     }
@@ -313,4 +314,39 @@ fn boundary_convex(p: &[DVec3], tris: &[BoundaryTri]) -> bool {
     }
     let root = find(&mut parent, 0);
     (0..tris.len() as u32).all(|i| find(&mut parent, i) == root)
+}
+
+/// Parameter `t` (in units of `q - o`) where the line `o + t (q - o)` meets
+/// the plane of `a, b, c`. The vertices are sorted first so the result does
+/// not depend on their order (coincident triangles give identical `t`).
+/// Returns `None` for a line parallel to the plane.
+pub fn line_plane_t(o: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<f64> {
+    let mut p = [a, b, c];
+    p.sort_by(|x, y| {
+        x.x.total_cmp(&y.x)
+            .then(x.y.total_cmp(&y.y))
+            .then(x.z.total_cmp(&y.z))
+    });
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    let den = n.dot(q - o);
+    if den == 0.0 || !den.is_finite() {
+        return None;
+    }
+    Some(n.dot(p[0] - o) / den)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_plane_parameter() {
+        let a = DVec3::new(0.0, 0.0, 0.0);
+        let b = DVec3::new(1.0, 0.0, 0.0);
+        let c = DVec3::new(0.0, 1.0, 0.0);
+        let o = DVec3::new(0.25, 0.25, 5.0);
+        let t = line_plane_t(o, o - DVec3::Z, a, b, c).unwrap();
+        assert!((t - 5.0).abs() < 1e-15);
+        assert_eq!(line_plane_t(o, o + DVec3::X, a, b, c), None);
+    }
 }

@@ -20,7 +20,7 @@
 //! 2. **Per view, MPVO**: the side of every face triangle's plane the eye is
 //!    on (perspective: the eye position; orthographic: the sign of
 //!    `n . forward`), by the float filter with exact fallback
-//!    (`numeric::predicates::orient3d` / [`exact::orient_dir`]). An interior
+//!    (`numeric::predicates::orient3d` / [`orient_dir`](crate::numeric::predicates::orient_dir)). An interior
 //!    face whose triangles agree directs the adjacency edge between its two
 //!    cells (the cell on the eye's side is drawn later). A quad whose two
 //!    triangles disagree is a **problem face** (MWS section V); both its cells
@@ -34,7 +34,7 @@
 //! 3. **Non-convex meshes** (boundary not convex): XMPVO sampled at image
 //!    resolution ([`raster`]). Every boundary triangle is rasterised at the
 //!    pixel-centre rays of [`Camera::pixel_ray`] (a float edge-function filter
-//!    with a margin, exact [`exact::ray_triangle`] inside the margin). Per
+//!    with a margin, exact [`ray_triangle`](crate::numeric::predicates::ray_triangle) inside the margin). Per
 //!    pixel the boundary crossings are sorted by depth; every exit from piece
 //!    `X` followed directly by an entry into piece `Y` adds the constraint "`Y`
 //!    before `X`". Along every pixel ray, consecutive pieces are then related
@@ -78,7 +78,6 @@
 //! pieces met by depth and checks that they are drawn back to front.
 
 pub mod bsp;
-pub mod exact;
 mod geometry;
 mod input;
 mod raster;

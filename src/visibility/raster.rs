@@ -20,9 +20,10 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::exact::{line_plane_t, ray_triangle, RayHit};
+use super::geometry::line_plane_t;
 use super::geometry::BoundaryTri;
 use crate::camera::Camera;
+use crate::numeric::predicates::{ray_triangle, RayHit};
 use crate::numeric::tolerance::RASTER_FILTER_PX;
 
 /// One boundary crossing of one pixel ray.

@@ -14,10 +14,18 @@
 //! decreasing distance of the band from `e` is back to front (bands on
 //! opposite sides of `e` never share a ray). Orthographic views use the sign
 //! of the gradient along the view direction `+z` instead.
+//!
+//! [`tet_slabs`] is the one slab expansion: the sorter lists a tet's
+//! [`super::Piece::Slab`]s from it, and [`crate::projection::slice_tet`]
+//! cuts the same slabs geometrically from it. Levels are the sorted,
+//! deduplicated finite breakpoints ([`order_levels`]), the
+//! [`super::Order::levels`] that slab pieces index.
 
 use std::ops::Range;
 
 use glam::{DMat3, DVec3};
+
+use super::NO_LEVEL;
 
 /// Indices of the sorted `levels` that lie strictly inside the range of
 /// `scalars` (empty when none does).
@@ -111,4 +119,82 @@ pub fn slab_order_into(
     );
     // Larger key = further back = drawn first.
     keyed.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+}
+
+/// The levels slabs index: the finite `breakpoints`, sorted, without
+/// duplicates.
+pub fn order_levels(breakpoints: &[f64]) -> Vec<f64> {
+    let mut levels: Vec<f64> = breakpoints
+        .iter()
+        .copied()
+        .filter(|b| b.is_finite())
+        .collect();
+    levels.sort_by(f64::total_cmp);
+    levels.dedup();
+    levels
+}
+
+/// The scalar band `(lo, hi)` of the slab between level indices `lo` and
+/// `hi` ([`NO_LEVEL`]: unbounded on that side).
+pub fn band_values(levels: &[f64], lo: u32, hi: u32) -> (f64, f64) {
+    let at = |i: u32, open: f64| {
+        if i == NO_LEVEL {
+            open
+        } else {
+            levels[i as usize]
+        }
+    };
+    (at(lo, f64::NEG_INFINITY), at(hi, f64::INFINITY))
+}
+
+/// Reusable buffers of [`tet_slabs`].
+#[derive(Clone, Debug, Default)]
+pub struct SlabScratch {
+    bands: Vec<(f64, f64)>,
+    keyed: Vec<(f64, usize)>,
+    slabs: Vec<(u32, u32)>,
+}
+
+/// The slabs of a tet, back to front: the one slab expansion.
+///
+/// `levels` are the order's levels ([`order_levels`]). The levels strictly
+/// inside the range of `range` (the tet's nodal scalars, or those of a
+/// fragment of the tet) cut it; `scalars` are the tet's nodal scalars and
+/// `view()` its view-space corners (called only when some level cuts), which
+/// give the back-to-front order ([`slab_order_into`]; `ortho` for an
+/// orthographic camera). Returns each slab as the level indices `(lo, hi)`
+/// of its band `levels[lo] <= s <= levels[hi]` ([`NO_LEVEL`] for an open
+/// end, see [`band_values`]), in drawing order; empty when no level cuts
+/// (the piece is drawn whole).
+pub fn tet_slabs<'s>(
+    range: &[f64],
+    scalars: &[f64; 4],
+    view: impl FnOnce() -> [DVec3; 4],
+    levels: &[f64],
+    ortho: bool,
+    scratch: &'s mut SlabScratch,
+) -> &'s [(u32, u32)] {
+    scratch.slabs.clear();
+    let inner = inner_levels(range, levels);
+    if inner.is_empty() {
+        return &scratch.slabs;
+    }
+    bands_into(&levels[inner.clone()], &mut scratch.bands);
+    slab_order_into(&view(), scalars, &scratch.bands, ortho, &mut scratch.keyed);
+    let last = scratch.bands.len() - 1;
+    for &(_, i) in &scratch.keyed {
+        // Band i lies between inner levels i - 1 and i.
+        let lo = if i == 0 {
+            NO_LEVEL
+        } else {
+            (inner.start + i - 1) as u32
+        };
+        let hi = if i == last {
+            NO_LEVEL
+        } else {
+            (inner.start + i) as u32
+        };
+        scratch.slabs.push((lo, hi));
+    }
+    &scratch.slabs
 }

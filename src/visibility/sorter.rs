@@ -6,7 +6,8 @@
 //! id `cells + base(slot) + k`. Interior faces between two whole cells are
 //! edges through `face_target` (the cell drawn later, or `NONE`); every other
 //! edge (per triangle next to a split cell, inside a split cell, non-convex
-//! constraints) is an "extra" edge in a CSR list rebuilt per round.
+//! constraints) is an edge of the round's [`RoundGraph`], a CSR list rebuilt
+//! per round.
 //!
 //! Speed: the sort is bound by memory, not arithmetic. Kahn reads the
 //! out-edges of a cell from `slot_target` (the face targets laid out by
@@ -16,21 +17,21 @@
 //! a layer's stride: on the 1M-hex grid this took the sort from 123 ms to
 //! 25 ms per view (benches/visibility.rs).
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::exact::orient_dir;
 use super::geometry::{Geometry, BOUNDARY, CONCAVE, FLIP, PLANAR};
 use super::raster::{exit_entry_pairs, rasterize};
 use super::scc::tarjan;
 use super::split::SplitPool;
-use super::{bsp, slabs};
-use super::{Order, OrderStats, Piece, SplitPolicy, VisibilityError, MAX_SPLIT_ROUNDS, NO_LEVEL};
+use super::{Order, OrderStats, SplitPolicy, VisibilityError, MAX_SPLIT_ROUNDS};
 use crate::camera::Camera;
 use crate::mesh::topology::Topology;
 use crate::mesh::{Cells, Mesh, NONE};
+use crate::numeric::predicates::orient_dir;
 use crate::numeric::predicates::{orient3d, Side};
 use crate::numeric::tolerance::PLANE_FILTER_EPS;
 
@@ -88,11 +89,15 @@ pub enum NonConvex {
     IgnoreApproximate,
 }
 
+mod finish;
+
 /// Built once per geometry; call [`Sorter::order`] per view.
 #[derive(Clone, Debug)]
 pub struct Sorter {
-    pub(super) mesh: Mesh,
-    pub(super) topo: Topology,
+    /// The mesh and its topology, shared with the caller (never copied by
+    /// [`Sorter::shared`]).
+    pub(super) mesh: Arc<Mesh>,
+    pub(super) topo: Arc<Topology>,
     pub(super) geom: Geometry,
     pub(super) pool: SplitPool,
     pub(super) invalid: Option<VisibilityError>,
@@ -115,9 +120,12 @@ pub struct Sorter {
     indeg: Vec<u32>,
 }
 
-/// Per-round graph data besides `face_target`.
+/// The constraint graph of one splitting round beyond `face_target`: the
+/// ids of the split cells' tets, and the edges that `face_target` cannot
+/// hold (per triangle next to a split cell, inside a split cell, non-convex
+/// constraints) as a CSR list over piece ids.
 #[derive(Default)]
-struct Extra {
+struct RoundGraph {
     /// `base[k]`: first tet id of `pool.active[k]`.
     base: Vec<u32>,
     /// The same by storage slot (`pool.slot_of`).
@@ -132,25 +140,38 @@ struct Extra {
 
 impl Sorter {
     /// Prepares the plane equations and adjacency of `mesh` (whose topology
-    /// is `topo`). Invalid input (point ids out of range, non-finite points,
-    /// a topology of another mesh) is reported by [`Sorter::order`].
+    /// is `topo`), copying the mesh's points and cells and the topology into
+    /// the sorter; [`Sorter::shared`] shares them instead. Invalid input
+    /// (point ids out of range, non-finite points, a topology of another
+    /// mesh) is reported by [`Sorter::order`].
     pub fn new(mesh: &Mesh, topo: &Topology) -> Sorter {
-        let n = mesh.cells.len();
-        let invalid = super::input::check_input(mesh, topo);
         let geo_mesh = Mesh {
             points: mesh.points.clone(),
             cells: mesh.cells.clone(),
             ..Default::default()
         };
+        Sorter::shared(Arc::new(geo_mesh), Arc::new(topo.clone()))
+    }
+
+    /// [`Sorter::new`] for a mesh and topology the caller shares: nothing is
+    /// copied, the sorter keeps the two `Arc`s for its lifetime (the
+    /// geometry must not change while it is in use; values may).
+    pub fn shared(mesh: Arc<Mesh>, topo: Arc<Topology>) -> Sorter {
+        let n = mesh.cells.len();
+        let invalid = super::input::check_input(&mesh, &topo);
         let (topo, geom) = if invalid.is_some() {
-            (Topology::build(&Cells::default()), Geometry::default())
+            (
+                Arc::new(Topology::build(&Cells::default())),
+                Geometry::default(),
+            )
         } else {
-            (topo.clone(), Geometry::build(mesh, topo))
+            let geom = Geometry::build(&mesh, &topo);
+            (topo, geom)
         };
         let nf = topo.face_count();
         let nt = geom.planes.len();
         Sorter {
-            mesh: geo_mesh,
+            mesh,
             pool: SplitPool::new(if invalid.is_some() { 0 } else { n }),
             invalid,
             nonconvex: NonConvex::PixelConstraints,
@@ -249,24 +270,24 @@ impl Sorter {
             } else {
                 stats.newly_split += change.newly_split;
             }
-            let mut extra = self.build_extra(view)?;
+            let mut graph = self.build_round_graph(view)?;
             stats.time_split += ts.elapsed();
             let tn = Instant::now();
-            let nc = self.add_nonconvex(&tri_pairs, &mut extra);
+            let nc = self.add_nonconvex(&tri_pairs, &mut graph);
             stats.nonconvex_constraints = nc;
             stats.time_nonconvex += tn.elapsed();
 
             let tk = Instant::now();
-            let emitted = self.kahn(&extra);
-            let total_alive = n - self.pool.active.len() + (extra.pieces - n);
+            let emitted = self.kahn(&graph);
+            let total_alive = n - self.pool.active.len() + (graph.pieces - n);
             if emitted.len() == total_alive {
-                let order = self.finish(emitted, Vec::new(), &extra, camera, policy, &mut stats);
+                let order = self.finish(emitted, Vec::new(), &graph, camera, policy, &mut stats);
                 stats.time_sort += tk.elapsed();
                 stats.time_total = t_start.elapsed();
                 return Ok(Order { stats, ..order });
             }
             // Cycles: strongly connected components of what is left.
-            let comps = self.components(&extra, &emitted);
+            let comps = self.components(&graph, &emitted);
             let cycles: Vec<&Vec<u32>> = comps.iter().filter(|c| c.len() > 1).collect();
             stats.cycles_found += cycles.len();
             let mut new_split = 0;
@@ -287,7 +308,7 @@ impl Sorter {
             }
             stats.cycle_split_cells += new_split;
             if new_split == 0 {
-                let order = self.finish(emitted, comps, &extra, camera, policy, &mut stats);
+                let order = self.finish(emitted, comps, &graph, camera, policy, &mut stats);
                 stats.time_sort += tk.elapsed();
                 stats.time_total = t_start.elapsed();
                 return Ok(Order { stats, ..order });
@@ -417,7 +438,7 @@ impl Sorter {
 
     /// Piece id of the owner of triangle `k` of face `f` on cell `c`'s side.
     #[inline]
-    fn piece_on(&self, extra: &Extra, c: u32, f: u32, k: usize) -> u32 {
+    fn piece_on(&self, graph: &RoundGraph, c: u32, f: u32, k: usize) -> u32 {
         let n = self.mesh.cells.len() as u32;
         let s = self.pool.slot_of[c as usize];
         if s == NONE {
@@ -426,22 +447,22 @@ impl Sorter {
         let sc = &self.pool.slots[s as usize];
         let side = (self.topo.face_cells[f as usize][0] != c) as usize;
         let li = self.topo.face_local[f as usize][side] as usize;
-        n + extra.base_by_slot[s as usize] + sc.owner(li, k)
+        n + graph.base_by_slot[s as usize] + sc.owner(li, k)
     }
 
     /// Tet ids, per-triangle edges next to split cells, edges inside split
     /// cells. Clears `face_target` of faces touching split cells.
-    fn build_extra(&mut self, view: View) -> Result<Extra, VisibilityError> {
+    fn build_round_graph(&mut self, view: View) -> Result<RoundGraph, VisibilityError> {
         let n = self.mesh.cells.len();
-        let mut extra = Extra::default();
+        let mut graph = RoundGraph::default();
         let mut next = 0u32;
-        extra.base_by_slot.resize(self.pool.slots.len(), 0);
+        graph.base_by_slot.resize(self.pool.slots.len(), 0);
         for (k, &c) in self.pool.active.iter().enumerate() {
-            extra.base.push(next);
-            extra.base_by_slot[self.pool.slot_of[c as usize] as usize] = next;
+            graph.base.push(next);
+            graph.base_by_slot[self.pool.slot_of[c as usize] as usize] = next;
             let sc = self.pool.get(c).map_or(0, |s| s.tets.len());
             for _ in 0..sc {
-                extra.tet_slot.push(k as u32);
+                graph.tet_slot.push(k as u32);
             }
             next = next
                 .checked_add(sc as u32)
@@ -451,7 +472,7 @@ impl Sorter {
         if pieces > (u32::MAX - 1) as usize {
             return Err(VisibilityError::TooManyPieces(pieces));
         }
-        extra.pieces = pieces;
+        graph.pieces = pieces;
         for &c in &self.pool.active {
             for &f in self.topo.faces_of(c as usize) {
                 self.face_target[f as usize] = NONE;
@@ -463,26 +484,32 @@ impl Sorter {
         let blocks: Vec<Vec<(u32, u32)>> = this
             .pool
             .active
-            .par_chunks(EXTRA_BLOCK)
+            .par_chunks(ROUND_GRAPH_BLOCK)
             .map(|block| {
                 let mut edges = Vec::new();
                 for &c in block {
-                    this.split_cell_edges(&extra, view, c, &mut edges);
+                    this.split_cell_edges(&graph, view, c, &mut edges);
                 }
                 edges
             })
             .collect();
         let edges = blocks.concat();
-        extra.to = Vec::new();
-        extra.off = Vec::new();
-        self.set_edges(&mut extra, edges);
-        Ok(extra)
+        graph.to = Vec::new();
+        graph.off = Vec::new();
+        self.set_edges(&mut graph, edges);
+        Ok(graph)
     }
 
     /// Appends the edges of split cell `c` to `edges`: per triangle of its
     /// faces shared with another cell (a face between two split cells from
     /// its first cell only), and between its own tets.
-    fn split_cell_edges(&self, extra: &Extra, view: View, c: u32, edges: &mut Vec<(u32, u32)>) {
+    fn split_cell_edges(
+        &self,
+        graph: &RoundGraph,
+        view: View,
+        c: u32,
+        edges: &mut Vec<(u32, u32)>,
+    ) {
         let n = self.mesh.cells.len();
         let p = &self.mesh.points;
         for &f in self.topo.faces_of(c as usize) {
@@ -502,8 +529,8 @@ impl Sorter {
                 if s == 0 {
                     continue;
                 }
-                let p0 = self.piece_on(extra, c0, f, k);
-                let p1 = self.piece_on(extra, c1, f, k);
+                let p0 = self.piece_on(graph, c0, f, k);
+                let p1 = self.piece_on(graph, c1, f, k);
                 // Eye on c1's side: c1's piece is drawn later.
                 if (s > 0) != flip {
                     edges.push((p0, p1));
@@ -513,7 +540,7 @@ impl Sorter {
             }
         }
         if let Some(sc) = self.pool.get(c) {
-            let b = n as u32 + extra.base_by_slot[self.pool.slot_of[c as usize] as usize];
+            let b = n as u32 + graph.base_by_slot[self.pool.slot_of[c as usize] as usize];
             for it in &sc.internal {
                 let [a, bb, cc] = it.tri.map(|v| p[v as usize]);
                 let se = view.side(a, bb, cc);
@@ -533,14 +560,14 @@ impl Sorter {
 
     /// Appends the non-convex constraints (mapped to pieces); returns their
     /// number.
-    fn add_nonconvex(&self, tri_pairs: &[(u32, u32)], extra: &mut Extra) -> usize {
+    fn add_nonconvex(&self, tri_pairs: &[(u32, u32)], graph: &mut RoundGraph) -> usize {
         if tri_pairs.is_empty() {
             return 0;
         }
         let owner = |i: u32| {
             let bt = &self.geom.boundary[i as usize];
             let c0 = self.topo.face_cells[bt.face as usize][0];
-            self.piece_on(extra, c0, bt.face, bt.k as usize)
+            self.piece_on(graph, c0, bt.face, bt.k as usize)
         };
         let mut cons: Vec<(u32, u32)> = tri_pairs
             .iter()
@@ -550,29 +577,29 @@ impl Sorter {
         cons.sort_unstable();
         cons.dedup();
         let count = cons.len();
-        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(extra.to.len() + count);
-        for v in 0..extra.pieces as u32 {
-            for &w in self.extra_out(extra, v) {
+        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(graph.to.len() + count);
+        for v in 0..graph.pieces as u32 {
+            for &w in self.graph_out(graph, v) {
                 edges.push((v, w));
             }
         }
         edges.extend(cons);
-        self.set_edges(extra, edges);
+        self.set_edges(graph, edges);
         count
     }
 
-    /// Stores `edges` as the CSR of `extra`.
-    fn set_edges(&self, extra: &mut Extra, edges: Vec<(u32, u32)>) {
+    /// Stores `edges` as the CSR of `graph`.
+    fn set_edges(&self, graph: &mut RoundGraph, edges: Vec<(u32, u32)>) {
         if edges.is_empty() {
-            extra.off.clear();
-            extra.to.clear();
+            graph.off.clear();
+            graph.to.clear();
             return;
         }
-        let mut off = vec![0u32; extra.pieces + 1];
+        let mut off = vec![0u32; graph.pieces + 1];
         for &(a, _) in &edges {
             off[a as usize + 1] += 1;
         }
-        for i in 0..extra.pieces {
+        for i in 0..graph.pieces {
             off[i + 1] += off[i];
         }
         let mut fill = off.clone();
@@ -581,22 +608,22 @@ impl Sorter {
             to[fill[a as usize] as usize] = b;
             fill[a as usize] += 1;
         }
-        extra.off = off;
-        extra.to = to;
+        graph.off = off;
+        graph.to = to;
     }
 
     #[inline]
-    fn extra_out<'a>(&self, extra: &'a Extra, v: u32) -> &'a [u32] {
-        if extra.off.is_empty() {
+    fn graph_out<'a>(&self, graph: &'a RoundGraph, v: u32) -> &'a [u32] {
+        if graph.off.is_empty() {
             return &[];
         }
-        &extra.to[extra.off[v as usize] as usize..extra.off[v as usize + 1] as usize]
+        &graph.to[graph.off[v as usize] as usize..graph.off[v as usize + 1] as usize]
     }
 
     /// Kahn's algorithm; returns the emitted piece ids (back to front).
-    fn kahn(&mut self, extra: &Extra) -> Vec<u32> {
+    fn kahn(&mut self, graph: &RoundGraph) -> Vec<u32> {
         let n = self.mesh.cells.len();
-        let pieces = extra.pieces;
+        let pieces = graph.pieces;
         self.indeg.clear();
         self.indeg.resize(pieces, 0);
         let topo = &self.topo;
@@ -616,7 +643,7 @@ impl Sorter {
             self.slot_target[slot] = t;
             self.indeg[t as usize] += 1;
         }
-        for &t in &extra.to {
+        for &t in &graph.to {
             self.indeg[t as usize] += 1;
         }
         // A stack rather than a queue: any order Kahn can emit is valid, and
@@ -652,9 +679,9 @@ impl Sorter {
                     ready.sort_unstable_by_key(|&t| std::cmp::Reverse(t.abs_diff(v)));
                 }
             }
-            if !extra.off.is_empty() {
+            if !graph.off.is_empty() {
                 for &w in
-                    &extra.to[extra.off[v as usize] as usize..extra.off[v as usize + 1] as usize]
+                    &graph.to[graph.off[v as usize] as usize..graph.off[v as usize + 1] as usize]
                 {
                     let d = &mut self.indeg[w as usize];
                     *d -= 1;
@@ -668,9 +695,9 @@ impl Sorter {
     }
 
     /// Strongly connected components of the pieces Kahn left (sinks first).
-    fn components(&self, extra: &Extra, emitted: &[u32]) -> Vec<Vec<u32>> {
+    fn components(&self, graph: &RoundGraph, emitted: &[u32]) -> Vec<Vec<u32>> {
         let n = self.mesh.cells.len();
-        let mut done = vec![false; extra.pieces];
+        let mut done = vec![false; graph.pieces];
         for &v in emitted {
             done[v as usize] = true;
         }
@@ -678,7 +705,7 @@ impl Sorter {
             done[c as usize] = true;
         }
         tarjan(
-            extra.pieces,
+            graph.pieces,
             |v| !done[v as usize],
             |v, out| {
                 if (v as usize) < n {
@@ -689,214 +716,11 @@ impl Sorter {
                         }
                     }
                 }
-                out.extend_from_slice(self.extra_out(extra, v));
+                out.extend_from_slice(self.graph_out(graph, v));
             },
         )
     }
-
-    /// Converts ids to pieces (tets holding breakpoints become their slabs,
-    /// back to front); appends the leftover components (topological order,
-    /// cycles as groups).
-    fn finish(
-        &self,
-        emitted: Vec<u32>,
-        comps: Vec<Vec<u32>>,
-        extra: &Extra,
-        camera: &Camera,
-        policy: &SplitPolicy,
-        stats: &mut OrderStats,
-    ) -> Order {
-        let mut levels: Vec<f64> = match policy.point_scalars {
-            Some(_) => policy
-                .breakpoints
-                .iter()
-                .copied()
-                .filter(|b| b.is_finite())
-                .collect(),
-            None => Vec::new(),
-        };
-        levels.sort_by(f64::total_cmp);
-        levels.dedup();
-        let emit = |capacity: usize| Emit {
-            pieces: Vec::with_capacity(capacity),
-            levels: &levels,
-            scalars: policy.point_scalars,
-            points: &self.mesh.points,
-            camera,
-            sliced: 0,
-            bands: Vec::new(),
-            keyed: Vec::new(),
-        };
-        // The emitted pieces in blocks on the thread pool (slicing a tet
-        // into its ordered slabs is most of the work), joined in order.
-        let blocks: Vec<Emit> = emitted
-            .par_chunks(FINISH_BLOCK)
-            .map(|block| {
-                let mut out = emit(block.len() + block.len() / 2);
-                for &v in block {
-                    out.push(self.piece(extra, v));
-                }
-                out
-            })
-            .collect();
-        let mut out = emit(blocks.iter().map(|b| b.pieces.len()).sum::<usize>() + comps.len());
-        for b in blocks {
-            out.pieces.extend_from_slice(&b.pieces);
-            out.sliced += b.sliced;
-        }
-        let view = if camera.ortho {
-            View::Dir(camera.forward)
-        } else {
-            View::Eye(camera.position)
-        };
-        let mut fragments = Vec::new();
-        let mut groups = Vec::new();
-        for comp in comps.into_iter().rev() {
-            if comp.len() == 1 {
-                out.push(self.piece(extra, comp[0]));
-                continue;
-            }
-            let start = out.pieces.len();
-            let mut members: Vec<(f64, Piece)> = comp
-                .iter()
-                .map(|&v| {
-                    let pc = self.piece(extra, v);
-                    (self.depth(&pc, camera), pc)
-                })
-                .collect();
-            members.sort_by(|a, b| b.0.total_cmp(&a.0));
-            let members: Vec<Piece> = members.into_iter().map(|m| m.1).collect();
-            if self.plane_split {
-                if let Some(frags) = bsp::order_group(&members, &self.mesh.points, &view) {
-                    stats.cycles_resolved_by_planes += 1;
-                    stats.fragments += frags.len();
-                    for (src, frag) in frags {
-                        let Piece::Tet { cell, tet } = members[src] else {
-                            continue;
-                        };
-                        out.pieces.push(Piece::Frag {
-                            cell,
-                            tet,
-                            frag: fragments.len() as u32,
-                        });
-                        fragments.push(frag);
-                    }
-                    continue;
-                }
-            }
-            for m in members {
-                out.push(m);
-            }
-            groups.push(start..out.pieces.len());
-        }
-        let pieces = out.pieces;
-        stats.cycle_groups = groups.len();
-        stats.pieces_in_groups = groups.iter().map(|g| g.len()).sum();
-        stats.pieces = pieces.len();
-        stats.split_cells = self.pool.active.len();
-        stats.tets = extra.pieces - self.mesh.cells.len();
-        stats.sliced_tets = out.sliced;
-        stats.slabs = pieces
-            .iter()
-            .filter(|p| matches!(p, Piece::Slab { .. }))
-            .count();
-        Order {
-            pieces,
-            fragments,
-            levels,
-            groups,
-            stats: OrderStats::default(),
-        }
-    }
-
-    fn piece(&self, extra: &Extra, v: u32) -> Piece {
-        let n = self.mesh.cells.len() as u32;
-        if v < n {
-            return Piece::Cell(v);
-        }
-        let k = (v - n) as usize;
-        let slot = extra.tet_slot[k] as usize;
-        let c = self.pool.active[slot];
-        let local = k - extra.base[slot] as usize;
-        match self.pool.get(c).and_then(|s| s.tets.get(local)) {
-            Some(&tet) => Piece::Tet { cell: c, tet },
-            None => Piece::Cell(c),
-        }
-    }
-
-    /// Depth of a piece's vertex centroid (for ordering inside groups).
-    fn depth(&self, piece: &Piece, camera: &Camera) -> f64 {
-        let p = &self.mesh.points;
-        let (sum, cnt) = match piece {
-            Piece::Cell(c) => {
-                let nodes = self.mesh.cells.nodes(*c as usize);
-                (
-                    nodes.iter().map(|&v| p[v as usize]).sum::<DVec3>(),
-                    nodes.len(),
-                )
-            }
-            Piece::Tet { tet, .. } | Piece::Slab { tet, .. } | Piece::Frag { tet, .. } => {
-                (tet.iter().map(|&v| p[v as usize]).sum::<DVec3>(), 4)
-            }
-        };
-        let centre = sum / cnt.max(1) as f64;
-        if camera.ortho {
-            (centre - camera.position).dot(camera.forward)
-        } else {
-            (centre - camera.position).length()
-        }
-    }
 }
 
-/// Emitted pieces per block of [`Sorter::finish`]'s parallel pass.
-const FINISH_BLOCK: usize = 1 << 14;
-
-/// Split cells per block of [`Sorter::build_extra`]'s parallel pass.
-const EXTRA_BLOCK: usize = 1 << 12;
-
-/// Appends pieces to an order, a tet holding breakpoints as its slabs.
-struct Emit<'a> {
-    pieces: Vec<Piece>,
-    levels: &'a [f64],
-    scalars: Option<&'a [f64]>,
-    points: &'a [DVec3],
-    camera: &'a Camera,
-    sliced: usize,
-    /// Scratch for the bands of one tet and their order.
-    bands: Vec<(f64, f64)>,
-    keyed: Vec<(f64, usize)>,
-}
-
-impl Emit<'_> {
-    fn push(&mut self, piece: Piece) {
-        let (Piece::Tet { cell, tet }, Some(sc)) = (piece, self.scalars) else {
-            self.pieces.push(piece);
-            return;
-        };
-        let s = tet.map(|v| sc.get(v as usize).copied().unwrap_or(0.0));
-        let inner = slabs::inner_levels(&s, self.levels);
-        if inner.is_empty() {
-            self.pieces.push(piece);
-            return;
-        }
-        self.sliced += 1;
-        slabs::bands_into(&self.levels[inner.clone()], &mut self.bands);
-        let view = tet.map(|v| self.camera.to_view(self.points[v as usize]));
-        slabs::slab_order_into(&view, &s, &self.bands, self.camera.ortho, &mut self.keyed);
-        let last = self.bands.len() - 1;
-        for &(_, i) in &self.keyed {
-            // Band i lies between inner levels i - 1 and i.
-            let lo = if i == 0 {
-                NO_LEVEL
-            } else {
-                (inner.start + i - 1) as u32
-            };
-            let hi = if i == last {
-                NO_LEVEL
-            } else {
-                (inner.start + i) as u32
-            };
-            self.pieces.push(Piece::Slab { cell, tet, lo, hi });
-        }
-    }
-}
+/// Split cells per block of [`Sorter::build_round_graph`]'s parallel pass.
+const ROUND_GRAPH_BLOCK: usize = 1 << 12;

@@ -17,11 +17,12 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use super::exact::{line_plane_t, ray_triangle, RayHit};
+use super::geometry::line_plane_t;
 use super::{Order, Piece};
 use crate::camera::Camera;
 use crate::mesh::tetra::triangulate_face;
 use crate::mesh::Mesh;
+use crate::numeric::predicates::{ray_triangle, RayHit};
 use crate::numeric::tolerance::VALIDATE_OVERLAP_REL;
 
 /// Two pieces drawn in the wrong order along one pixel ray.

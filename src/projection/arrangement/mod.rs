@@ -26,22 +26,26 @@
 //! rounded pixel positions classify their triangles front or back by
 //! rounding noise, so front edges may cross front edges. Their order is
 //! decided exactly too, by the side of the third crossing (a degree-4
-//! polynomial evaluated with exact expansions, `exact`), with a symbolic
+//! polynomial evaluated with exact expansions,
+//! [`crossing_side_times_turn`]), with a symbolic
 //! perturbation when the three lines meet in one point. Crossing positions
 //! are never used for a decision: those of nearly parallel pieces may be
 //! far from the exact point (they are clamped to both bounding boxes).
 
 use glam::DVec2;
 
-use super::exact;
-use super::subdivision::{Subdivision, TopologyError, NIL};
-use crate::numeric::predicates::{orient2d, Side};
+mod faces;
+
+pub use faces::is_outer;
+
+use super::subdivision::{Subdivision, NIL};
+use crate::numeric::predicates::{crossing_side_times_turn, orient2d, Side};
 
 /// A segment between two original points, with the triangles on its sides:
 /// `side = [front_left, front_right, back_left, back_right]` (triangle ids or
 /// `NIL`), left and right of the direction `a -> b`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Piece {
+pub struct Segment {
     pub a: u32,
     pub b: u32,
     pub side: [u32; 4],
@@ -66,8 +70,8 @@ pub struct Arrangement {
     /// for original points).
     pub cross: Vec<[u32; 2]>,
     /// The prepared pieces.
-    pub pieces: Vec<Piece>,
-    /// Piece of every edge (`h >> 1`); the even half-edge runs `a -> b`.
+    pub pieces: Vec<Segment>,
+    /// Segment of every edge (`h >> 1`); the even half-edge runs `a -> b`.
     pub edge_piece: Vec<u32>,
     chains: Vec<Vec<ChainEntry>>,
     /// Cyclic angular rank (counter-clockwise) of each piece's direction at
@@ -104,7 +108,7 @@ impl Arrangement {
     /// Clears the arrangement and prepares `segments` over `points` (see
     /// module docs). Segments are `(a, b, side)` with `a != b`; `points`
     /// become subdivision vertices `0..points.len()`.
-    pub fn prepare(&mut self, points: &[DVec2], segments: &[Piece]) {
+    pub fn prepare(&mut self, points: &[DVec2], segments: &[Segment]) {
         self.sub.clear();
         self.pos.clear();
         self.cross.clear();
@@ -156,7 +160,7 @@ impl Arrangement {
             let mut prev = s.a;
             for i in 0..=on.len() {
                 let next = if i < on.len() { on[i] } else { s.b };
-                self.add_piece(Piece {
+                self.add_piece(Segment {
                     a: prev,
                     b: next,
                     side: s.side,
@@ -231,12 +235,12 @@ impl Arrangement {
         self.hrank[h as usize] = r;
     }
 
-    fn add_piece(&mut self, p: Piece) {
+    fn add_piece(&mut self, p: Segment) {
         // Canonical direction a < b (flip sides accordingly), then merge.
         let p = if p.a < p.b {
             p
         } else {
-            Piece {
+            Segment {
                 a: p.b,
                 b: p.a,
                 side: [p.side[1], p.side[0], p.side[3], p.side[2]],
@@ -269,7 +273,7 @@ impl Arrangement {
     }
 
     /// Whether pieces `p` and `q` cross properly (exact).
-    fn crosses(&self, p: Piece, q: Piece) -> bool {
+    fn crosses(&self, p: Segment, q: Segment) -> bool {
         if p.a == q.a || p.a == q.b || p.b == q.a || p.b == q.b {
             return false;
         }
@@ -345,7 +349,7 @@ impl Arrangement {
     /// `q_i`: then `X1` comes first iff `sigma cross(u1, u2) > 0`. As
     /// `u1 x u2 = s1 s2 (e1 x e2)`, this is the sign of
     /// `sigma (e1 x e2) s1 s2`, and `sigma (e1 x e2)` is one exact polynomial
-    /// ([`exact::crossing_side_times_turn`]).
+    /// ([`crossing_side_times_turn`]).
     ///
     /// When the three lines meet in one point, the piece `r` with the largest
     /// id among the three is taken as translated by an infinitesimal amount
@@ -364,7 +368,7 @@ impl Arrangement {
             Side::Negative => -1,
             Side::On => 0,
         };
-        let mut st = sign(exact::crossing_side_times_turn(sp, s1, s2));
+        let mut st = sign(crossing_side_times_turn(sp, s1, s2));
         if st == 0 {
             // Y on the line of p exactly: perturb the largest id.
             // turn = sign(e1 x e2) = side of q2.b from q1 (q2 straddles q1).
@@ -389,7 +393,7 @@ impl Arrangement {
 
     /// The side of the line of `l` on which all of `m` lies (endpoints on the
     /// line allowed, not both), or `None`.
-    fn one_side(&self, l: Piece, m: Piece) -> Option<Side> {
+    fn one_side(&self, l: Segment, m: Segment) -> Option<Side> {
         let (l0, l1) = (self.pt(l.a), self.pt(l.b));
         let (s1, s2) = (
             orient2d(l0, l1, self.pt(m.a)),
@@ -420,7 +424,7 @@ impl Arrangement {
     fn cross_sign(&self, u: u32, d1: (u32, bool), d2: (u32, bool)) -> Side {
         let (p1, p2) = (self.pieces[d1.0 as usize], self.pieces[d2.0 as usize]);
         if (u as usize) < self.n_points {
-            let far = |p: Piece| if p.a == u { p.b } else { p.a };
+            let far = |p: Segment| if p.a == u { p.b } else { p.a };
             orient2d(self.pt(u), self.pt(far(p1)), self.pt(far(p2)))
         } else {
             // Crossing of exactly two pieces: cross(forward p1, forward p2)
@@ -556,126 +560,6 @@ impl Arrangement {
         self.edge_piece[e] = p;
     }
 
-    /// Checks the topology ([`Subdivision::sanity_check`]) and, once every
-    /// piece is in, the geometry: a single outer boundary (one connected
-    /// component), and bounded faces whose areas sum to the area inside it
-    /// (they partition the silhouette).
-    pub fn sanity_check(&self) -> Result<(), TopologyError> {
-        self.sub.sanity_check()?;
-        if !self.done() || self.sub.half_edge_count() == 0 {
-            return Ok(());
-        }
-        let mut mark = Vec::new();
-        let mut areas = Vec::new();
-        self.sub
-            .trace_faces(&mut mark, |h0| areas.push((h0, self.cycle_area(h0))));
-        let outer = self.outer_cycle(&mut mark);
-        let amin = areas.iter().fold(0.0, |m: f64, c| m.min(c.1));
-        let a_outer = areas
-            .iter()
-            .find(|c| outer[c.0 as usize])
-            .map_or(0.0, |c| c.1);
-        // The exact outer cycle, plus any other cycle of clearly negative
-        // area (a second component).
-        let n_outer = 1 + areas
-            .iter()
-            .filter(|c| !outer[c.0 as usize] && is_outer(c.1, amin))
-            .count();
-        let inside: f64 = areas
-            .iter()
-            .filter(|c| !outer[c.0 as usize])
-            .map(|c| c.1)
-            .sum();
-        if n_outer != 1 || a_outer >= 0.0 {
-            return Err(TopologyError::Geometry("not exactly one outer boundary"));
-        }
-        if (inside + a_outer).abs() > 1e-9 * -a_outer {
-            return Err(TopologyError::Geometry(
-                "regions do not partition the silhouette",
-            ));
-        }
-        Ok(())
-    }
-
-    /// The outgoing half-edge of the lexicographically lowest original point
-    /// (smallest `x`, then `y`) that has edges, with the unbounded face on
-    /// its left (`NIL` without edges). Exact: every crossing lies strictly
-    /// inside a piece, so lexicographically above that piece's lower end,
-    /// and the lowest vertex `v` of the arrangement is an original point.
-    /// All its edges leave it at angles in `(-pi/2, pi/2]`; the ray from `v`
-    /// towards `-x` meets nothing, so the gap `(pi/2, 3 pi/2)` belongs to the
-    /// unbounded face, which lies on the left of the most counter-clockwise
-    /// edge (exact angular ranks, as for insertion).
-    pub fn outer_half_edge(&self) -> u32 {
-        let mut low = NIL;
-        for v in 0..self.n_points as u32 {
-            if self.sub.vertex_edge(v) == NIL {
-                continue;
-            }
-            let p = self.pt(v);
-            if low == NIL || {
-                let q = self.pt(low);
-                p.x < q.x || (p.x == q.x && p.y < q.y)
-            } {
-                low = v;
-            }
-        }
-        if low == NIL {
-            return NIL;
-        }
-        let key = |h: u32| {
-            let piece = self.edge_piece[(h >> 1) as usize];
-            let d = self.dir_vec((piece, h & 1 == 0));
-            (half_of(d) == 0, self.hrank[h as usize])
-        };
-        let h0 = self.sub.vertex_edge(low);
-        let (mut best, mut h, mut guard) = (h0, self.sub.cw_next(h0), 0);
-        while h != h0 && guard <= self.sub.half_edge_count() {
-            if key(h) > key(best) {
-                best = h;
-            }
-            h = self.sub.cw_next(h);
-            guard += 1;
-        }
-        best
-    }
-
-    /// Flags (one per half-edge, in `mark`) of the unbounded face's cycle
-    /// ([`Self::outer_half_edge`]).
-    pub fn outer_cycle<'m>(&self, mark: &'m mut Vec<bool>) -> &'m [bool] {
-        mark.clear();
-        mark.resize(self.sub.half_edge_count(), false);
-        let h0 = self.outer_half_edge();
-        if h0 != NIL {
-            let mut h = h0;
-            while !mark[h as usize] {
-                mark[h as usize] = true;
-                h = self.sub.next(h);
-            }
-        }
-        mark
-    }
-
-    /// Twice the signed area of the face cycle through `h0`, from positions
-    /// relative to its first vertex: its rounding error scales with the
-    /// face's size, not with the pixel coordinates (a piece a fraction of a
-    /// pixel wide far from the image origin would otherwise give its slivers
-    /// areas of rounding noise larger than `is_outer`'s threshold).
-    pub fn cycle_area(&self, h0: u32) -> f64 {
-        let o = self.pt(self.sub.origin(h0));
-        let mut a = 0.0;
-        let mut h = h0;
-        let mut k = 0;
-        loop {
-            a += (self.pt(self.sub.origin(h)) - o).perp_dot(self.pt(self.sub.dest(h)) - o);
-            h = self.sub.next(h);
-            k += 1;
-            if h == h0 || k > self.sub.half_edge_count() {
-                return a;
-            }
-        }
-    }
-
     fn other_piece(&self, v: u32, p: u32) -> u32 {
         let c = self.cross[v as usize];
         if c[0] == p {
@@ -702,16 +586,6 @@ pub(super) fn segment_crossing(p0: DVec2, p1: DVec2, q0: DVec2, q1: DVec2) -> DV
     let lo = p0.min(p1).max(q0.min(q1));
     let hi = p0.max(p1).min(q0.max(q1));
     x.max(lo).min(hi)
-}
-
-/// Whether a face cycle of (twice the) signed area `a` is clearly an outer
-/// boundary, given the most negative cycle area `amin`: bounded faces have
-/// positive area, except slivers whose rounded crossing points make their
-/// computed area zero or slightly negative; those are tiny next to the outer
-/// cycle. Only a fallback for a second component: the outer cycle itself is
-/// found exactly ([`Arrangement::outer_half_edge`]).
-pub fn is_outer(a: f64, amin: f64) -> bool {
-    a < 0.0 && -a > 1e-9 * -amin
 }
 
 #[cfg(test)]
@@ -760,8 +634,8 @@ mod tests {
             pts[perm[2 * i] as usize] = s[0];
             pts[perm[2 * i + 1] as usize] = s[1];
         }
-        let pieces: Vec<Piece> = (0..segs.len())
-            .map(|i| Piece {
+        let pieces: Vec<Segment> = (0..segs.len())
+            .map(|i| Segment {
                 a: perm[2 * i],
                 b: perm[2 * i + 1],
                 side: [NIL; 4],
@@ -838,9 +712,9 @@ mod tests {
             v(32.00060639978205, 24.00000744201851),
             v(32.04840129791201, 23.98343747846012),
         ];
-        let pieces: Vec<Piece> = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]
+        let pieces: Vec<Segment> = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]
             .iter()
-            .map(|&(a, b)| Piece {
+            .map(|&(a, b)| Segment {
                 a,
                 b,
                 side: [NIL; 4],
@@ -876,7 +750,7 @@ mod tests {
         for n in [3, 4] {
             for perm in perms(2 * n, 60) {
                 let tied = crossing_orders(&segs[..n], &perm);
-                // Piece ids follow segment order here (prepare keeps it):
+                // Segment ids follow segment order here (prepare keeps it):
                 // shift segment i left by 2^-(40 - 10 i).
                 let shifted: Vec<[DVec2; 2]> = segs[..n]
                     .iter()
