@@ -8,8 +8,8 @@
 //!   used by cycle groups, which integrate breakpoints exactly along rays;
 //! - [`PieceSource::parts`]: the parts a projected-cell mode draws, in
 //!   back-to-front order: the piece itself, or for a fragment holding
-//!   breakpoints its slabs (bands back to front along the tet's gradient,
-//!   [`slab_order`]). Pieces whose scalar range maps to zero extinction
+//!   breakpoints its slabs (back to front along the tet's gradient,
+//!   [`tet_slabs`], the slab expansion the order uses too). Pieces whose scalar range maps to zero extinction
 //!   everywhere are left out ([`PieceSource::invisible`]): they neither emit
 //!   nor absorb in the glow model. The tet of consecutive slabs is built
 //!   once ([`PartScratch`]).
@@ -22,8 +22,8 @@ use crate::projection::coverage::PixelGrid;
 use crate::projection::{ClipValue, Clipper, Polyhedron, ProjectionError};
 use crate::tf::TransferFunction;
 use crate::visibility::bsp::Fragment;
-use crate::visibility::slabs::{bands as slab_bands, inner_levels, slab_order};
-use crate::visibility::{Piece, NO_LEVEL};
+use crate::visibility::slabs::{band_values, tet_slabs, SlabScratch};
+use crate::visibility::Piece;
 
 use super::scene::ScalarsRef;
 
@@ -79,6 +79,7 @@ pub struct PartScratch {
     /// `whole` and reset this).
     whole_of: Option<(u32, [u32; 4])>,
     clipper: Clipper,
+    slabs: SlabScratch,
 }
 
 /// What [`PieceSource::parts`] did with a piece.
@@ -145,6 +146,7 @@ impl PieceSource<'_> {
             whole,
             whole_of,
             clipper,
+            slabs,
         } = scratch;
         match *piece {
             Piece::Cell(c) => {
@@ -177,16 +179,22 @@ impl PieceSource<'_> {
                     done.invisible = true;
                     return Ok(done);
                 }
-                // Breakpoints inside: the fragment's bands, back to front
-                // along the tet's gradient.
-                let bands = slab_bands(&self.levels[inner_levels(&whole.scalars, self.levels)]);
+                // Breakpoints inside: the fragment's slabs, back to front
+                // along the tet's gradient (the one slab expansion).
                 let (p, s) = self.tet_view(cell, tet);
-                for i in slab_order(&p, &s, &bands, self.camera.ortho) {
-                    let (blo, bhi) = bands[i];
-                    if bands.len() == 1 {
-                        draw(whole)?;
-                        continue;
-                    }
+                let order = tet_slabs(
+                    &whole.scalars,
+                    &s,
+                    || p,
+                    self.levels,
+                    self.camera.ortho,
+                    slabs,
+                );
+                if order.is_empty() {
+                    draw(whole)?;
+                }
+                for &(lo, hi) in order {
+                    let (blo, bhi) = band_values(self.levels, lo, hi);
                     if clipper
                         .clip(whole, ClipValue::Scalar, blo, bhi, poly)
                         .map_err(Self::projection(cell))?
@@ -283,14 +291,7 @@ impl PieceSource<'_> {
 
     /// The scalar bounds of a slab ([`Piece::Slab`]).
     fn band(&self, lo: u32, hi: u32) -> (f64, f64) {
-        let level = |k: u32, open: f64| {
-            if k == NO_LEVEL {
-                open
-            } else {
-                self.levels.get(k as usize).copied().unwrap_or(open)
-            }
-        };
-        (level(lo, f64::NEG_INFINITY), level(hi, f64::INFINITY))
+        band_values(self.levels, lo, hi)
     }
 
     /// Whether extinction is zero over the whole scalar interval.
