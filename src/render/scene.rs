@@ -22,6 +22,7 @@
 //!   bounds diagonal / 10, glow).
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use crate::field::{self, Association, FieldSpec, ScalarField};
 use crate::mesh::ghost::remove_ghost_cells;
@@ -62,8 +63,8 @@ pub enum ScalarsRef<'a> {
 /// Everything a render needs that does not depend on the view.
 #[derive(Debug)]
 pub struct Scene {
-    pub mesh: Mesh,
-    pub topology: Topology,
+    pub mesh: Arc<Mesh>,
+    pub topology: Arc<Topology>,
     /// The field integrated (`None`: constant scalar 0).
     pub field: Option<ScalarField>,
     /// Scalar range the TF was mapped onto.
@@ -139,8 +140,8 @@ impl Scene {
         };
         let unit_distance = tf.unit_distance.unwrap_or(default_unit);
         Ok(Scene {
-            mesh,
-            topology,
+            mesh: Arc::new(mesh),
+            topology: Arc::new(topology),
             field,
             range,
             tf,
