@@ -396,6 +396,7 @@ fn check_channel<const N: usize>(what: &'static str, p: Channel<N>) -> Result<()
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrate::RayMaterial;
 
     fn n(s: f64, tau: f64, c: f64) -> Node {
         Node {
