@@ -668,7 +668,8 @@ impl CellRay<'_> {
             self.edge(k[1], k[2]),
             self.edge(k[2], k[0]),
         ];
-        let x = RayFrame::crossing(e, k.map(|i| self.proj[i].2.z))?;
+        let [p0, p1, p2] = k.map(|i| &self.proj[i].2);
+        let x = self.frame.crossing(e, [p0, p1, p2])?;
         let nodes = self.nodes;
         let s = match self.scalars {
             Scalars::Point(v) => {

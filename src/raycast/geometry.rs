@@ -36,7 +36,7 @@ use glam::DVec3;
 
 use crate::camera::Ray;
 use crate::numeric::predicates::{orient3d, Side};
-use crate::numeric::tolerance::PLUCKER_FILTER_K;
+use crate::numeric::tolerance::{EDGE_ON_CROSSING_K, PLUCKER_FILTER_K};
 
 /// A vertex in a ray's frame.
 #[derive(Clone, Copy, Debug, Default)]
@@ -50,22 +50,18 @@ pub struct Proj {
 }
 
 /// The orthonormal `u, v` (`u x v = d`) of a ray's frame, which are also
-/// the directions of the symbolic perturbation. With [`USE_IMAGE_BASIS`],
-/// `u` is the image's right direction made orthogonal to the ray
+/// the directions of the symbolic perturbation. For a pixel ray `u` is the
+/// image's right direction made orthogonal to the ray
 /// ([`Ray::right`]), so `v = d x u` is the image's down direction, and
 /// moving the origin by `e u + e^2 v` moves the point where the ray meets
 /// any surface by a positive multiple of it on the image: a pixel centre on
 /// a projected edge belongs to the triangle on its right, or below it for
 /// a horizontal edge — the rasteriser's top-left rule (`gpu::cpu`).
-/// Otherwise (and for a ray with no image direction) the basis is fixed by
-/// the ray's direction alone.
+/// For a ray with no image direction the basis is fixed by the ray's
+/// direction alone.
 pub fn tie_basis(ray: &Ray) -> (DVec3, DVec3) {
     let d = ray.dir;
-    let r = if USE_IMAGE_BASIS {
-        ray.right - d * ray.right.dot(d)
-    } else {
-        DVec3::ZERO
-    };
+    let r = ray.right - d * ray.right.dot(d);
     let u = if r.length_squared() > 1e-12 {
         r.normalize()
     } else {
@@ -74,13 +70,6 @@ pub fn tie_basis(ray: &Ray) -> (DVec3, DVec3) {
     };
     (u, d.cross(u))
 }
-
-/// Whether ties follow the image (right, then down: the rasteriser's
-/// top-left rule). Off: with it, the walk's images of one cube cut into 5
-/// and into 6 tets differed by 5.9e-3 on a pixel whose ray runs along a
-/// face (`tests/raycast_walk.rs`), a case of the walk's tie handling not
-/// yet found; the fixed basis keeps them identical.
-const USE_IMAGE_BASIS: bool = false;
 
 /// One ray with its frame and symbolic perturbation.
 #[derive(Clone, Copy, Debug)]
@@ -203,9 +192,12 @@ impl RayFrame {
     }
 
     /// Crossing of the triangle with the given edge values
-    /// (`e_ab`, `e_bc`, `e_ca`) and vertex depths, if the ray crosses it.
+    /// (`e_ab`, `e_bc`, `e_ca`) and projected vertices, if the ray crosses
+    /// it. The weights are the edge values (opposite edges) unless the
+    /// triangle is seen edge-on ([`EDGE_ON_CROSSING_K`]): then the crossing
+    /// is the middle of the ray's overlap with it ([`edge_on_weights`]).
     #[inline]
-    pub fn crossing(e: [f64; 3], z: [f64; 3]) -> Option<Crossing> {
+    pub fn crossing(&self, e: [f64; 3], p: [&Proj; 3]) -> Option<Crossing> {
         let [eab, ebc, eca] = e;
         let sign = if eab > 0.0 && ebc > 0.0 && eca > 0.0 {
             1
@@ -217,13 +209,69 @@ impl RayFrame {
         // Weight of a vertex is the value of the opposite edge.
         let (wa, wb, wc) = (ebc.abs(), eca.abs(), eab.abs());
         let sum = wa + wb + wc;
-        let w = if sum > 0.0 && sum.is_finite() {
+        let [na, nb, nc] = p.map(|q| q.n2.sqrt());
+        let err = self.bound2.sqrt() * (na * nb + nb * nc + nc * na);
+        let w = if sum > EDGE_ON_CROSSING_K * err && sum.is_finite() {
             [wa / sum, wb / sum, wc / sum]
         } else {
-            [1.0 / 3.0; 3]
+            edge_on_weights(p)
         };
-        let t = w[0] * z[0] + w[1] * z[1] + w[2] * z[2];
+        let t = w[0] * p[0].z + w[1] * p[1].z + w[2] * p[2].z;
         Some(Crossing { t, w, sign })
+    }
+}
+
+/// Weights of the crossing of a triangle the ray sees edge-on: the middle
+/// of the segment of triangle points straight across from the ray (in the
+/// plane through the ray and the triangle's normal, coordinate `m` across
+/// the ray in the triangle's plane), in depth. The ray is within rounding
+/// of the triangle's plane all along that segment, so each of its points is
+/// a faithful crossing; the middle keeps the crossing strictly inside the
+/// part of the ray the triangle's cells share, so the crossings before and
+/// after it (through the cells' other faces) stay in order. A degenerate
+/// triangle (zero normal) gives the middle of its depth range; a segment
+/// missed by rounding, the vertex closest to the ray.
+fn edge_on_weights(p: [&Proj; 3]) -> [f64; 3] {
+    let [a, b, c] = p;
+    let nx = (b.y - a.y) * (c.z - a.z) - (b.z - a.z) * (c.y - a.y);
+    let ny = (b.z - a.z) * (c.x - a.x) - (b.x - a.x) * (c.z - a.z);
+    let m = p.map(|q| ny * q.x - nx * q.y);
+    // End points of the segment: (depth, weights).
+    let mut lo: Option<(f64, [f64; 3])> = None;
+    let mut hi: Option<(f64, [f64; 3])> = None;
+    let mut add = |w: [f64; 3]| {
+        let t = w[0] * a.z + w[1] * b.z + w[2] * c.z;
+        if lo.is_none_or(|l| t < l.0) {
+            lo = Some((t, w));
+        }
+        if hi.is_none_or(|h| t > h.0) {
+            hi = Some((t, w));
+        }
+    };
+    for i in 0..3 {
+        let j = (i + 1) % 3;
+        if m[i] == 0.0 {
+            let mut w = [0.0; 3];
+            w[i] = 1.0;
+            add(w);
+        } else if (m[i] > 0.0) != (m[j] > 0.0) && m[j] != 0.0 {
+            let s = m[i] / (m[i] - m[j]);
+            let mut w = [0.0; 3];
+            w[i] = 1.0 - s;
+            w[j] = s;
+            add(w);
+        }
+    }
+    match (lo, hi) {
+        (Some((_, l)), Some((_, h))) => [0, 1, 2].map(|k| 0.5 * (l[k] + h[k])),
+        _ => {
+            let k = (0..3)
+                .min_by(|&i, &j| m[i].abs().total_cmp(&m[j].abs()))
+                .unwrap_or(0);
+            let mut w = [0.0; 3];
+            w[k] = 1.0;
+            w
+        }
     }
 }
 
@@ -242,7 +290,7 @@ mod tests {
             f.edge(ids[1], p[1], &pr[1], ids[2], p[2], &pr[2]),
             f.edge(ids[2], p[2], &pr[2], ids[0], p[0], &pr[0]),
         ];
-        RayFrame::crossing(e, pr.map(|x| x.z))
+        f.crossing(e, [&pr[0], &pr[1], &pr[2]])
     }
 
     #[test]

@@ -254,7 +254,7 @@ impl<'a> WalkMesh<'a> {
                     frame.edge(i1, p[1], &pr[1], i2, p[2], &pr[2]),
                     frame.edge(i2, p[2], &pr[2], i0, p[0], &pr[0]),
                 ];
-                if let Some(c) = RayFrame::crossing(e, pr.map(|x| x.z)) {
+                if let Some(c) = frame.crossing(e, [&pr[0], &pr[1], &pr[2]]) {
                     if c.sign * b.outward < 0 && c.t >= t0 {
                         entries.push((c.t, i, c.w));
                     }
@@ -311,7 +311,7 @@ impl<'a> WalkMesh<'a> {
                 edge(tri[2], tri[0]),
             ];
             let [a, b, cc] = tri.map(|k| &proj[k]);
-            let Some(x) = RayFrame::crossing(e, [a.2.z, b.2.z, cc.2.z]) else {
+            let Some(x) = frame.crossing(e, [&a.2, &b.2, &cc.2]) else {
                 return;
             };
             let better = match &best {
