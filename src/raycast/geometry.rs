@@ -92,6 +92,19 @@ pub struct Crossing {
     pub w: [f64; 3],
     /// +1 when the ray goes along the triangle's right-hand normal.
     pub sign: i8,
+    /// The vertices in an order fixed by their coordinates: sums over the
+    /// vertices (the depth, an interpolated scalar) taken in this order
+    /// give the same bits whatever winding the triangle was read in.
+    pub order: [usize; 3],
+}
+
+impl Crossing {
+    /// `sum w_i v_i` over the vertices, in [`Crossing::order`].
+    #[inline]
+    pub fn interpolate(&self, v: [f64; 3]) -> f64 {
+        let [a, b, c] = self.order;
+        self.w[a] * v[a] + self.w[b] * v[b] + self.w[c] * v[c]
+    }
 }
 
 impl RayFrame {
@@ -193,9 +206,9 @@ impl RayFrame {
 
     /// Crossing of the triangle with the given edge values
     /// (`e_ab`, `e_bc`, `e_ca`) and projected vertices, if the ray crosses
-    /// it. The weights are the edge values (opposite edges) unless the
-    /// triangle is seen edge-on ([`EDGE_ON_CROSSING_K`]): then the crossing
-    /// is the middle of the ray's overlap with it ([`edge_on_weights`]).
+    /// it. The weights are the edge values (opposite edges); where these
+    /// may be noise (the triangle seen edge-on, [`EDGE_ON_CROSSING_K`]) the
+    /// crossing is kept on the triangle's [`chord`] across from the ray.
     #[inline]
     pub fn crossing(&self, e: [f64; 3], p: [&Proj; 3]) -> Option<Crossing> {
         let [eab, ebc, eca] = e;
@@ -206,73 +219,105 @@ impl RayFrame {
         } else {
             return None;
         };
-        // Weight of a vertex is the value of the opposite edge.
-        let (wa, wb, wc) = (ebc.abs(), eca.abs(), eab.abs());
-        let sum = wa + wb + wc;
-        let [na, nb, nc] = p.map(|q| q.n2.sqrt());
-        let err = self.bound2.sqrt() * (na * nb + nb * nc + nc * na);
-        let w = if sum > EDGE_ON_CROSSING_K * err && sum.is_finite() {
-            [wa / sum, wb / sum, wc / sum]
-        } else {
-            edge_on_weights(p)
-        };
-        let t = w[0] * p[0].z + w[1] * p[1].z + w[2] * p[2].z;
-        Some(Crossing { t, w, sign })
+        // Weight of a vertex is the value of the opposite edge. Sums run
+        // over the vertices in an order fixed by their coordinates, so that
+        // every traversal gets the same bits whatever the winding it reads
+        // the triangle in.
+        let ws = [ebc.abs(), eca.abs(), eab.abs()];
+        let k = vertex_order(p);
+        let sum = ws[k[0]] + ws[k[1]] + ws[k[2]];
+        let n = p.map(|q| q.n2.sqrt());
+        let err = self.bound2.sqrt() * (n[k[0]] * n[k[1]] + n[k[1]] * n[k[2]] + n[k[2]] * n[k[0]]);
+        let bary = (sum > 0.0 && sum.is_finite()).then(|| ws.map(|x| x / sum));
+        let mut w = bary.unwrap_or([0.0; 3]);
+        let mut t = w[k[0]] * p[k[0]].z + w[k[1]] * p[k[1]].z + w[k[2]] * p[k[2]].z;
+        if bary.is_none() || sum <= EDGE_ON_CROSSING_K * err {
+            // The crossing point lies on the chord; the depth from noisy
+            // weights may not: take the chord's nearer end (its middle
+            // without weights).
+            let [(lo, wlo), (hi, whi)] = chord(k.map(|i| p[i]));
+            let wk = if bary.is_none() {
+                Some([0, 1, 2].map(|j| 0.5 * (wlo[j] + whi[j])))
+            } else if t < lo {
+                Some(wlo)
+            } else if t > hi {
+                Some(whi)
+            } else {
+                None
+            };
+            if let Some(wk) = wk {
+                for j in 0..3 {
+                    w[k[j]] = wk[j];
+                }
+                t = w[k[0]] * p[k[0]].z + w[k[1]] * p[k[1]].z + w[k[2]] * p[k[2]].z;
+            }
+        }
+        Some(Crossing {
+            t,
+            w,
+            sign,
+            order: k,
+        })
     }
 }
 
-/// Weights of the crossing of a triangle the ray sees edge-on: the middle
-/// of the segment of triangle points straight across from the ray (in the
-/// plane through the ray and the triangle's normal, coordinate `m` across
-/// the ray in the triangle's plane), in depth. The ray is within rounding
-/// of the triangle's plane all along that segment, so each of its points is
-/// a faithful crossing; the middle keeps the crossing strictly inside the
-/// part of the ray the triangle's cells share, so the crossings before and
-/// after it (through the cells' other faces) stay in order. A degenerate
-/// triangle (zero normal) gives the middle of its depth range; a segment
-/// missed by rounding, the vertex closest to the ray.
-fn edge_on_weights(p: [&Proj; 3]) -> [f64; 3] {
+/// The triangle's vertices ordered by depth, then `x`, then `y`.
+fn vertex_order(p: [&Proj; 3]) -> [usize; 3] {
+    let mut k = [0, 1, 2];
+    k.sort_unstable_by(|&i, &j| {
+        let (a, b) = (p[i], p[j]);
+        a.z.total_cmp(&b.z)
+            .then(a.x.total_cmp(&b.x))
+            .then(a.y.total_cmp(&b.y))
+    });
+    k
+}
+
+/// The chord of a triangle across from the ray: its points in the plane
+/// through the ray and the triangle's normal (`m = 0`, `m` the coordinate
+/// across the ray in the triangle's plane). The exact crossing point is on
+/// it; when the ray runs within rounding of the triangle's plane the chord
+/// is the whole stretch of the ray the triangle's two sides share. Returns
+/// its two ends as (depth, weights), nearer end first; a chord missed by
+/// rounding is the vertex closest to the ray.
+fn chord(p: [&Proj; 3]) -> [(f64, [f64; 3]); 2] {
     let [a, b, c] = p;
     let nx = (b.y - a.y) * (c.z - a.z) - (b.z - a.z) * (c.y - a.y);
     let ny = (b.z - a.z) * (c.x - a.x) - (b.x - a.x) * (c.z - a.z);
     let m = p.map(|q| ny * q.x - nx * q.y);
-    // End points of the segment: (depth, weights).
-    let mut lo: Option<(f64, [f64; 3])> = None;
-    let mut hi: Option<(f64, [f64; 3])> = None;
+    let depth = |w: [f64; 3]| w[0] * a.z + w[1] * b.z + w[2] * c.z;
+    let mut ends: Option<[(f64, [f64; 3]); 2]> = None;
     let mut add = |w: [f64; 3]| {
-        let t = w[0] * a.z + w[1] * b.z + w[2] * c.z;
-        if lo.is_none_or(|l| t < l.0) {
-            lo = Some((t, w));
-        }
-        if hi.is_none_or(|h| t > h.0) {
-            hi = Some((t, w));
-        }
+        let e = (depth(w), w);
+        ends = Some(match ends {
+            None => [e, e],
+            Some([lo, hi]) => [
+                if e.0 < lo.0 { e } else { lo },
+                if e.0 > hi.0 { e } else { hi },
+            ],
+        });
     };
     for i in 0..3 {
         let j = (i + 1) % 3;
+        let mut w = [0.0; 3];
         if m[i] == 0.0 {
-            let mut w = [0.0; 3];
             w[i] = 1.0;
             add(w);
         } else if (m[i] > 0.0) != (m[j] > 0.0) && m[j] != 0.0 {
             let s = m[i] / (m[i] - m[j]);
-            let mut w = [0.0; 3];
             w[i] = 1.0 - s;
             w[j] = s;
             add(w);
         }
     }
-    match (lo, hi) {
-        (Some((_, l)), Some((_, h))) => [0, 1, 2].map(|k| 0.5 * (l[k] + h[k])),
-        _ => {
-            let k = (0..3)
-                .min_by(|&i, &j| m[i].abs().total_cmp(&m[j].abs()))
-                .unwrap_or(0);
-            let mut w = [0.0; 3];
-            w[k] = 1.0;
-            w
-        }
-    }
+    ends.unwrap_or_else(|| {
+        let k = (0..3)
+            .min_by(|&i, &j| m[i].abs().total_cmp(&m[j].abs()))
+            .unwrap_or(0);
+        let mut w = [0.0; 3];
+        w[k] = 1.0;
+        [(depth(w), w); 2]
+    })
 }
 
 #[cfg(test)]
