@@ -48,7 +48,7 @@ mod vertex;
 
 pub use context::{Context, ContextInfo, PendingContext};
 pub use frame::{DrawKind, Frame, FrameOptions, FrameStats};
-pub use vertex::{piece_depth, ClipMapper, ExactVertex, MAX_PIECES};
+pub use vertex::{piece_depth, ClipMapper, ExactVertex, MAX_PIECES, SUBPIXEL};
 
 use thiserror::Error;
 

@@ -142,11 +142,8 @@ pub(super) struct ChunkOut {
     /// ([`grid_area_positive`]).
     degenerate: usize,
     pub(super) error: Option<String>,
-    /// Scratch of [`push_projected`]: vertices used by a triangle, and
-    /// their index in `vertices`.
+    /// Scratch of [`push_projected`]: vertices used by a triangle.
     scratch_used: Vec<bool>,
-    scratch_remap: Vec<u32>,
-    scratch_grid: Vec<[i64; 2]>,
 }
 
 impl ChunkOut {
@@ -408,48 +405,77 @@ fn push_projected(
     let mapper = ClipMapper::for_camera(ctx.camera);
     let piece = out.pieces;
     out.pieces += 1;
-    // Index of each used vertex in `out.vertices` (u32::MAX: not emitted),
-    // and its snapped grid position (from `first` on).
-    let first = out.vertices.len() as u32;
-    out.scratch_grid.clear();
-    let remap = &mut out.scratch_remap;
-    remap.clear();
-    for ((v, vv), &u) in proj.vertices.iter().zip(vals.iter()).zip(used.iter()) {
-        if !u {
-            remap.push(u32::MAX);
-            continue;
-        }
+    // Each triangle gets its own three vertices: snapping moves its corners
+    // (by up to 1/512 px), and the attributes at the snapped corners are
+    // those of the exact triangle's affine interpolation there
+    // ([`snapped_attributes`]), so that a covered centre gets the value the
+    // exact triangle gives it. Shared corners with the exact corners'
+    // values would shift the attributes with the corners: an error of
+    // the thickness gradient times the shift, up to 0.1 where a face is
+    // seen nearly edge-on.
+    let snap = |v: &crate::projection::RegionVertex| mapper.ndc(v.px, v.py);
+    for t in &proj.triangles {
+        let v = t.map(|i| &proj.vertices[i as usize]);
         // Region positions are finite and on screen or clipped near it
         // (`clip_to_image`); one that is not cannot be drawn exactly.
-        let Some(([x, y], g)) = mapper.ndc(v.px, v.py) else {
-            remap.push(u32::MAX);
+        let (Some(s0), Some(s1), Some(s2)) = (snap(v[0]), snap(v[1]), snap(v[2])) else {
+            out.degenerate += 1;
             continue;
         };
-        remap.push(out.vertices.len() as u32);
-        out.scratch_grid.push(g);
-        out.vertices.push(
-            ExactVertex::new(
-                [x, y, 0.5, 1.0],
-                (v.l * k) as f32,
-                (vv.tau_mean / k) as f32,
-                [vv.glow[0] as f32, vv.glow[1] as f32, vv.glow[2] as f32],
-            )
-            .with_piece(piece),
-        );
-    }
-    for t in &proj.triangles {
-        let idx = t.map(|i| remap[i as usize]);
-        if idx.contains(&u32::MAX) {
+        let sn = [s0, s1, s2];
+        if !grid_area_positive(sn[0].1, sn[1].1, sn[2].1) {
             out.degenerate += 1;
             continue;
         }
-        let [a, b, c] = idx.map(|i| out.scratch_grid[(i - first) as usize]);
-        if grid_area_positive(a, b, c) {
-            out.indices.extend_from_slice(&idx);
-        } else {
-            out.degenerate += 1;
+        let attrs = t.map(|i| {
+            let (v, vv) = (&proj.vertices[i as usize], &vals[i as usize]);
+            [v.l * k, vv.tau_mean / k, vv.glow[0], vv.glow[1], vv.glow[2]]
+        });
+        let at = snapped_attributes(
+            v.map(|v| [v.px, v.py]),
+            sn.map(|s| s.1.map(|g| g as f64 / crate::gpu::SUBPIXEL)),
+            attrs,
+        );
+        let first = out.vertices.len() as u32;
+        for c in 0..3 {
+            let [x, y] = sn[c].0;
+            let a = at[c];
+            out.vertices.push(
+                ExactVertex::new(
+                    [x, y, 0.5, 1.0],
+                    a[0] as f32,
+                    a[1] as f32,
+                    [a[2] as f32, a[3] as f32, a[4] as f32],
+                )
+                .with_piece(piece),
+            );
         }
+        out.indices
+            .extend_from_slice(&[first, first + 1, first + 2]);
     }
+}
+
+/// The attributes at the snapped corners `q` of the affine interpolation
+/// of `attrs` over the exact triangle `p` (pixel coordinates): drawn at
+/// `q`, the triangle gives every point the value the exact triangle's
+/// interpolation has there. A triangle of zero exact area keeps its corner
+/// values.
+fn snapped_attributes(p: [[f64; 2]; 3], q: [[f64; 2]; 3], attrs: [[f64; 5]; 3]) -> [[f64; 5]; 3] {
+    let (e1, e2) = (
+        [p[1][0] - p[0][0], p[1][1] - p[0][1]],
+        [p[2][0] - p[0][0], p[2][1] - p[0][1]],
+    );
+    let det = e1[0] * e2[1] - e1[1] * e2[0];
+    if det == 0.0 || !det.is_finite() {
+        return attrs;
+    }
+    q.map(|q| {
+        let d = [q[0] - p[0][0], q[1] - p[0][1]];
+        let b1 = (d[0] * e2[1] - d[1] * e2[0]) / det;
+        let b2 = (e1[0] * d[1] - e1[1] * d[0]) / det;
+        let b0 = 1.0 - b1 - b2;
+        [0, 1, 2, 3, 4].map(|k| b0 * attrs[0][k] + b1 * attrs[1][k] + b2 * attrs[2][k])
+    })
 }
 
 /// Per-piece scale `k` sending `l k` and `tau / k` to the shader (their
