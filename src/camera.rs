@@ -56,7 +56,7 @@ pub struct Ray {
     pub dir: DVec3,
     /// The image's right direction for a pixel ray (zero when the ray has
     /// no image), for breaking ties by the rasteriser's top-left rule
-    /// ([`crate::raycast::geometry::tie_basis`], not yet switched on).
+    /// ([`crate::raycast::geometry::tie_basis`]).
     pub right: DVec3,
 }
 

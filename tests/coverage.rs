@@ -13,14 +13,21 @@
 //!   consistent tetrahedralisation, and the ray caster's `tets` walk
 //!   returns one segment per tet the (tie-broken) ray passes through.
 //!
-//! The GPU draws the corners snapped to its 1/256-pixel grid and breaks
-//! ties by the top-left rule; the ray caster breaks them by its own
-//! perturbation (`raycast::geometry::tie_basis`). A centre within that
-//! distance of a piece's silhouette, or exactly on it, may be decided the
-//! other way: every mismatch must lie within [`TIE_BAND_PX`] of a projected
-//! tet edge. Meshes whose vertices project exactly onto pixel centres
-//! (every edge through centres, faces seen edge-on) put many centres on
-//! edges; there the GPU and the CPU twin must still agree exactly.
+//! Both break ties the same way: the rasteriser by the top-left rule, the
+//! ray caster by moving its ray right, then down, on the image
+//! (`raycast::geometry::tie_basis`), which is the same rule. So on meshes
+//! whose vertices project exactly onto pixel centres (every edge through
+//! centres, faces seen edge-on, all corners on the sub-pixel grid already)
+//! the piece counts equal the ray's tet counts at every centre: zero
+//! mismatches.
+//!
+//! In general views one cause of mismatch remains, and it is not a tie:
+//! the rasteriser draws the corners snapped to its grid of 1/256 px (each
+//! moves by at most 1/512 px in x and y, so an edge by at most
+//! [`SNAP_BAND_PX`]); the ray caster meets the exact tets. A centre closer
+//! than that to a projected edge can fall on the other side of the snapped
+//! edge (measured: 0 to 87 such centres per view, most on `mixed.vtk`).
+//! Every mismatch must lie within [`SNAP_BAND_PX`] of a projected tet edge.
 
 use glam::DVec3;
 use zoovr::camera::{Camera, CameraParams};
@@ -35,10 +42,11 @@ use zoovr::render::{Compositor, RenderOptions, Renderer, ScalarsRef, Scene, Scen
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
-/// Centres this close to a projected edge may be decided differently by the
-/// GPU (snapped corners) and the ray caster (exact corners): half a grid
-/// step of 1/256 px per corner, doubled.
-const TIE_BAND_PX: f64 = 1.0 / 128.0;
+/// Centres this close to a projected edge may be on the other side of the
+/// GPU's snapped edge than of the exact one: a snapped corner moves by at
+/// most half a grid step of 1/256 px in x and in y, so every point of an
+/// edge between snapped corners by at most `sqrt(2) / 512` px.
+const SNAP_BAND_PX: f64 = std::f64::consts::SQRT_2 / 512.0;
 
 fn gpu_available() -> bool {
     match Context::new(&GpuOptions::default()) {
@@ -140,13 +148,14 @@ fn distance_to_edges(mesh: &Mesh, camera: &Camera, i: u32, j: u32) -> f64 {
     best
 }
 
-/// Every centre whose piece count differs from the ray's tet count lies in
-/// the tie band of a projected edge; returns how many differ.
-fn check_ties(
+/// Every centre whose piece count differs from the ray's tet count lies
+/// within `band` px of a projected edge; returns how many differ.
+fn check_mismatches(
     scene: &Scene,
     camera: &Camera,
     pieces: &[usize],
     want: &[usize],
+    band: f64,
     tag: &str,
 ) -> usize {
     let mut ties = 0;
@@ -157,7 +166,7 @@ fn check_ties(
         let (i, j) = (k as u32 % camera.width, k as u32 / camera.width);
         let d = distance_to_edges(&scene.mesh, camera, i, j);
         assert!(
-            d <= TIE_BAND_PX,
+            d <= band,
             "{tag}: pixel ({i}, {j}) drawn by {} pieces, the ray meets {} tets, \
              {d:.2e} px from the nearest projected edge",
             pieces[k],
@@ -254,16 +263,23 @@ fn on_grid_meshes_are_covered_exactly_once() {
         let tag = format!("on-grid shear {shear}");
         let (pieces, folds) = check_twin(&mut renderer, &camera, gpu, &tag);
         let want = reference_counts(&scene, &camera);
-        let ties = check_ties(&scene, &camera, &pieces, &want, &tag);
+        // No band: a single mismatch fails.
+        check_mismatches(&scene, &camera, &pieces, &want, -1.0, &tag);
         assert!(want.iter().any(|&c| c > 0), "{tag}: nothing covered");
-        eprintln!("{tag}: {ties} centres on edges decided the other way");
+        let on_edges = (0..want.len())
+            .filter(|&k| {
+                let (i, j) = (k as u32 % camera.width, k as u32 / camera.width);
+                distance_to_edges(&scene.mesh, &camera, i, j) == 0.0
+            })
+            .count();
+        eprintln!("{tag}: {on_edges} centres on projected edges, all decided alike");
         assert_eq!(folds, 0, "{tag}: folds on an on-grid mesh");
     }
 }
 
 /// Real meshes in seeded random views: the GPU counts equal the twin's, and
 /// every centre whose piece count differs from the ray's tet count lies in
-/// the tie band of a projected edge.
+/// the snap band of a projected edge.
 #[test]
 fn datasets_are_covered_exactly_once_in_random_views() {
     let gpu = gpu_available();
@@ -304,8 +320,8 @@ fn datasets_are_covered_exactly_once_in_random_views() {
             let tag = format!("{} view {view} {params:?}", path.display());
             let (pieces, folds) = check_twin(&mut renderer, &camera, gpu, &tag);
             let want = reference_counts(&scene, &camera);
-            let ties = check_ties(&scene, &camera, &pieces, &want, &tag);
-            eprintln!("{tag}: {ties} tie-band pixels, {folds} fold pixels");
+            let snapped = check_mismatches(&scene, &camera, &pieces, &want, SNAP_BAND_PX, &tag);
+            eprintln!("{tag}: {snapped} snap-band pixels, {folds} fold pixels");
         }
     }
 }

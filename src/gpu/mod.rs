@@ -58,7 +58,7 @@ mod target;
 
 pub use device::{Context, ContextInfo, PendingContext};
 pub use frame::{DrawKind, Frame, FrameOptions, FrameStats};
-pub use raster::{piece_depth, ClipMapper, GpuVertex, MAX_PIECES};
+pub use raster::{piece_depth, ClipMapper, GpuVertex, MAX_PIECES, SUBPIXEL};
 pub use stage::{Binding, Resource, Stage, StageDesc};
 pub use table::Table;
 

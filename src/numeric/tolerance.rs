@@ -93,6 +93,18 @@ pub const PERSPECTIVE_INTERP_REL: f64 = 1e-3;
 /// direction's own rounding); 64 leaves a margin. Larger only means more
 /// exact evaluations, never a different answer.
 pub const PLUCKER_FILTER_K: f64 = 64.0;
+/// A ray/triangle crossing's depth comes from barycentric weights, the
+/// three edge values (`raycast::geometry`). When their sum is below this
+/// factor times the sum of their certified error bounds, the weights may be
+/// off by more than 1/K and the triangle is seen nearly edge-on: the depth
+/// is then kept within the triangle's chord across from the ray (where the
+/// exact crossing lies; on a triangle seen exactly edge-on, noise weights
+/// put it anywhere on the triangle, past the cells' other faces, so the
+/// walk clamped the next segments and a ray along a cube's face diagonal
+/// came out 2% long). Clamping to the chord only moves the depth towards
+/// the exact one, so K only trades speed (the chord costs two cross
+/// products) against how far noisy weights may go before it is checked.
+pub const EDGE_ON_CROSSING_K: f64 = 1048576.0;
 
 /// The ray caster stops a ray when its transmittance falls below this
 /// (accumulated opacity `>= 1 - 1e-6`): the rest of the ray can change each

@@ -668,14 +668,11 @@ impl CellRay<'_> {
             self.edge(k[1], k[2]),
             self.edge(k[2], k[0]),
         ];
-        let x = RayFrame::crossing(e, k.map(|i| self.proj[i].2.z))?;
+        let [p0, p1, p2] = k.map(|i| &self.proj[i].2);
+        let x = self.frame.crossing(e, [p0, p1, p2])?;
         let nodes = self.nodes;
         let s = match self.scalars {
-            Scalars::Point(v) => {
-                x.w[0] * v[nodes[k[0]] as usize]
-                    + x.w[1] * v[nodes[k[1]] as usize]
-                    + x.w[2] * v[nodes[k[2]] as usize]
-            }
+            Scalars::Point(v) => x.interpolate(k.map(|i| v[nodes[i] as usize])),
             Scalars::Cell(v) => v[self.cell as usize],
             Scalars::Constant(s) => s,
         };

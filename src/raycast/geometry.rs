@@ -36,7 +36,7 @@ use glam::DVec3;
 
 use crate::camera::Ray;
 use crate::numeric::predicates::{orient3d, Side};
-use crate::numeric::tolerance::PLUCKER_FILTER_K;
+use crate::numeric::tolerance::{EDGE_ON_CROSSING_K, PLUCKER_FILTER_K};
 
 /// A vertex in a ray's frame.
 #[derive(Clone, Copy, Debug, Default)]
@@ -50,22 +50,18 @@ pub struct Proj {
 }
 
 /// The orthonormal `u, v` (`u x v = d`) of a ray's frame, which are also
-/// the directions of the symbolic perturbation. With [`USE_IMAGE_BASIS`],
-/// `u` is the image's right direction made orthogonal to the ray
+/// the directions of the symbolic perturbation. For a pixel ray `u` is the
+/// image's right direction made orthogonal to the ray
 /// ([`Ray::right`]), so `v = d x u` is the image's down direction, and
 /// moving the origin by `e u + e^2 v` moves the point where the ray meets
 /// any surface by a positive multiple of it on the image: a pixel centre on
 /// a projected edge belongs to the triangle on its right, or below it for
 /// a horizontal edge — the rasteriser's top-left rule (`gpu::cpu`).
-/// Otherwise (and for a ray with no image direction) the basis is fixed by
-/// the ray's direction alone.
+/// For a ray with no image direction the basis is fixed by the ray's
+/// direction alone.
 pub fn tie_basis(ray: &Ray) -> (DVec3, DVec3) {
     let d = ray.dir;
-    let r = if USE_IMAGE_BASIS {
-        ray.right - d * ray.right.dot(d)
-    } else {
-        DVec3::ZERO
-    };
+    let r = ray.right - d * ray.right.dot(d);
     let u = if r.length_squared() > 1e-12 {
         r.normalize()
     } else {
@@ -74,13 +70,6 @@ pub fn tie_basis(ray: &Ray) -> (DVec3, DVec3) {
     };
     (u, d.cross(u))
 }
-
-/// Whether ties follow the image (right, then down: the rasteriser's
-/// top-left rule). Off: with it, the walk's images of one cube cut into 5
-/// and into 6 tets differed by 5.9e-3 on a pixel whose ray runs along a
-/// face (`tests/raycast_walk.rs`), a case of the walk's tie handling not
-/// yet found; the fixed basis keeps them identical.
-const USE_IMAGE_BASIS: bool = false;
 
 /// One ray with its frame and symbolic perturbation.
 #[derive(Clone, Copy, Debug)]
@@ -103,6 +92,19 @@ pub struct Crossing {
     pub w: [f64; 3],
     /// +1 when the ray goes along the triangle's right-hand normal.
     pub sign: i8,
+    /// The vertices in an order fixed by their coordinates: sums over the
+    /// vertices (the depth, an interpolated scalar) taken in this order
+    /// give the same bits whatever winding the triangle was read in.
+    pub order: [usize; 3],
+}
+
+impl Crossing {
+    /// `sum w_i v_i` over the vertices, in [`Crossing::order`].
+    #[inline]
+    pub fn interpolate(&self, v: [f64; 3]) -> f64 {
+        let [a, b, c] = self.order;
+        self.w[a] * v[a] + self.w[b] * v[b] + self.w[c] * v[c]
+    }
 }
 
 impl RayFrame {
@@ -203,9 +205,12 @@ impl RayFrame {
     }
 
     /// Crossing of the triangle with the given edge values
-    /// (`e_ab`, `e_bc`, `e_ca`) and vertex depths, if the ray crosses it.
+    /// (`e_ab`, `e_bc`, `e_ca`) and projected vertices, if the ray crosses
+    /// it. The weights are the edge values (opposite edges); where these
+    /// may be noise (the triangle seen edge-on, [`EDGE_ON_CROSSING_K`]) the
+    /// crossing is kept on the triangle's [`chord`] across from the ray.
     #[inline]
-    pub fn crossing(e: [f64; 3], z: [f64; 3]) -> Option<Crossing> {
+    pub fn crossing(&self, e: [f64; 3], p: [&Proj; 3]) -> Option<Crossing> {
         let [eab, ebc, eca] = e;
         let sign = if eab > 0.0 && ebc > 0.0 && eca > 0.0 {
             1
@@ -214,17 +219,105 @@ impl RayFrame {
         } else {
             return None;
         };
-        // Weight of a vertex is the value of the opposite edge.
-        let (wa, wb, wc) = (ebc.abs(), eca.abs(), eab.abs());
-        let sum = wa + wb + wc;
-        let w = if sum > 0.0 && sum.is_finite() {
-            [wa / sum, wb / sum, wc / sum]
-        } else {
-            [1.0 / 3.0; 3]
-        };
-        let t = w[0] * z[0] + w[1] * z[1] + w[2] * z[2];
-        Some(Crossing { t, w, sign })
+        // Weight of a vertex is the value of the opposite edge. Sums run
+        // over the vertices in an order fixed by their coordinates, so that
+        // every traversal gets the same bits whatever the winding it reads
+        // the triangle in.
+        let ws = [ebc.abs(), eca.abs(), eab.abs()];
+        let k = vertex_order(p);
+        let sum = ws[k[0]] + ws[k[1]] + ws[k[2]];
+        let n = p.map(|q| q.n2.sqrt());
+        let err = self.bound2.sqrt() * (n[k[0]] * n[k[1]] + n[k[1]] * n[k[2]] + n[k[2]] * n[k[0]]);
+        let bary = (sum > 0.0 && sum.is_finite()).then(|| ws.map(|x| x / sum));
+        let mut w = bary.unwrap_or([0.0; 3]);
+        let mut t = w[k[0]] * p[k[0]].z + w[k[1]] * p[k[1]].z + w[k[2]] * p[k[2]].z;
+        if bary.is_none() || sum <= EDGE_ON_CROSSING_K * err {
+            // The crossing point lies on the chord; the depth from noisy
+            // weights may not: take the chord's nearer end (its middle
+            // without weights).
+            let [(lo, wlo), (hi, whi)] = chord(k.map(|i| p[i]));
+            let wk = if bary.is_none() {
+                Some([0, 1, 2].map(|j| 0.5 * (wlo[j] + whi[j])))
+            } else if t < lo {
+                Some(wlo)
+            } else if t > hi {
+                Some(whi)
+            } else {
+                None
+            };
+            if let Some(wk) = wk {
+                for j in 0..3 {
+                    w[k[j]] = wk[j];
+                }
+                t = w[k[0]] * p[k[0]].z + w[k[1]] * p[k[1]].z + w[k[2]] * p[k[2]].z;
+            }
+        }
+        Some(Crossing {
+            t,
+            w,
+            sign,
+            order: k,
+        })
     }
+}
+
+/// The triangle's vertices ordered by depth, then `x`, then `y`.
+fn vertex_order(p: [&Proj; 3]) -> [usize; 3] {
+    let mut k = [0, 1, 2];
+    k.sort_unstable_by(|&i, &j| {
+        let (a, b) = (p[i], p[j]);
+        a.z.total_cmp(&b.z)
+            .then(a.x.total_cmp(&b.x))
+            .then(a.y.total_cmp(&b.y))
+    });
+    k
+}
+
+/// The chord of a triangle across from the ray: its points in the plane
+/// through the ray and the triangle's normal (`m = 0`, `m` the coordinate
+/// across the ray in the triangle's plane). The exact crossing point is on
+/// it; when the ray runs within rounding of the triangle's plane the chord
+/// is the whole stretch of the ray the triangle's two sides share. Returns
+/// its two ends as (depth, weights), nearer end first; a chord missed by
+/// rounding is the vertex closest to the ray.
+fn chord(p: [&Proj; 3]) -> [(f64, [f64; 3]); 2] {
+    let [a, b, c] = p;
+    let nx = (b.y - a.y) * (c.z - a.z) - (b.z - a.z) * (c.y - a.y);
+    let ny = (b.z - a.z) * (c.x - a.x) - (b.x - a.x) * (c.z - a.z);
+    let m = p.map(|q| ny * q.x - nx * q.y);
+    let depth = |w: [f64; 3]| w[0] * a.z + w[1] * b.z + w[2] * c.z;
+    let mut ends: Option<[(f64, [f64; 3]); 2]> = None;
+    let mut add = |w: [f64; 3]| {
+        let e = (depth(w), w);
+        ends = Some(match ends {
+            None => [e, e],
+            Some([lo, hi]) => [
+                if e.0 < lo.0 { e } else { lo },
+                if e.0 > hi.0 { e } else { hi },
+            ],
+        });
+    };
+    for i in 0..3 {
+        let j = (i + 1) % 3;
+        let mut w = [0.0; 3];
+        if m[i] == 0.0 {
+            w[i] = 1.0;
+            add(w);
+        } else if (m[i] > 0.0) != (m[j] > 0.0) && m[j] != 0.0 {
+            let s = m[i] / (m[i] - m[j]);
+            w[i] = 1.0 - s;
+            w[j] = s;
+            add(w);
+        }
+    }
+    ends.unwrap_or_else(|| {
+        let k = (0..3)
+            .min_by(|&i, &j| m[i].abs().total_cmp(&m[j].abs()))
+            .unwrap_or(0);
+        let mut w = [0.0; 3];
+        w[k] = 1.0;
+        [(depth(w), w); 2]
+    })
 }
 
 #[cfg(test)]
@@ -242,7 +335,7 @@ mod tests {
             f.edge(ids[1], p[1], &pr[1], ids[2], p[2], &pr[2]),
             f.edge(ids[2], p[2], &pr[2], ids[0], p[0], &pr[0]),
         ];
-        RayFrame::crossing(e, pr.map(|x| x.z))
+        f.crossing(e, [&pr[0], &pr[1], &pr[2]])
     }
 
     #[test]

@@ -72,7 +72,9 @@ pub struct WalkMesh<'a> {
 #[derive(Default)]
 pub struct Scratch {
     proj: Vec<(u32, DVec3, Proj)>,
-    entries: Vec<(f64, u32, [f64; 3])>,
+    /// Boundary entries: depth, triangle, and the crossing's vertices and
+    /// weights in [`super::geometry::Crossing::order`].
+    entries: Vec<(f64, u32, [u32; 3], [f64; 3])>,
     stack: Vec<u32>,
     /// Edge values of the current cell by local node pair (NaN: not yet).
     edges: Vec<f64>,
@@ -186,7 +188,7 @@ impl<'a> WalkMesh<'a> {
         let slack = crate::numeric::tolerance::RAY_REENTRY_SLACK_REL * 2.0 * self.radius;
         let mut steps_left = 4 * self.cells.len() + 16;
         let mut t_cur = f64::NEG_INFINITY;
-        'entries: for &(t, b, w) in &entries {
+        'entries: for &(t, b, v, w) in &entries {
             if t < t_cur - slack {
                 continue;
             }
@@ -194,7 +196,7 @@ impl<'a> WalkMesh<'a> {
             let mut cell = bt.cell;
             let mut entry = (bt.face, bt.key);
             let mut t_in = t;
-            let mut v_in = bt.verts;
+            let mut v_in = v;
             let mut w_in = w;
             loop {
                 if steps_left == 0 {
@@ -238,7 +240,7 @@ impl<'a> WalkMesh<'a> {
         frame: &RayFrame,
         t0: f64,
         scratch: &mut Scratch,
-        entries: &mut Vec<(f64, u32, [f64; 3])>,
+        entries: &mut Vec<(f64, u32, [u32; 3], [f64; 3])>,
     ) {
         entries.clear();
         let pts = self.points;
@@ -254,9 +256,14 @@ impl<'a> WalkMesh<'a> {
                     frame.edge(i1, p[1], &pr[1], i2, p[2], &pr[2]),
                     frame.edge(i2, p[2], &pr[2], i0, p[0], &pr[0]),
                 ];
-                if let Some(c) = RayFrame::crossing(e, pr.map(|x| x.z)) {
+                if let Some(c) = frame.crossing(e, [&pr[0], &pr[1], &pr[2]]) {
                     if c.sign * b.outward < 0 && c.t >= t0 {
-                        entries.push((c.t, i, c.w));
+                        entries.push((
+                            c.t,
+                            i,
+                            c.order.map(|k| b.verts[k]),
+                            c.order.map(|k| c.w[k]),
+                        ));
                     }
                 }
             });
@@ -311,7 +318,7 @@ impl<'a> WalkMesh<'a> {
                 edge(tri[2], tri[0]),
             ];
             let [a, b, cc] = tri.map(|k| &proj[k]);
-            let Some(x) = RayFrame::crossing(e, [a.2.z, b.2.z, cc.2.z]) else {
+            let Some(x) = frame.crossing(e, [&a.2, &b.2, &cc.2]) else {
                 return;
             };
             let better = match &best {
@@ -331,8 +338,8 @@ impl<'a> WalkMesh<'a> {
                     face: fid,
                     key,
                     t: x.t,
-                    verts: g,
-                    w: x.w,
+                    verts: x.order.map(|k| g[k]),
+                    w: x.order.map(|k| x.w[k]),
                 });
             }
         };

@@ -18,8 +18,10 @@
 //!    makes each vertex ([`ProjectedMode::vertex`]).
 //! 4. The driver snaps every corner to the rasteriser's sub-pixel grid
 //!    ([`ClipMapper::ndc`]), drops triangles that are flat or inverted
-//!    there ([`grid_area_positive`]), and numbers the part as one piece
-//!    (each piece colours a pixel at most once, [`crate::gpu::frame`]).
+//!    there ([`grid_area_positive`]), gives each triangle its own corners
+//!    with the payload the exact triangle has at the snapped positions
+//!    ([`snapped_weights`]), and numbers the part as one piece (each piece
+//!    colours a pixel at most once, [`crate::gpu::frame`]).
 //!
 //! Pieces are processed in chunks of consecutive pieces by worker threads,
 //! handed to the GPU in order as soon as each chunk and all before it are
@@ -43,7 +45,7 @@ use crate::gpu::cpu::{CpuFrame, CpuStage};
 use crate::gpu::layer::{LayerTwin, LayerVertex, LAYER_STAGE};
 use crate::gpu::{
     ClipMapper, Context, Frame, FrameOptions, FrameStats, GpuError, GpuVertex, PendingContext,
-    Stage, MAX_PIECES,
+    Stage, MAX_PIECES, SUBPIXEL,
 };
 use crate::image::Image;
 use crate::projection::coverage::PixelGrid;
@@ -98,13 +100,17 @@ pub trait ProjectedMode: Sync {
         refined: &mut usize,
     );
 
-    /// Vertex `i` of `proj` at normalised device coordinates `ndc` (on the
-    /// sub-pixel grid), in piece 0 (the driver numbers the pieces).
+    /// The vertex at barycentric weights `weights` of region triangle
+    /// `corners` of `proj` (an affine combination of the corners' payload,
+    /// weights summing to 1, possibly slightly outside `[0, 1]`), drawn at
+    /// normalised device coordinates `ndc`, in piece 0 (the driver numbers
+    /// the pieces).
     fn vertex(
         &self,
         payload: &Self::Payload,
         proj: &Projected,
-        i: usize,
+        corners: [u32; 3],
+        weights: [f64; 3],
         ndc: [f32; 2],
     ) -> Self::Vertex;
 }
@@ -160,11 +166,8 @@ struct Worker<P> {
     parts: PartScratch,
     proj: Projected,
     payload: P,
-    /// Vertices used by a kept triangle, their index in the output, and
-    /// their snapped grid position.
+    /// Vertices used by a kept triangle.
     used: Vec<bool>,
-    remap: Vec<u32>,
-    grid: Vec<[i64; 2]>,
 }
 
 impl<P: Default> Worker<P> {
@@ -181,8 +184,6 @@ impl<P: Default> Worker<P> {
             proj: Projected::default(),
             payload: P::default(),
             used: Vec::new(),
-            remap: Vec::new(),
-            grid: Vec::new(),
         }
     }
 }
@@ -215,41 +216,68 @@ fn draw_part<M: ProjectedMode>(
     let mapper = ClipMapper::for_camera(src.camera);
     let piece = out.pieces;
     out.pieces += 1;
-    // Index of each used vertex in `out.vertices` (u32::MAX: not emitted),
-    // and its snapped grid position (from `first` on).
-    let first = out.vertices.len() as u32;
-    w.grid.clear();
-    w.remap.clear();
-    for (i, v) in proj.vertices.iter().enumerate() {
-        if !used[i] {
-            w.remap.push(u32::MAX);
-            continue;
-        }
+    // Each triangle gets its own three vertices: snapping moves its corners
+    // (by up to 1/512 px), and the payload at a snapped corner is the exact
+    // triangle's affine interpolation there ([`snapped_weights`]), so a
+    // covered centre gets the value the exact triangle gives it. Shared
+    // corners carrying the exact corners' values would move the payload
+    // with the corners: an error of its gradient times the shift, up to 0.1
+    // where a face is seen nearly edge-on (thickness changes steeply).
+    for t in &proj.triangles {
+        let v = t.map(|i| &proj.vertices[i as usize]);
         // Region positions are finite and on screen or clipped near it
         // (`clip_to_image`); one that is not cannot be drawn exactly.
-        let Some((ndc, g)) = mapper.ndc(v.px, v.py) else {
-            w.remap.push(u32::MAX);
+        let (Some(s0), Some(s1), Some(s2)) = (
+            mapper.ndc(v[0].px, v[0].py),
+            mapper.ndc(v[1].px, v[1].py),
+            mapper.ndc(v[2].px, v[2].py),
+        ) else {
+            out.degenerate += 1;
             continue;
         };
-        w.remap.push(out.vertices.len() as u32);
-        w.grid.push(g);
-        out.vertices
-            .push(mode.vertex(&w.payload, proj, i, ndc).with_piece(piece));
-    }
-    for t in &proj.triangles {
-        let idx = t.map(|i| w.remap[i as usize]);
-        if idx.contains(&u32::MAX) {
+        let sn = [s0, s1, s2];
+        if !grid_area_positive(s0.1, s1.1, s2.1) {
             out.degenerate += 1;
             continue;
         }
-        let [a, b, c] = idx.map(|i| w.grid[(i - first) as usize]);
-        if grid_area_positive(a, b, c) {
-            out.indices.extend_from_slice(&idx);
-        } else {
-            out.degenerate += 1;
+        let weights = snapped_weights(
+            v.map(|v| [v.px, v.py]),
+            sn.map(|s| s.1.map(|g| g as f64 / SUBPIXEL)),
+        );
+        let first = out.vertices.len() as u32;
+        for c in 0..3 {
+            out.vertices.push(
+                mode.vertex(&w.payload, proj, *t, weights[c], sn[c].0)
+                    .with_piece(piece),
+            );
         }
+        out.indices
+            .extend_from_slice(&[first, first + 1, first + 2]);
     }
     Ok(())
+}
+
+/// Barycentric weights, over the exact triangle `p` (pixel coordinates),
+/// of each of its snapped corners `q`: drawn at `q` with the payload these
+/// weights give, the triangle gives every point the value the exact
+/// triangle's interpolation has there. A triangle of zero exact area keeps
+/// its corner values.
+fn snapped_weights(p: [[f64; 2]; 3], q: [[f64; 2]; 3]) -> [[f64; 3]; 3] {
+    let unit = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let (e1, e2) = (
+        [p[1][0] - p[0][0], p[1][1] - p[0][1]],
+        [p[2][0] - p[0][0], p[2][1] - p[0][1]],
+    );
+    let det = e1[0] * e2[1] - e1[1] * e2[0];
+    if det == 0.0 || !det.is_finite() {
+        return unit;
+    }
+    q.map(|q| {
+        let d = [q[0] - p[0][0], q[1] - p[0][1]];
+        let b1 = (d[0] * e2[1] - d[1] * e2[0]) / det;
+        let b2 = (e1[0] * d[1] - e1[1] * d[0]) / det;
+        [1.0 - b1 - b2, b1, b2]
+    })
 }
 
 /// Whether the GPU sees the triangle `a, b, c` (region triangles are CCW in
