@@ -11,7 +11,9 @@ use anyhow::{anyhow, Context as _, Result};
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
-use zoovr::render::{Compositor, Mode, RenderOptions, Renderer, Scene, SceneSpec};
+use zoovr::render::{
+    Compositor, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
+};
 
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -48,9 +50,12 @@ fn main() -> Result<()> {
     let mut renderer = Renderer::new(&scene);
     let opts = RenderOptions {
         camera,
-        split_all,
-        compositor: Compositor::Cpu,
-        watch: Some((i, j)),
+        projected: ProjectedOptions {
+            split_all,
+            compositor: Compositor::Cpu,
+            watch: Some((i, j)),
+            ..Default::default()
+        },
         ..Default::default()
     };
     let (img, stats) = renderer.render(&opts, |_, _| {})?;
@@ -61,12 +66,18 @@ fn main() -> Result<()> {
     };
     let ropts = RenderOptions {
         mode: Mode::Raycast,
-        model,
+        reference: ReferenceOptions {
+            model,
+            ..opts.clone().reference
+        },
         ..opts.clone()
     };
     let (reference, _) = renderer.render(&ropts, |_, _| {})?;
     let gopts = RenderOptions {
-        compositor: Compositor::Gpu,
+        projected: ProjectedOptions {
+            compositor: Compositor::Gpu,
+            ..opts.clone().projected
+        },
         ..opts.clone()
     };
     match renderer.render(&gopts, |_, _| {}) {

@@ -38,7 +38,9 @@ use zoovr::io::{self, ReadOptions};
 use zoovr::mesh::tetra::tetrahedralize_cell;
 use zoovr::mesh::Mesh;
 use zoovr::raycast::{self, FieldModel, Raycaster};
-use zoovr::render::{Compositor, RenderOptions, Renderer, ScalarsRef, Scene, SceneSpec};
+use zoovr::render::{
+    Compositor, ProjectedOptions, RenderOptions, Renderer, ScalarsRef, Scene, SceneSpec,
+};
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
@@ -78,9 +80,12 @@ fn counts(
     compositor: Compositor,
 ) -> Image {
     let opts = RenderOptions {
-        split_all: true,
-        draw: kind,
-        compositor,
+        projected: ProjectedOptions {
+            split_all: true,
+            draw: kind,
+            compositor,
+            ..Default::default()
+        },
         ..Default::default()
     };
     renderer

@@ -16,7 +16,9 @@ use zoovr::io::{self, ReadOptions};
 use zoovr::mesh::ghost::{GhostCounts, GhostError};
 use zoovr::mesh::{Cells, Mesh};
 use zoovr::raycast::FieldModel;
-use zoovr::render::{Mode, RenderError, RenderOptions, Renderer, Scene, SceneSpec};
+use zoovr::render::{
+    Mode, ReferenceOptions, RenderError, RenderOptions, Renderer, Scene, SceneSpec,
+};
 
 const N: usize = 4;
 
@@ -78,7 +80,10 @@ fn render(scene: &Scene, mode: Mode) -> Image {
             ..Default::default()
         },
         mode,
-        model: FieldModel::Faces,
+        reference: ReferenceOptions {
+            model: FieldModel::Faces,
+            ..Default::default()
+        },
         ..Default::default()
     };
     let (img, _) = Renderer::new(scene).render(&opts, |_, _| {}).unwrap();

@@ -16,7 +16,9 @@ use zoovr::image::{compare_display, Image};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
 use zoovr::render::modes::SHADERS;
-use zoovr::render::{Compositor, Mode, RenderOptions, Renderer, Scene, SceneSpec};
+use zoovr::render::{
+    Compositor, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
+};
 use zoovr::testdata::mesh_file;
 
 fn scene(name: &str) -> Scene {
@@ -81,7 +83,10 @@ fn registry_is_complete() {
             // The CPU twin exists and draws: a render through it.
             let s = scene("tetra.vtu");
             let opts = RenderOptions {
-                compositor: Compositor::Cpu,
+                projected: ProjectedOptions {
+                    compositor: Compositor::Cpu,
+                    ..options(mode, false).projected
+                },
                 ..options(mode, false)
             };
             let img = render(&s, &opts);
@@ -116,10 +121,13 @@ fn every_mode_matches_the_reference() {
         for ortho in [false, true] {
             for split in [false, true] {
                 let reference = RenderOptions {
-                    model: if split {
-                        FieldModel::Tets
-                    } else {
-                        FieldModel::Faces
+                    reference: ReferenceOptions {
+                        model: if split {
+                            FieldModel::Tets
+                        } else {
+                            FieldModel::Faces
+                        },
+                        ..options(Mode::Raycast, ortho).reference
                     },
                     ..options(Mode::Raycast, ortho)
                 };
@@ -135,8 +143,11 @@ fn every_mode_matches_the_reference() {
                     }
                     for compositor in compositors {
                         let opts = RenderOptions {
-                            split_all: split,
-                            compositor,
+                            projected: ProjectedOptions {
+                                split_all: split,
+                                compositor,
+                                ..options(mode, ortho).projected
+                            },
                             ..options(mode, ortho)
                         };
                         let got = render(&s, &opts);

@@ -18,7 +18,9 @@ use zoovr::gpu::{Context, GpuOptions};
 use zoovr::image::{check_images_with, Bounds, Image};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
-use zoovr::render::{Mode, RenderOptions, Renderer, Scene, SceneSpec};
+use zoovr::render::{
+    Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
+};
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
@@ -89,8 +91,14 @@ fn render(scene: &Scene, mode: Mode, model: FieldModel, split_all: bool, ortho: 
             ..Default::default()
         },
         mode,
-        model,
-        split_all,
+        projected: ProjectedOptions {
+            split_all,
+            ..Default::default()
+        },
+        reference: ReferenceOptions {
+            model,
+            ..Default::default()
+        },
         ..Default::default()
     };
     let (img, _) = Renderer::new(scene).render(&opts, |_, _| {}).unwrap();
@@ -269,7 +277,10 @@ fn coverage_culling_changes_no_pixel() {
                             ortho,
                             ..Default::default()
                         },
-                        cull_to_pixels: cull,
+                        projected: ProjectedOptions {
+                            cull_to_pixels: cull,
+                            ..Default::default()
+                        },
                         ..Default::default()
                     };
                     let (img, stats) = Renderer::new(&scene).render(&opts, |_, _| {}).unwrap();

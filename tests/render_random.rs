@@ -13,7 +13,9 @@ use zoovr::camera::CameraParams;
 use zoovr::image::{compare_display, Image};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
-use zoovr::render::{Compositor, Mode, RenderOptions, Renderer, Scene, SceneSpec};
+use zoovr::render::{
+    Compositor, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
+};
 use zoovr::testdata::{mesh_file, shared_file};
 
 /// Bound over every pixel (PNG values). The goal is 2/255; the seeded
@@ -86,14 +88,20 @@ fn random_views_match_the_reference_on_every_pixel() {
         let mut renderer = Renderer::new(scene);
         let exact = RenderOptions {
             camera,
-            split_all: true,
-            compositor: Compositor::Cpu,
+            projected: ProjectedOptions {
+                split_all: true,
+                compositor: Compositor::Cpu,
+                ..Default::default()
+            },
             ..Default::default()
         };
         let (img, _) = renderer.render(&exact, |_, _| {}).unwrap();
         let reference = RenderOptions {
             mode: Mode::Raycast,
-            model: FieldModel::Tets,
+            reference: ReferenceOptions {
+                model: FieldModel::Tets,
+                ..exact.reference
+            },
             ..exact.clone()
         };
         let (want, _) = renderer.render(&reference, |_, _| {}).unwrap();
@@ -108,7 +116,10 @@ fn random_views_match_the_reference_on_every_pixel() {
         if d.max_abs > bound {
             let (i, j) = d.worst;
             let watch = RenderOptions {
-                watch: Some((i, j)),
+                projected: ProjectedOptions {
+                    watch: Some((i, j)),
+                    ..exact.projected
+                },
                 ..exact.clone()
             };
             let (_, stats) = renderer.render(&watch, |_, _| {}).unwrap();

@@ -10,7 +10,10 @@ use zoovr::camera::CameraParams;
 use zoovr::gpu::{AccumFormat, Backend, GpuOptions};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::{FieldModel, Traversal};
-use zoovr::render::{Mode, RenderOptions, RenderStats, Renderer, Scene, SceneSpec};
+use zoovr::render::{
+    Mode, ProjectedOptions, ReferenceOptions, RenderOptions, RenderStats, Renderer, Scene,
+    SceneSpec,
+};
 
 use super::args::{parse_finite, parse_positive, parse_range, parse_rgb, parse_size};
 
@@ -138,15 +141,19 @@ impl ViewArgs {
                 ..Default::default()
             },
             mode: self.mode,
-            model: self.model.unwrap_or_default(),
-            traversal: self.traversal.unwrap_or_default(),
-            split_all: self.split.is_some(),
+            reference: ReferenceOptions {
+                model: self.model.unwrap_or_default(),
+                traversal: self.traversal.unwrap_or_default(),
+            },
+            projected: ProjectedOptions {
+                split_all: self.split.is_some(),
+                ..Default::default()
+            },
             gpu: GpuOptions {
                 backend: self.backend,
                 cpu_adapter: self.cpu_adapter,
             },
             accum: AccumFormat::Auto,
-            ..Default::default()
         }
     }
 
@@ -253,7 +260,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             info.name
         );
     }
-    if !info.gpu && opts.split_all {
+    if !info.gpu && opts.projected.split_all {
         eprintln!(
             "zoovr: note: --split all is for the projected-cell modes; the ray caster's field \
              is --model (`--model tets` integrates the consistent tets)"

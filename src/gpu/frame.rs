@@ -48,7 +48,7 @@ pub const DEFAULT_BATCH_VERTICES: usize = 1 << 18;
 const MAX_INDEX_VALUE: usize = (1 << 24) - 1;
 
 /// What a frame's fragments do.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub enum DrawKind {
     /// Composite the exact integrals back to front ("over"), each piece at
     /// most once per pixel.

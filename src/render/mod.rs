@@ -14,6 +14,7 @@ pub mod breakpoints;
 pub mod driver;
 mod group;
 pub mod modes;
+mod options;
 pub mod pieces;
 pub mod scene;
 pub mod stats;
@@ -23,15 +24,16 @@ use std::time::Instant;
 
 use thiserror::Error;
 
-use crate::camera::{Camera, CameraParams};
-use crate::gpu::{AccumFormat, Context, DrawKind, GpuError, GpuOptions, PendingContext};
+use crate::camera::Camera;
+use crate::gpu::{Context, GpuError, PendingContext};
 use crate::image::Image;
 use crate::raycast::brute::Brute;
-use crate::raycast::{self, FieldModel, Raycaster, Traversal};
+use crate::raycast::{self, FieldModel, Raycaster};
 use crate::visibility::{Sorter, VisibilityError};
 
 pub use breakpoints::split_points;
 pub use modes::{Bounds, Mode, ModeInfo};
+pub use options::{Compositor, ProjectedOptions, ReferenceOptions, RenderOptions};
 pub use pieces::PieceError;
 pub use scene::{ScalarsRef, Scene, SceneSpec};
 pub use stats::{ModeStats, ProjectedStats, RaycastStats, RenderStats};
@@ -67,62 +69,6 @@ pub enum RenderError {
         model: crate::tf::EmissionModel,
         supported: String,
     },
-}
-
-/// Per-render options (camera, mode, field model, GPU).
-#[derive(Clone, Debug)]
-pub struct RenderOptions {
-    pub camera: CameraParams,
-    pub mode: Mode,
-    /// Field model of the ray caster.
-    pub model: FieldModel,
-    /// How the ray caster finds the pieces along a ray (walk by adjacency,
-    /// or brute force: `faces` and `tets` only).
-    pub traversal: Traversal,
-    /// `--split all`: every cell drawn as its consistent tets.
-    pub split_all: bool,
-    pub gpu: GpuOptions,
-    pub accum: AccumFormat,
-    /// Exact mode: leave out region triangles that contain no pixel centre
-    /// ([`crate::projection::coverage`]; on by default). The image is the
-    /// same either way; off only to check that.
-    pub cull_to_pixels: bool,
-    /// Exact mode: where the triangles are rasterised and composited: the
-    /// GPU, or its CPU twin ([`crate::gpu::cpu`]; no adapter needed).
-    pub compositor: Compositor,
-    /// Exact mode: composite, or count coverage (tests and diagnostics).
-    pub draw: DrawKind,
-    /// Exact mode on the CPU twin: the pixel whose fragments are listed in
-    /// [`ProjectedStats::watched`].
-    pub watch: Option<(u32, u32)>,
-}
-
-/// Where the exact mode's triangles are drawn.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Compositor {
-    /// wgpu ([`crate::gpu::Frame`]).
-    #[default]
-    Gpu,
-    /// The CPU twin of the GPU stage ([`crate::gpu::cpu::CpuFrame`]).
-    Cpu,
-}
-
-impl Default for RenderOptions {
-    fn default() -> Self {
-        RenderOptions {
-            camera: CameraParams::default(),
-            mode: Mode::Exact,
-            model: FieldModel::Faces,
-            traversal: Traversal::Walk,
-            split_all: false,
-            gpu: GpuOptions::default(),
-            accum: AccumFormat::Auto,
-            cull_to_pixels: true,
-            compositor: Compositor::Gpu,
-            draw: DrawKind::Composite,
-            watch: None,
-        }
-    }
 }
 
 /// Reusable state for rendering many views of one scene.

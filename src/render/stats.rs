@@ -38,7 +38,7 @@ pub struct ProjectedStats {
     /// reading the image back.
     pub gpu_total_s: f64,
     pub order: OrderStats,
-    /// CPU twin with [`super::RenderOptions::watch`]: the fragments drawn
+    /// CPU twin with [`super::ProjectedOptions::watch`]: the fragments drawn
     /// at the watched pixel, in drawing order.
     #[serde(skip)]
     pub watched: Vec<crate::gpu::cpu::Fragment>,

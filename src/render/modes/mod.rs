@@ -33,11 +33,12 @@ use crate::raycast::FieldModel;
 use crate::tf::EmissionModel;
 
 /// The rendering modes that exist (`--mode`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, ValueEnum, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Mode {
     /// Projection of convex pieces with exact vertex integrals, composited
     /// by wgpu.
+    #[default]
     Exact,
     /// The CPU reference ray caster.
     Raycast,

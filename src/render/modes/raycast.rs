@@ -48,41 +48,41 @@ pub(crate) fn render(
         scalars,
     };
     let ro = RaycastOptions {
-        model: opts.model,
-        traversal: opts.traversal,
+        model: opts.reference.model,
+        traversal: opts.reference.traversal,
         ..Default::default()
     };
     let mut stats = RaycastStats {
-        model: opts.model,
-        traversal: opts.traversal,
+        model: opts.reference.model,
+        traversal: opts.reference.traversal,
         termination_transmittance: ro.early_termination,
         native: Default::default(),
         brute: Default::default(),
     };
     let setup_s;
-    let img = match opts.traversal {
+    let img = match opts.reference.traversal {
         Traversal::Walk => {
             let rc = match r.raycaster.take() {
-                Some((m, rc)) if m == opts.model => rc,
-                _ => Raycaster::new(rs, opts.model)?,
+                Some((m, rc)) if m == opts.reference.model => rc,
+                _ => Raycaster::new(rs, opts.reference.model)?,
             };
             setup_s = t0.elapsed().as_secs_f64();
             let before = rc.native_stats();
             let img = rc.render_with_progress(&scene.tf, camera, &ro, progress);
             stats.native = rc.native_stats().since(&before);
-            r.raycaster = Some((opts.model, rc));
+            r.raycaster = Some((opts.reference.model, rc));
             img
         }
         Traversal::Brute => {
             let b = match r.brute.take() {
-                Some((m, b)) if m == opts.model => b,
-                _ => Brute::new(rs, opts.model)?,
+                Some((m, b)) if m == opts.reference.model => b,
+                _ => Brute::new(rs, opts.reference.model)?,
             };
             setup_s = t0.elapsed().as_secs_f64();
             let before = b.stats();
             let img = b.render_with_progress(&scene.tf, camera, &ro, progress);
             stats.brute = b.stats().since(&before);
-            r.brute = Some((opts.model, b));
+            r.brute = Some((opts.reference.model, b));
             img
         }
     };

@@ -34,7 +34,7 @@ impl Sorter {
         stats: &mut OrderStats,
     ) -> Order {
         let levels = match policy.point_scalars {
-            Some(_) => slabs::order_levels(&policy.breakpoints),
+            Some(_) => slabs::order_levels(policy.breakpoints),
             None => Vec::new(),
         };
         let writer = |capacity: usize| OrderWriter {

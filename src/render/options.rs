@@ -1,0 +1,110 @@
+//! What one render is asked to do: the camera, the mode, the GPU, and the
+//! typed options of each kind of mode. Each kind's options print as one
+//! line (`Display`) and serialise (serde) for reports and `bench`.
+
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::camera::CameraParams;
+use crate::gpu::{AccumFormat, DrawKind, GpuOptions};
+use crate::raycast::{FieldModel, Traversal};
+
+use super::Mode;
+
+/// Per-render options.
+#[derive(Clone, Debug, Default)]
+pub struct RenderOptions {
+    pub camera: CameraParams,
+    pub mode: Mode,
+    pub gpu: GpuOptions,
+    pub accum: AccumFormat,
+    /// Options of the projected-cell modes ([`super::driver`]).
+    pub projected: ProjectedOptions,
+    /// Options of the reference ray caster.
+    pub reference: ReferenceOptions,
+}
+
+/// Where a projected-cell mode's triangles are drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Compositor {
+    /// wgpu ([`crate::gpu::Frame`]).
+    #[default]
+    Gpu,
+    /// The CPU twin of the GPU stage ([`crate::gpu::cpu::CpuFrame`]).
+    Cpu,
+}
+
+/// Options of the projected-cell modes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct ProjectedOptions {
+    /// `--split all`: every cell drawn as its consistent tets.
+    pub split_all: bool,
+    /// Leave out region triangles that contain no pixel centre
+    /// ([`crate::projection::coverage`]; on by default). The image is the
+    /// same either way; off only to check that.
+    pub cull_to_pixels: bool,
+    /// Where the triangles are rasterised and composited: the GPU, or its
+    /// CPU twin ([`crate::gpu::cpu`]; no adapter needed).
+    pub compositor: Compositor,
+    /// Composite, or count coverage (tests and diagnostics).
+    pub draw: DrawKind,
+    /// On the CPU twin: the pixel whose fragments are listed in
+    /// [`super::ProjectedStats::watched`].
+    pub watch: Option<(u32, u32)>,
+}
+
+impl Default for ProjectedOptions {
+    fn default() -> Self {
+        ProjectedOptions {
+            split_all: false,
+            cull_to_pixels: true,
+            compositor: Compositor::Gpu,
+            draw: DrawKind::Composite,
+            watch: None,
+        }
+    }
+}
+
+impl fmt::Display for ProjectedOptions {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}, coverage culling {}, compositor {:?}, draw {:?}",
+            if self.split_all {
+                "every cell as its tets"
+            } else {
+                "whole cells"
+            },
+            if self.cull_to_pixels { "on" } else { "off" },
+            self.compositor,
+            self.draw
+        )?;
+        if let Some((i, j)) = self.watch {
+            write!(f, ", watching pixel ({i}, {j})")?;
+        }
+        Ok(())
+    }
+}
+
+/// Options of the reference ray caster.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct ReferenceOptions {
+    /// Field model of the ray caster.
+    pub model: FieldModel,
+    /// How the ray caster finds the pieces along a ray (walk by adjacency,
+    /// or brute force: `faces` and `tets` only).
+    pub traversal: Traversal,
+}
+
+impl fmt::Display for ReferenceOptions {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "model {}, traversal {}",
+            self.model.name(),
+            self.traversal.name()
+        )
+    }
+}
