@@ -105,17 +105,13 @@ pub trait ProjectedMode: Sync {
         refined: &mut usize,
     );
 
-    /// The vertex at barycentric weights `weights` of region triangle
-    /// `corners` of `proj` (an affine combination of the corners' payload,
-    /// weights summing to 1, possibly slightly outside `[0, 1]`), drawn at
-    /// normalised device coordinates `ndc`, in piece 0 (the driver numbers
-    /// the pieces).
+    /// Vertex `i` of `proj` at normalised device coordinates `ndc` (on the
+    /// sub-pixel grid), in piece 0 (the driver numbers the pieces).
     fn vertex(
         &self,
         payload: &Self::Payload,
         proj: &Projected,
-        corners: [u32; 3],
-        weights: [f64; 3],
+        i: usize,
         ndc: [f32; 2],
     ) -> Self::Vertex;
 }
@@ -246,11 +242,8 @@ fn draw_part<M: ProjectedMode>(
         };
         w.remap.push(out.vertices.len() as u32);
         w.grid.push(g);
-        let c = i as u32;
-        out.vertices.push(
-            mode.vertex(&w.payload, proj, [c, c, c], [1.0, 0.0, 0.0], ndc)
-                .with_piece(piece),
-        );
+        out.vertices
+            .push(mode.vertex(&w.payload, proj, i, ndc).with_piece(piece));
     }
     for t in &proj.triangles {
         let idx = t.map(|i| w.remap[i as usize]);

@@ -334,24 +334,15 @@ impl ProjectedMode for ExactMode {
         &self,
         payload: &ExactPayload,
         proj: &Projected,
-        corners: [u32; 3],
-        weights: [f64; 3],
+        i: usize,
         ndc: [f32; 2],
     ) -> ExactVertex {
-        let k = payload.balance;
-        let mut a = [0.0f64; 5];
-        for (&i, &w) in corners.iter().zip(&weights) {
-            let (v, vv) = (&proj.vertices[i as usize], &payload.values[i as usize]);
-            let at = [v.l * k, vv.tau_mean / k, vv.glow[0], vv.glow[1], vv.glow[2]];
-            for (s, x) in a.iter_mut().zip(at) {
-                *s += w * x;
-            }
-        }
+        let (v, vv, k) = (&proj.vertices[i], &payload.values[i], payload.balance);
         ExactVertex::new(
             [ndc[0], ndc[1], 0.5, 1.0],
-            a[0] as f32,
-            a[1] as f32,
-            [a[2] as f32, a[3] as f32, a[4] as f32],
+            (v.l * k) as f32,
+            (vv.tau_mean / k) as f32,
+            [vv.glow[0] as f32, vv.glow[1] as f32, vv.glow[2] as f32],
         )
     }
 }
