@@ -74,7 +74,7 @@ fn registry_is_complete() {
             assert!(
                 SHADERS
                     .iter()
-                    .any(|(n, s)| *n == stage.name && *s == stage.wgsl),
+                    .any(|(n, s)| *n == stage.name && stage.wgsl.ends_with(s)),
                 "{}: its shader {} is not in SHADERS",
                 info.name,
                 stage.name

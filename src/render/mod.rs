@@ -143,6 +143,9 @@ impl<'s> Renderer<'s> {
         }
         let (image, detail, setup_s) = match opts.mode {
             Mode::Exact => self.projected(&modes::exact::ExactMode, opts, camera, progress)?,
+            Mode::ExactFrag => {
+                self.projected(&modes::exact_frag::ExactFragMode, opts, camera, progress)?
+            }
             Mode::Raycast => {
                 let (img, s, setup) = modes::raycast::render(self, opts, camera, progress)?;
                 (img, ModeStats::Raycast(s), setup)
