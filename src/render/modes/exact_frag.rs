@@ -32,7 +32,7 @@ use crate::render::pieces::PieceSource;
 use crate::tf::{EmissionModel, TransferFunction};
 
 use super::integral::{closed_form_constants, TfBuffer};
-use super::segment::{segment_at, ScalarMap, SegmentVertex, SegmentView};
+use super::segment::{segment_at, ScalarMap, SegmentPayload, SegmentVertex, SegmentView};
 use super::{Bounds, ModeInfo};
 
 /// The registry entry of the exact-frag mode.
@@ -125,34 +125,6 @@ impl CpuStage<SegmentVertex> for ExactFragTwin {
     fn describe(&self, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {
         let seg = segment_at(&self.view, &self.mapper, tri, bary);
         vec![("s_f", seg.s_f), ("s_b", seg.s_b), ("l", seg.l)]
-    }
-}
-
-/// The payload of the segment modes for one part: the frame's scalar map
-/// and projection (the values themselves are the projection's).
-#[derive(Clone, Copy, Debug)]
-pub struct SegmentPayload {
-    pub map: ScalarMap,
-    pub ortho: bool,
-}
-
-impl Default for SegmentPayload {
-    fn default() -> Self {
-        SegmentPayload {
-            map: ScalarMap {
-                offset: 0.0,
-                scale: 1.0,
-            },
-            ortho: true,
-        }
-    }
-}
-
-impl SegmentPayload {
-    /// Sets the frame's map and projection from `src`.
-    pub fn set(&mut self, src: &PieceSource) {
-        self.map = ScalarMap::of(src.tf);
-        self.ortho = src.camera.ortho;
     }
 }
 

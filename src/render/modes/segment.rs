@@ -28,6 +28,7 @@ use crate::camera::Camera;
 use crate::gpu::cpu::lerp;
 use crate::gpu::{ClipMapper, GpuVertex};
 use crate::projection::{Projected, ViewMap};
+use crate::render::pieces::PieceSource;
 use crate::tf::TransferFunction;
 
 /// Normalised scalars beyond this magnitude are clamped (they lie far in the
@@ -231,6 +232,34 @@ pub fn segment_at(
         s_b,
         l,
         ok: s_f.is_finite() && s_b.is_finite() && l.is_finite(),
+    }
+}
+
+/// The payload of the segment modes for one part: the frame's scalar map
+/// and projection (the values themselves are the projection's).
+#[derive(Clone, Copy, Debug)]
+pub struct SegmentPayload {
+    pub map: ScalarMap,
+    pub ortho: bool,
+}
+
+impl Default for SegmentPayload {
+    fn default() -> Self {
+        SegmentPayload {
+            map: ScalarMap {
+                offset: 0.0,
+                scale: 1.0,
+            },
+            ortho: true,
+        }
+    }
+}
+
+impl SegmentPayload {
+    /// Sets the frame's map and projection from `src`.
+    pub fn set(&mut self, src: &PieceSource) {
+        self.map = ScalarMap::of(src.tf);
+        self.ortho = src.camera.ortho;
     }
 }
 
