@@ -63,11 +63,12 @@ pub enum RenderError {
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Raycast(#[from] raycast::RaycastError),
-    #[error("the {mode} mode cannot draw {model:?} emission (it supports {supported}); use --mode raycast")]
+    #[error("the {mode} mode cannot draw {model:?} emission (it supports {supported}); modes that can: --mode {alternatives}")]
     Unsupported {
         mode: &'static str,
         model: crate::tf::EmissionModel,
         supported: String,
+        alternatives: String,
     },
 }
 
@@ -139,6 +140,12 @@ impl<'s> Renderer<'s> {
                 mode: info.name,
                 model,
                 supported: format!("{:?}", info.emission),
+                alternatives: Mode::ALL
+                    .iter()
+                    .filter(|m| m.info().emission.contains(&model))
+                    .map(|m| m.name())
+                    .collect::<Vec<_>>()
+                    .join(", --mode "),
             });
         }
         let (image, detail, setup_s) = match opts.mode {

@@ -70,20 +70,18 @@ pub static EXACT_FRAG_STAGE: StageDesc = StageDesc {
     bindings: &[Binding::Uniform, Binding::Storage, Binding::Storage],
 };
 
-/// Binds the exact-frag stage for one frame: the view of `camera` and the
-/// transfer function.
+/// Binds the exact-frag stage for one frame: its view and transfer
+/// function (normalised as the vertices' scalars are).
 pub fn bind_exact_frag_stage(
     gpu: &Context,
-    tf: &TransferFunction,
-    camera: &crate::camera::Camera,
+    view: &SegmentView,
+    tf: &TfBuffer,
 ) -> Result<Stage, GpuError> {
-    let view = SegmentView::of(camera);
-    let tf = TfBuffer::new(tf, &ScalarMap::of(tf));
     let consts = closed_form_constants();
     gpu.bind_stage(
         &EXACT_FRAG_STAGE,
         &[
-            Resource::Uniform(bytemuck::bytes_of(&view)),
+            Resource::Uniform(bytemuck::bytes_of(view)),
             Resource::Storage(&tf.bytes()),
             Resource::Storage(bytemuck::cast_slice(&consts)),
         ],
@@ -101,10 +99,20 @@ pub struct ExactFragTwin {
 impl ExactFragTwin {
     /// The twin for `tf` seen by `camera`.
     pub fn new(tf: &TransferFunction, camera: &crate::camera::Camera) -> ExactFragTwin {
+        ExactFragTwin::with(
+            SegmentView::of(camera),
+            ClipMapper::for_camera(camera),
+            TfBuffer::new(tf, &ScalarMap::of(tf)),
+        )
+    }
+
+    /// The twin of a stage bound to `view` and `tf`, drawing through
+    /// `mapper`.
+    pub fn with(view: SegmentView, mapper: ClipMapper, tf: TfBuffer) -> ExactFragTwin {
         ExactFragTwin {
-            view: SegmentView::of(camera),
-            mapper: ClipMapper::for_camera(camera),
-            tf: TfBuffer::new(tf, &ScalarMap::of(tf)),
+            view,
+            mapper,
+            tf,
             consts: closed_form_constants(),
         }
     }
@@ -144,7 +152,8 @@ impl ProjectedMode for ExactFragMode {
     }
 
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
-        bind_exact_frag_stage(gpu, src.tf, src.camera)
+        let tf = TfBuffer::new(src.tf, &ScalarMap::of(src.tf));
+        bind_exact_frag_stage(gpu, &SegmentView::of(src.camera), &tf)
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {

@@ -174,6 +174,14 @@ pub struct SegmentView {
 }
 
 impl SegmentView {
+    /// An orthographic view (the fragment's position is not needed).
+    pub fn ortho() -> SegmentView {
+        SegmentView {
+            ortho: 1,
+            ..Default::default()
+        }
+    }
+
     /// The view of `camera` (framebuffer position = continuous pixel
     /// position, see [`crate::gpu::raster_side`]).
     pub fn of(camera: &Camera) -> SegmentView {
