@@ -135,8 +135,8 @@ fn composite(parts: impl Iterator<Item = [f32; 4]>) -> [f32; 4] {
 
 fn check(case: &Case, got: [f32; 4], how: &str) -> f64 {
     let mut worst = 0.0f64;
-    for k in 0..4 {
-        let (g, e) = (got[k] as f64, case.expected[k]);
+    for (k, (&g, &e)) in got.iter().zip(&case.expected).enumerate() {
+        let g = g as f64;
         let err = (g - e).abs();
         assert!(
             err <= REL * e.abs() + ABS,
