@@ -492,6 +492,39 @@ mod tests {
         assert!(worst < 2e-6, "{worst:e}");
     }
 
+    /// Thickness and extinction of 0, 1e-12 and 1e12 (and far beyond), any
+    /// scalars: finite colour, opacity in [0, 1].
+    #[test]
+    fn extreme_inputs_stay_finite() {
+        use crate::tf::Node;
+        let c = closed_form_constants();
+        for model in [EmissionModel::Glow, EmissionModel::Independent] {
+            for tau in [0.0, 1e-12, 1.0, 1e12, 1e30] {
+                let node = |s: f64, t: f64| Node {
+                    s,
+                    tau: t,
+                    color: [0.5, 1.0, 0.2],
+                    emission: [1e3, 0.0, 2.0],
+                };
+                let tf = TransferFunction::from_nodes(
+                    &[node(0.0, 0.0), node(0.5, tau), node(0.5, 0.1 * tau), node(1.0, tau)],
+                    model,
+                )
+                .unwrap();
+                let buf = TfBuffer::new(&tf, &ScalarMap::of(&tf));
+                for l in [0.0f32, 1e-12, 1e-3, 1.0, 1e12, 1e38, f32::INFINITY, f32::NAN] {
+                    for (sf, sb) in [(0.0f32, 1.0f32), (1.0, 0.0), (0.5, 0.5), (-1e30, 1e30), (0.2, f32::NAN)] {
+                        let v = buf.integrate_segment(&c, l, sf, sb);
+                        assert!(
+                            v.iter().all(|x| x.is_finite()) && (0.0..=1.0).contains(&v[3]),
+                            "{model:?} tau {tau} l {l} s {sf}..{sb}: {v:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
     /// The short rules integrate polynomials of degree 2n - 1 exactly.
     #[test]
     fn gauss_rules_are_exact_to_their_degree() {
