@@ -1,4 +1,5 @@
-//! The exact mode end to end: bluntfin (default field and TF), the
+//! Every GPU mode end to end (`RENDER_BENCH_MODES=exact,exact-frag` picks),
+//! with its error against the reference ray caster (`faces`, PNG values): bluntfin (default field and TF), the
 //! hex_shell scene of `../shared/data/synthetic/README.md` (bench_tf.json,
 //! azimuth 20, elevation 35, zoom 1.25, perspective) and the generated
 //! 1M-hex grid, at 512^2 and 1024^2, on every backend present (Vulkan
@@ -28,6 +29,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use zoovr::camera::CameraParams;
 use zoovr::generate::{warped_hex_grid, Warp};
 use zoovr::gpu::{Backend, Context, GpuOptions};
+use zoovr::image::compare_display;
 use zoovr::io::{self, ReadOptions};
 use zoovr::render::{Mode, RenderOptions, Renderer, Scene, SceneSpec};
 use zoovr::testdata::shared_file;
@@ -97,45 +99,83 @@ fn bench(c: &mut Criterion) {
         eprintln!("no GPU adapter: nothing to bench");
         return;
     }
+    // Every GPU mode of the registry (RENDER_BENCH_MODES=a,b to pick).
+    let picked = std::env::var("RENDER_BENCH_MODES").ok();
+    let modes: Vec<Mode> = Mode::ALL
+        .iter()
+        .copied()
+        .filter(|m| m.info().gpu)
+        .filter(|m| {
+            picked
+                .as_deref()
+                .is_none_or(|p| p.split(',').any(|n| n == m.name()))
+        })
+        .collect();
     for (name, scene, cam) in scenes() {
-        for &(bname, gpu) in &backends {
-            let mut renderer = Renderer::new(&scene);
-            for size in [512u32, 1024] {
+        let mut renderer = Renderer::new(&scene);
+        for size in [512u32, 1024] {
+            let camera = CameraParams {
+                width: size,
+                height: size,
+                ..cam
+            };
+            // The reference image (faces model) for each mode's error.
+            let reference = if name == "grid_1m" {
+                None
+            } else {
                 let opts = RenderOptions {
-                    camera: CameraParams {
-                        width: size,
-                        height: size,
-                        ..cam
-                    },
-                    mode: Mode::Exact,
-                    gpu,
+                    camera,
+                    mode: Mode::Raycast,
                     ..Default::default()
                 };
-                // The first frame builds the sorter and opens the device.
-                let (_, first) = renderer.render(&opts, |_, _| {}).unwrap();
-                let (_, s) = renderer.render(&opts, |_, _| {}).unwrap();
-                let e = s.projected().unwrap();
-                eprintln!(
-                    "{name} {bname} {size}: frame {:.2} s (first {:.2} s) = sort {:.3} + project/integrals {:.2} + gpu {:.2} (upload+draw {:.2}, wait {:.2}, readback {:.3}); {} pieces, {} triangles, {} batches",
-                    s.total_s,
-                    first.total_s,
-                    e.sort_s,
-                    e.project_s,
-                    e.gpu_total_s,
-                    e.gpu.upload_s,
-                    e.gpu.gpu_wait_s,
-                    e.gpu.readback_s,
-                    e.pieces,
-                    e.triangles,
-                    e.gpu.batches
-                );
-                if name == "bluntfin" {
-                    let mut g = c.benchmark_group(format!("exact/{name}/{bname}"));
-                    g.sample_size(10).measurement_time(Duration::from_secs(8));
-                    g.bench_function(format!("{size}"), |b| {
-                        b.iter(|| renderer.render(&opts, |_, _| {}).unwrap())
-                    });
-                    g.finish();
+                Some(renderer.render(&opts, |_, _| {}).unwrap().0)
+            };
+            for &(bname, gpu) in &backends {
+                for &mode in &modes {
+                    let opts = RenderOptions {
+                        camera,
+                        mode,
+                        gpu,
+                        ..Default::default()
+                    };
+                    // The first frame builds the sorter and opens the device.
+                    let (_, first) = renderer.render(&opts, |_, _| {}).unwrap();
+                    let (img, s) = renderer.render(&opts, |_, _| {}).unwrap();
+                    let e = s.projected().unwrap();
+                    let err = reference
+                        .as_ref()
+                        .map(|r| {
+                            let (d, _) = compare_display(&img, r, [0.0; 3]).unwrap();
+                            format!(
+                                "max {:.2e} rms {:.2e} ({:.3}/255)",
+                                d.max_abs,
+                                d.rms,
+                                d.rms * 255.0
+                            )
+                        })
+                        .unwrap_or_default();
+                    eprintln!(
+                        "{name} {mode} {bname} {size}: frame {:.2} s (first {:.2} s) = sort {:.3} + project/payload {:.2} + gpu {:.2} (upload+draw {:.2}, wait {:.2}, readback {:.3}); {} pieces, {} triangles, {} batches; error {err}",
+                        s.total_s,
+                        first.total_s,
+                        e.sort_s,
+                        e.project_s,
+                        e.gpu_total_s,
+                        e.gpu.upload_s,
+                        e.gpu.gpu_wait_s,
+                        e.gpu.readback_s,
+                        e.pieces,
+                        e.triangles,
+                        e.gpu.batches
+                    );
+                    if name == "bluntfin" {
+                        let mut g = c.benchmark_group(format!("{mode}/{name}/{bname}"));
+                        g.sample_size(10).measurement_time(Duration::from_secs(8));
+                        g.bench_function(format!("{size}"), |b| {
+                            b.iter(|| renderer.render(&opts, |_, _| {}).unwrap())
+                        });
+                        g.finish();
+                    }
                 }
             }
         }

@@ -507,13 +507,33 @@ mod tests {
                     emission: [1e3, 0.0, 2.0],
                 };
                 let tf = TransferFunction::from_nodes(
-                    &[node(0.0, 0.0), node(0.5, tau), node(0.5, 0.1 * tau), node(1.0, tau)],
+                    &[
+                        node(0.0, 0.0),
+                        node(0.5, tau),
+                        node(0.5, 0.1 * tau),
+                        node(1.0, tau),
+                    ],
                     model,
                 )
                 .unwrap();
                 let buf = TfBuffer::new(&tf, &ScalarMap::of(&tf));
-                for l in [0.0f32, 1e-12, 1e-3, 1.0, 1e12, 1e38, f32::INFINITY, f32::NAN] {
-                    for (sf, sb) in [(0.0f32, 1.0f32), (1.0, 0.0), (0.5, 0.5), (-1e30, 1e30), (0.2, f32::NAN)] {
+                for l in [
+                    0.0f32,
+                    1e-12,
+                    1e-3,
+                    1.0,
+                    1e12,
+                    1e38,
+                    f32::INFINITY,
+                    f32::NAN,
+                ] {
+                    for (sf, sb) in [
+                        (0.0f32, 1.0f32),
+                        (1.0, 0.0),
+                        (0.5, 0.5),
+                        (-1e30, 1e30),
+                        (0.2, f32::NAN),
+                    ] {
                         let v = buf.integrate_segment(&c, l, sf, sb);
                         assert!(
                             v.iter().all(|x| x.is_finite()) && (0.0..=1.0).contains(&v[3]),
