@@ -1,10 +1,10 @@
-//! Takes one pixel of the exact mode apart: renders a file with the CPU twin
+//! Takes one pixel of a projected mode (`--mode NAME`, default exact) apart: renders a file with the CPU twin
 //! of the GPU stage (`zoovr::gpu::cpu`) and the reference ray caster, and
 //! prints both values at the pixel, the fragments that coloured it (piece,
 //! interpolated thickness, extinction, glow) and the ray caster's segments.
 //!
 //! ```sh
-//! cargo run --release --example pixel -- FILE I J [WIDTH] [--height H] [--ortho] [--azimuth A] [--elevation E] [--zoom Z] [--split]
+//! cargo run --release --example pixel -- FILE I J [WIDTH] [--height H] [--ortho] [--azimuth A] [--elevation E] [--zoom Z] [--split] [--mode NAME] [--no-cull]
 //! ```
 
 use anyhow::{anyhow, Context as _, Result};
@@ -45,15 +45,25 @@ fn main() -> Result<()> {
         ..Default::default()
     };
     let split_all = args.iter().any(|a| a == "--split");
+    let mode: Mode = match args.iter().position(|a| a == "--mode") {
+        Some(k) => args
+            .get(k + 1)
+            .context("--mode NAME")?
+            .parse()
+            .map_err(|e: String| anyhow!(e))?,
+        None => Mode::Exact,
+    };
     let mesh = io::read(std::path::Path::new(file), &ReadOptions::default())?;
     let scene = Scene::build(mesh, &SceneSpec::default())?;
     let mut renderer = Renderer::new(&scene);
     let opts = RenderOptions {
         camera,
+        mode,
         projected: ProjectedOptions {
             split_all,
             compositor: Compositor::Cpu,
             watch: Some((i, j)),
+            cull_to_pixels: !args.iter().any(|a| a == "--no-cull"),
             ..Default::default()
         },
         ..Default::default()
@@ -82,16 +92,16 @@ fn main() -> Result<()> {
     };
     match renderer.render(&gopts, |_, _| {}) {
         Ok((g, _)) => {
-            println!("exact (gpu)      {:?}", g.get(i, j));
+            println!("{mode} (gpu)      {:?}", g.get(i, j));
             let (d, _) = zoovr::image::compare_display(&g, &img, [0.0; 3])?;
             println!(
                 "gpu vs twin: max {:.3e} at {:?}, rms {:.3e}",
                 d.max_abs, d.worst, d.rms
             );
         }
-        Err(e) => println!("exact (gpu)      unavailable: {e}"),
+        Err(e) => println!("{mode} (gpu)      unavailable: {e}"),
     }
-    println!("exact (cpu twin) {:?}", img.get(i, j));
+    println!("{mode} (cpu twin) {:?}", img.get(i, j));
     println!("raycast ({})    {:?}", model.name(), reference.get(i, j));
     for f in &stats
         .projected()

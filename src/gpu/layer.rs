@@ -75,6 +75,21 @@ impl GpuVertex for LayerVertex {
     fn is_finite(&self) -> bool {
         self.pos.iter().chain(&self.rgba).all(|v| v.is_finite())
     }
+    fn with_clip(self, pos: [f32; 4]) -> Self {
+        LayerVertex { pos, ..self }
+    }
+    fn lerp3(tri: [&Self; 3], bary: [f64; 3]) -> Self {
+        LayerVertex {
+            rgba: [0, 1, 2, 3].map(|k| super::cpu::lerp(tri, bary, |v| v.rgba[k])),
+            ..*tri[0]
+        }
+    }
+    fn transparent(self) -> Self {
+        LayerVertex {
+            rgba: [0.0; 4],
+            ..self
+        }
+    }
 }
 
 /// The layer stage.

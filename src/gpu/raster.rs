@@ -34,6 +34,15 @@ pub trait GpuVertex: Pod + Send + Sync {
     fn with_piece(self, piece: u32) -> Self;
     /// Whether every value the shader reads is finite.
     fn is_finite(&self) -> bool;
+    /// This vertex at clip position `clip`.
+    fn with_clip(self, clip: [f32; 4]) -> Self;
+    /// The attributes at barycentric weights `bary` of `tri`, interpolated
+    /// as the rasteriser does (linearly: the projected-cell modes send
+    /// `w = 1`); position and piece of `tri[0]`.
+    fn lerp3(tri: [&Self; 3], bary: [f64; 3]) -> Self;
+    /// This vertex with attributes that make the stage draw nothing
+    /// (premultiplied colour and opacity 0) but still pass the depth test.
+    fn transparent(self) -> Self;
 }
 
 /// The depth key of piece number `piece` in drawing order (CPU twin of

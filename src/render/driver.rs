@@ -62,6 +62,7 @@ use super::group::composite_group;
 use super::pieces::{PartScratch, PieceError, PieceSource};
 use super::scene::{ScalarsRef, Scene};
 use super::stats::ProjectedStats;
+use super::ties::{fix_ties, PartTriangles, TieScratch};
 use super::workers::run_ordered;
 use super::{Compositor, RenderError, RenderOptions};
 
@@ -137,6 +138,9 @@ pub(super) struct ChunkOut<V> {
     /// Triangles dropped as degenerate on the sub-pixel grid
     /// ([`grid_area_positive`]).
     degenerate: usize,
+    /// Pixel quads deciding centres next to a part's outline
+    /// ([`super::ties`]).
+    tie_pixels: usize,
     pub(super) error: Option<PieceError>,
 }
 
@@ -150,6 +154,7 @@ impl<V> Default for ChunkOut<V> {
             slabs: 0,
             refined: 0,
             degenerate: 0,
+            tie_pixels: 0,
             error: None,
         }
     }
@@ -165,12 +170,13 @@ impl<V> ChunkOut<V> {
         self.slabs = 0;
         self.refined = 0;
         self.degenerate = 0;
+        self.tie_pixels = 0;
         self.error = None;
     }
 }
 
 /// Scratch of one worker, reused from piece to piece.
-struct Worker<P> {
+struct Worker<P, V> {
     projector: Projector,
     parts: PartScratch,
     proj: Projected,
@@ -180,9 +186,14 @@ struct Worker<P> {
     used: Vec<bool>,
     remap: Vec<u32>,
     grid: Vec<[i64; 2]>,
+    /// Triangles drawn, with their snapped corners, and the pixel quads
+    /// of the centres next to the outline ([`super::ties`]).
+    drawn: Vec<([u32; 3], [[i64; 2]; 3])>,
+    ties: TieScratch,
+    quad_vertices: Vec<V>,
 }
 
-impl<P: Default> Worker<P> {
+impl<P: Default, V> Worker<P, V> {
     fn new(src: &PieceSource, perspective_refine: bool) -> Self {
         let mut projector = Projector::new();
         // Pieces cut by the near plane reach ~1e9 pixels off screen: clip
@@ -199,6 +210,9 @@ impl<P: Default> Worker<P> {
             used: Vec::new(),
             remap: Vec::new(),
             grid: Vec::new(),
+            drawn: Vec::new(),
+            ties: TieScratch::default(),
+            quad_vertices: Vec::new(),
         }
     }
 }
@@ -209,7 +223,7 @@ fn draw_part<M: ProjectedMode>(
     mode: &M,
     src: &PieceSource,
     part: &Polyhedron,
-    w: &mut Worker<M::Payload>,
+    w: &mut Worker<M::Payload, M::Vertex>,
     out: &mut ChunkOut<M::Vertex>,
 ) -> Result<(), crate::projection::ProjectionError> {
     w.projector.project(part, src.camera, &mut w.proj)?;
@@ -254,18 +268,54 @@ fn draw_part<M: ProjectedMode>(
         out.vertices
             .push(mode.vertex(&w.payload, proj, i, ndc).with_piece(piece));
     }
+    let drawn = &mut w.drawn;
+    drawn.clear();
     for t in &proj.triangles {
         let idx = t.map(|i| w.remap[i as usize]);
         if idx.contains(&u32::MAX) {
             out.degenerate += 1;
             continue;
         }
-        let [a, b, c] = idx.map(|i| w.grid[(i - first) as usize]);
-        if grid_area_positive(a, b, c) {
-            out.indices.extend_from_slice(&idx);
+        let g = idx.map(|i| w.grid[(i - first) as usize]);
+        if grid_area_positive(g[0], g[1], g[2]) {
+            drawn.push((*t, g));
         } else {
             out.degenerate += 1;
         }
+    }
+    // Centres next to the outline first (they decide their pixels), then
+    // the triangles.
+    let part_tris = PartTriangles {
+        proj,
+        drawn,
+        exact: &proj.triangles,
+        width: src.camera.width,
+        height: src.camera.height,
+    };
+    let vertices = &out.vertices;
+    let remap = &w.remap;
+    let mut quad_v = std::mem::take(&mut w.quad_vertices);
+    quad_v.clear();
+    let mut quad_i = Vec::new();
+    out.tie_pixels += fix_ties(
+        &part_tris,
+        &mapper,
+        |i| {
+            let r = remap[i as usize];
+            (r != u32::MAX).then(|| vertices[r as usize])
+        },
+        piece,
+        &mut w.ties,
+        &mut quad_v,
+        &mut quad_i,
+    );
+    let base = out.vertices.len() as u32;
+    out.vertices.extend_from_slice(&quad_v);
+    out.indices.extend(quad_i.iter().map(|&i| i + base));
+    w.quad_vertices = quad_v;
+    for (t, _) in w.drawn.iter() {
+        out.indices
+            .extend_from_slice(&t.map(|i| w.remap[i as usize]));
     }
     Ok(())
 }
@@ -299,7 +349,7 @@ fn process_chunk<M: ProjectedMode>(
     pieces: &[Piece],
     mut out: ChunkOut<M::Vertex>,
 ) -> ChunkOut<M::Vertex> {
-    let mut w = Worker::<M::Payload>::new(src, mode.perspective_refine());
+    let mut w = Worker::<M::Payload, M::Vertex>::new(src, mode.perspective_refine());
     for piece in pieces {
         let mut parts = std::mem::take(&mut w.parts);
         let done = src.parts(piece, &mut parts, |part| {
@@ -433,6 +483,7 @@ fn push_out<V: GpuVertex>(
     stats.culled_pieces += out.culled;
     stats.slabs += out.slabs;
     stats.refined_triangles += out.refined;
+    stats.tie_pixels += out.tie_pixels;
     stats.triangles += out.indices.len() / 3;
     sink.push(&out.vertices, &out.indices)?;
     Ok(())

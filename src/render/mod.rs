@@ -18,6 +18,7 @@ mod options;
 pub mod pieces;
 pub mod scene;
 pub mod stats;
+pub mod ties;
 mod workers;
 
 use std::time::Instant;

@@ -23,6 +23,9 @@ pub struct ProjectedStats {
     pub slabs: usize,
     pub triangles: usize,
     pub refined_triangles: usize,
+    /// Pixel centres next to a part's outline that snapping would have put
+    /// on the wrong side, decided by a pixel quad ([`super::ties`]).
+    pub tie_pixels: usize,
     /// Pixels of the per-pixel layers of cycle groups
     /// ([`super::group`]).
     pub group_pixels: usize,
@@ -71,8 +74,8 @@ impl fmt::Display for ProjectedStats {
         )?;
         writeln!(
             f,
-            "project+draw {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles)",
-            e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles
+            "project+draw {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles, {} tie pixels)",
+            e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles, e.tie_pixels
         )?;
         write!(
             f,

@@ -118,6 +118,24 @@ impl GpuVertex for ExactVertex {
             && self.tau.is_finite()
             && self.glow.iter().all(|v| v.is_finite())
     }
+    fn with_clip(self, pos: [f32; 4]) -> Self {
+        ExactVertex { pos, ..self }
+    }
+    fn lerp3(tri: [&Self; 3], bary: [f64; 3]) -> Self {
+        ExactVertex {
+            thickness: lerp(tri, bary, |v| v.thickness),
+            tau: lerp(tri, bary, |v| v.tau),
+            glow: [0, 1, 2].map(|k| lerp(tri, bary, |v| v.glow[k])),
+            ..*tri[0]
+        }
+    }
+    fn transparent(self) -> Self {
+        // alpha_of(0, tau) = 0, and the colour is glow * alpha.
+        ExactVertex {
+            thickness: 0.0,
+            ..self
+        }
+    }
 }
 
 /// Uniforms of the exact stage. Keep in sync with `Params` in

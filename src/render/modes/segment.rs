@@ -128,6 +128,21 @@ impl GpuVertex for SegmentVertex {
             && self.back.iter().all(|v| v.is_finite())
             && self.thick.is_finite()
     }
+    fn with_clip(self, pos: [f32; 4]) -> Self {
+        SegmentVertex { pos, ..self }
+    }
+    fn lerp3(tri: [&Self; 3], bary: [f64; 3]) -> Self {
+        SegmentVertex {
+            front: [0, 1].map(|k| lerp(tri, bary, |v| v.front[k])),
+            back: [0, 1].map(|k| lerp(tri, bary, |v| v.back[k])),
+            thick: lerp(tri, bary, |v| v.thick),
+            ..*tri[0]
+        }
+    }
+    fn transparent(self) -> Self {
+        // l = 0: the empty segment.
+        SegmentVertex { thick: 0.0, ..self }
+    }
 }
 
 /// The affine map sending data scalars to the values the segment stages
