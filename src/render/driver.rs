@@ -20,12 +20,16 @@
 //!    ([`ClipMapper::ndc`]), drops triangles that are flat or inverted
 //!    there ([`grid_area_positive`]), and numbers the part as one piece
 //!    (each piece colours a pixel at most once, [`crate::gpu::frame`]).
-//!    Corners carry the payload of the exact (unsnapped) corner: snapping
-//!    moves them by up to 1/512 px, which costs the payload's gradient
-//!    times that shift where a face is seen nearly edge-on (measured up to
-//!    5.5e-2 at the plane cuts of cycle groups). Giving each triangle the
-//!    exact triangle's affine payload at its snapped corners removes that
-//!    but extrapolates on near-slivers (measured 1.5e-2 on other scenes):
+//!    Pixel centres within snapping distance of the part's outline are
+//!    decided on the exact geometry ([`super::ties`]): where the snapped
+//!    triangles would take or leave a centre the exact part does not, a
+//!    pixel quad drawn first in the part decides it. Corners carry the
+//!    payload of the exact (unsnapped) corner: snapping moves them by up
+//!    to 1/512 px, which costs the payload's gradient times that shift
+//!    where a face is seen nearly edge-on (measured up to 5.5e-2 at the
+//!    plane cuts of cycle groups). Giving each triangle the exact
+//!    triangle's affine payload at its snapped corners removes that but
+//!    extrapolates on near-slivers (measured 1.5e-2 on other scenes):
 //!    still open.
 //!
 //! Pieces are processed in chunks of consecutive pieces by worker threads,
