@@ -16,3 +16,18 @@ fn piece_depth(piece: u32) -> f32 {
 fn finite(x: f32) -> bool {
     return abs(x) <= 3.4028235e38;
 }
+
+// Clip z of the corners of a blocker quad (src/render/ties.rs: a pixel the
+// snapped triangles of a piece would take but its exact outline does not;
+// twin: gpu::raster::BLOCKER_Z). Other geometry is drawn at z = 0.5.
+const BLOCKER_Z: f32 = 0.25;
+
+// What a counting fragment adds (fs_count): 1 to red, except for a blocker
+// quad, which only takes the pixel for its piece. `z` is the fragment's
+// @builtin(position).z.
+fn count_of(z: f32) -> vec4<f32> {
+    if z < 0.375 {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(1.0, 0.0, 0.0, 0.0);
+}

@@ -42,7 +42,7 @@ fn fs_main(f: VertexOut) -> FragOut {
 @fragment
 fn fs_count(f: VertexOut) -> FragOut {
     var out: FragOut;
-    out.color = vec4<f32>(1.0, 0.0, 0.0, 0.0);
+    out.color = count_of(f.clip.z);
     out.depth = piece_depth(f.piece);
     return out;
 }

@@ -105,7 +105,7 @@ fn segment_at(f: VertexOut, p: vec2<f32>) -> Seg {
 @fragment
 fn fs_count(f: VertexOut) -> FragOut {
     var out: FragOut;
-    out.color = vec4<f32>(1.0, 0.0, 0.0, 0.0);
+    out.color = count_of(f.clip.z);
     out.depth = piece_depth(f.piece);
     return out;
 }

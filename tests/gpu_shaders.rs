@@ -42,8 +42,16 @@ fn shaders_parse_and_validate() {
             std::fs::read_to_string(dir.join(name)).unwrap(),
             "{name} differs from the embedded copy"
         );
+        // A file that ends a stage made of several files (a mode on the
+        // segment payload: shaders/segment.wgsl, integral.wgsl, then its
+        // own) is validated as that whole stage; the others alone.
         let full = if *name == "common.wgsl" {
             src.to_string()
+        } else if let Some(stage) = stages()
+            .into_iter()
+            .find(|s| s.name == *name && s.wgsl != *src && s.wgsl.ends_with(src))
+        {
+            stage_source(stage.wgsl)
         } else {
             stage_source(src)
         };

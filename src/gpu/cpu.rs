@@ -44,7 +44,7 @@
 use half::f16;
 
 use super::frame::{validate, DrawKind};
-use super::raster::{piece_depth, raster_side, ClipMapper, GpuVertex};
+use super::raster::{piece_depth, raster_side, ClipMapper, GpuVertex, BLOCKER_Z};
 use super::{AccumFormat, GpuError};
 use crate::image::Image;
 
@@ -258,7 +258,14 @@ impl CpuFrame {
                     return;
                 }
             },
-            DrawKind::CountPieces | DrawKind::CountTriangles => [1.0, 0.0, 0.0, 0.0],
+            DrawKind::CountPieces | DrawKind::CountTriangles => {
+                // `count_of`: blocker quads count nothing.
+                if tri[0].clip()[2] == BLOCKER_Z * tri[0].clip()[3] {
+                    [0.0; 4]
+                } else {
+                    [1.0, 0.0, 0.0, 0.0]
+                }
+            }
         };
         let key = piece_depth(piece);
         let passes = self.draw == DrawKind::CountTriangles || key < self.depth[at];

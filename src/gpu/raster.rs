@@ -59,6 +59,12 @@ pub fn piece_depth(piece: u32) -> f32 {
 /// refuses more.
 pub const MAX_PIECES: u32 = 0x3F7F_FFFF;
 
+/// Clip z of the corners of a blocker quad ([`crate::render::ties`]): a
+/// pixel quad that takes a pixel for its piece without colouring or
+/// counting it (`count_of` in `shaders/common.wgsl`). Everything else is
+/// drawn at z = 0.5.
+pub const BLOCKER_Z: f32 = 0.25;
+
 /// Sub-pixel grid of the rasteriser: positions are snapped to 1/`SUBPIXEL`
 /// pixel (8 bits, what lavapipe, llvmpipe and the desktop drivers use).
 pub const SUBPIXEL: f64 = 256.0;

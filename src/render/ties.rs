@@ -18,7 +18,8 @@
 //! triangles the GPU will draw (integer grid, the same rule). Where they
 //! disagree, a pixel quad is drawn first in the part: with the exact
 //! triangle's payload interpolated at the centre where the exact part
-//! covers it, or transparent where it does not. Each piece colours a pixel
+//! covers it, or transparent where it does not (a blocker, drawn at
+//! [`BLOCKER_Z`], which counting draws do not count). Each piece colours a pixel
 //! once (its depth key), so the quad decides the pixel and the triangles
 //! drawn after it leave it alone.
 //!
@@ -28,6 +29,7 @@
 
 use glam::DVec2;
 
+use crate::gpu::raster::BLOCKER_Z;
 use crate::gpu::{ClipMapper, GpuVertex, SUBPIXEL};
 use crate::numeric::predicates::{orient2d, Side};
 use crate::projection::Projected;
@@ -187,6 +189,7 @@ pub fn fix_ties<V: GpuVertex>(
         let q = [i as i64 * sub + sub / 2, j as i64 * sub + sub / 2];
         let grid_in = part.drawn.iter().any(|(_, g)| covers_grid(*g, q));
         let exact_tri = part.exact.iter().find(|t| covers_exact(t.map(pos), c));
+        let mut z = 0.5;
         let value = match (exact_tri, grid_in) {
             (Some(t), false) => {
                 let p = t.map(pos);
@@ -201,6 +204,7 @@ pub fn fix_ties<V: GpuVertex>(
                 let Some(v) = part.drawn.first().and_then(|(t, _)| vertex(t[0])) else {
                     continue;
                 };
+                z = BLOCKER_Z;
                 v.transparent()
             }
             _ => continue,
@@ -210,11 +214,7 @@ pub fn fix_ties<V: GpuVertex>(
             let Some((ndc, _)) = mapper.ndc((i + di) as f64, (j + dj) as f64) else {
                 continue;
             };
-            vertices.push(
-                value
-                    .with_clip([ndc[0], ndc[1], 0.5, 1.0])
-                    .with_piece(piece),
-            );
+            vertices.push(value.with_clip([ndc[0], ndc[1], z, 1.0]).with_piece(piece));
         }
         if vertices.len() as u32 == base + 4 {
             indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
