@@ -56,7 +56,7 @@ fn cameras(scene: &Scene) -> Vec<Camera> {
 #[test]
 fn interlocked_tets_are_ordered_by_plane_cuts() {
     let scene = scene();
-    let mut sorter = Sorter::shared(scene.mesh.clone(), scene.topology.clone());
+    let mut sorter = Sorter::new(scene.mesh.clone(), scene.topology.clone());
     for cam in cameras(&scene) {
         let order = sorter.order(&cam, &SplitPolicy::default()).unwrap();
         let st = &order.stats;
@@ -117,7 +117,7 @@ fn interlocked_tets_are_ordered_by_plane_cuts() {
 #[test]
 fn without_plane_cuts_interlocked_tets_form_a_group() {
     let scene = scene();
-    let mut sorter = Sorter::shared(scene.mesh.clone(), scene.topology.clone());
+    let mut sorter = Sorter::new(scene.mesh.clone(), scene.topology.clone());
     sorter.plane_split = false;
     for cam in cameras(&scene) {
         let order = sorter.order(&cam, &SplitPolicy::default()).unwrap();

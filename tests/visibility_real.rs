@@ -7,6 +7,8 @@
 //! `cargo test --release`) and are ignored in debug builds, where they are
 //! slow.
 
+use std::sync::Arc;
+
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::topology::Topology;
 use zoovr::mesh::Mesh;
@@ -48,8 +50,9 @@ fn check_with(
     let Some(mesh) = load(rel) else {
         return;
     };
+    let mesh = Arc::new(mesh);
     let topo = Topology::build(&mesh.cells);
-    let mut sorter = Sorter::new(&mesh, &topo);
+    let mut sorter = Sorter::new(mesh.clone(), topo);
     let mut rng = Rng(0x5EED ^ rel.len() as u64);
     let policy = SplitPolicy {
         all: split_all,

@@ -108,7 +108,7 @@ impl<'s> Renderer<'s> {
     pub fn sorter(&mut self) -> &mut Sorter {
         let scene = self.scene;
         self.sorter
-            .get_or_insert_with(|| Sorter::shared(scene.mesh.clone(), scene.topology.clone()))
+            .get_or_insert_with(|| Sorter::new(scene.mesh.clone(), scene.topology.clone()))
     }
 
     /// Renders one image with the camera of `opts.camera` (fitted to the
@@ -174,7 +174,7 @@ impl<'s> Renderer<'s> {
         let mut sorter = self
             .sorter
             .take()
-            .unwrap_or_else(|| Sorter::shared(scene.mesh.clone(), scene.topology.clone()));
+            .unwrap_or_else(|| Sorter::new(scene.mesh.clone(), scene.topology.clone()));
         let sorter_s = t0.elapsed().as_secs_f64();
         let result = driver::render_projected(
             mode,
