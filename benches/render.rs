@@ -99,7 +99,8 @@ fn bench(c: &mut Criterion) {
     }
     for (name, scene, cam) in scenes() {
         for &(bname, gpu) in &backends {
-            let mut renderer = Renderer::new(&scene);
+            let mut renderer = Renderer::new(scene.geometry());
+            let shading = scene.shading();
             for size in [512u32, 1024] {
                 let opts = RenderOptions {
                     camera: CameraParams {
@@ -112,8 +113,8 @@ fn bench(c: &mut Criterion) {
                     ..Default::default()
                 };
                 // The first frame builds the sorter and opens the device.
-                let (_, first) = renderer.render(&opts, |_, _| {}).unwrap();
-                let (_, s) = renderer.render(&opts, |_, _| {}).unwrap();
+                let (_, first) = renderer.render(&shading, &opts, |_, _| {}).unwrap();
+                let (_, s) = renderer.render(&shading, &opts, |_, _| {}).unwrap();
                 let e = s.projected().unwrap();
                 eprintln!(
                     "{name} {bname} {size}: frame {:.2} s (first {:.2} s) = sort {:.3} + project/integrals {:.2} + gpu {:.2} (upload+draw {:.2}, wait {:.2}, readback {:.3}); {} pieces, {} triangles, {} batches",
@@ -133,7 +134,7 @@ fn bench(c: &mut Criterion) {
                     let mut g = c.benchmark_group(format!("exact/{name}/{bname}"));
                     g.sample_size(10).measurement_time(Duration::from_secs(8));
                     g.bench_function(format!("{size}"), |b| {
-                        b.iter(|| renderer.render(&opts, |_, _| {}).unwrap())
+                        b.iter(|| renderer.render(&shading, &opts, |_, _| {}).unwrap())
                     });
                     g.finish();
                 }

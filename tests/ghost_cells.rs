@@ -86,7 +86,9 @@ fn render(scene: &Scene, mode: Mode) -> Image {
         },
         ..Default::default()
     };
-    let (img, _) = Renderer::new(scene).render(&opts, |_, _| {}).unwrap();
+    let (img, _) = Renderer::new(scene.geometry())
+        .render(&scene.shading(), &opts, |_, _| {})
+        .unwrap();
     assert_eq!(img.count_non_finite(), 0);
     img
 }

@@ -43,8 +43,8 @@ fn options(mode: Mode, ortho: bool) -> RenderOptions {
 }
 
 fn render(scene: &Scene, opts: &RenderOptions) -> Image {
-    let (img, _) = Renderer::new(scene)
-        .render(opts, |_, _| {})
+    let (img, _) = Renderer::new(scene.geometry())
+        .render(&scene.shading(), opts, |_, _| {})
         .unwrap_or_else(|e| panic!("{:?}: {e}", opts.mode));
     assert_eq!(img.count_non_finite(), 0);
     img

@@ -101,7 +101,9 @@ fn render(scene: &Scene, mode: Mode, model: FieldModel, split_all: bool, ortho: 
         },
         ..Default::default()
     };
-    let (img, _) = Renderer::new(scene).render(&opts, |_, _| {}).unwrap();
+    let (img, _) = Renderer::new(scene.geometry())
+        .render(&scene.shading(), &opts, |_, _| {})
+        .unwrap();
     assert_eq!(img.count_non_finite(), 0, "non-finite pixels");
     img
 }
@@ -283,7 +285,9 @@ fn coverage_culling_changes_no_pixel() {
                         },
                         ..Default::default()
                     };
-                    let (img, stats) = Renderer::new(&scene).render(&opts, |_, _| {}).unwrap();
+                    let (img, stats) = Renderer::new(scene.geometry())
+                        .render(&scene.shading(), &opts, |_, _| {})
+                        .unwrap();
                     triangles[k] = stats.projected().unwrap().gpu.triangles;
                     images.push(img);
                 }

@@ -119,7 +119,7 @@ fn run(case: Case, gpu: bool) {
     let size = 96;
     let mut scene = Scene::build(case.mesh, &SceneSpec::default()).unwrap();
     scene.tf = tf(case.range, case.tau_max);
-    let mut r = Renderer::new(&scene);
+    let mut r = Renderer::new(scene.geometry());
     for (vi, &v) in case.views.iter().enumerate() {
         let cam = camera(&scene.mesh, v, size);
         let mut render = |mode: Mode, model: FieldModel, split_all: bool| -> Image {
@@ -136,7 +136,7 @@ fn run(case: Case, gpu: bool) {
                 ..Default::default()
             };
             let (img, _) = r
-                .render_with_camera(&opts, &cam, |_, _| {})
+                .render_with_camera(&scene.shading(), &opts, &cam, |_, _| {})
                 .unwrap_or_else(|e| panic!("{} view {vi} {mode:?}: {e}", case.name));
             assert_eq!(
                 img.count_non_finite(),
@@ -443,7 +443,7 @@ fn eye_inside_a_constant_block_matches_the_closed_form() {
             want.pixels[(j * size + i) as usize] = [0.9 * a, 0.6 * a, 0.3 * a, a].map(|v| v as f32);
         }
     }
-    let mut r = Renderer::new(&scene);
+    let mut r = Renderer::new(scene.geometry());
     let mut modes = vec![(Mode::Raycast, FieldModel::Faces, false)];
     if gpu {
         modes.push((Mode::Exact, FieldModel::Faces, false));
@@ -462,7 +462,9 @@ fn eye_inside_a_constant_block_matches_the_closed_form() {
             },
             ..Default::default()
         };
-        let (img, _) = r.render_with_camera(&opts, &cam, |_, _| {}).unwrap();
+        let (img, _) = r
+            .render_with_camera(&scene.shading(), &opts, &cam, |_, _| {})
+            .unwrap();
         let d = check_images_with(
             &format!("stress_eye_inside_block_{mode:?}_{split_all}"),
             &img,
@@ -538,7 +540,7 @@ fn constant_block_has_no_seams_or_double_cover() {
         EmissionModel::Glow,
     )
     .unwrap();
-    let mut r = Renderer::new(&scene);
+    let mut r = Renderer::new(scene.geometry());
     for (vi, view) in [
         View::Fit(20.0, 35.0, false),
         View::Fit(-50.0, 10.0, true),
@@ -557,7 +559,9 @@ fn constant_block_has_no_seams_or_double_cover() {
                 },
                 ..Default::default()
             };
-            r.render_with_camera(&opts, &cam, |_, _| {}).unwrap().0
+            r.render_with_camera(&scene.shading(), &opts, &cam, |_, _| {})
+                .unwrap()
+                .0
         };
         let reference = img(Mode::Raycast, false);
         for split_all in [false, true] {
