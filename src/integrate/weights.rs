@@ -25,14 +25,10 @@
 //!   never overflow (so `tau_f ~ tau_b` and depths of 1e6 are harmless).
 
 use super::tables_sf::{GL12, GL8, SF_TABLE};
-use crate::numeric::tolerance::{SERIES_SUM_FLOOR, SERIES_TRUNCATION_REL};
+use crate::numeric::tolerance::{
+    GAUSS_LEGENDRE_8_MAX_DEPTH, GAUSS_LEGENDRE_MAX_DEPTH, SERIES_SUM_FLOOR, SERIES_TRUNCATION_REL,
+};
 
-/// Segments with `max(a, b)` at or below this use the Gauss-Legendre rule.
-const SMALL_DEPTH: f64 = 2.0;
-/// At or below this `max(a, b)` 8 nodes suffice: their error against 12
-/// nodes is 1e-14 at depth 1 but falls like `max(a, b)^16`, to rounding
-/// level (< 1e-15, tested) at 1/2; two thirds of the cost of 12 nodes.
-const SMALL_DEPTH_GL8: f64 = 0.5;
 /// Above this argument the special functions use their asymptotic series.
 const ASYM_X: f64 = 8.0;
 /// Spacing of the tabulated centres.
@@ -218,12 +214,12 @@ pub fn weights(a: f64, b: f64) -> Weights {
     let a = sanitize(a);
     let b = sanitize(b);
     let d1 = 0.5 * (a + b);
-    if a.max(b) <= SMALL_DEPTH {
+    if a.max(b) <= GAUSS_LEGENDRE_MAX_DEPTH {
         // One transcendental: T = 1 - alpha is accurate here (T >= e^-2).
         let alpha = -(-d1).exp_m1();
         let t = 1.0 - alpha;
         // Positive integrands only: no cancellation for any a, b >= 0.
-        let rule: &[(f64, f64)] = if a.max(b) <= SMALL_DEPTH_GL8 {
+        let rule: &[(f64, f64)] = if a.max(b) <= GAUSS_LEGENDRE_8_MAX_DEPTH {
             &GL8
         } else {
             &GL12

@@ -18,6 +18,7 @@ use glam::DVec3;
 
 use crate::camera::Camera;
 use crate::mesh::Mesh;
+use crate::numeric::tolerance::{LEFT_LIMIT_FLOOR, LEFT_LIMIT_REL};
 use crate::projection::coverage::PixelGrid;
 use crate::projection::{ClipValue, Clipper, Polyhedron, ProjectionError};
 use crate::tf::TransferFunction;
@@ -304,7 +305,9 @@ impl PieceSource<'_> {
         }
         for &b in self.breakpoints {
             if b >= lo && b <= hi {
-                let left = self.tf.tau_at(b - b.abs().max(1e-300) * 1e-15);
+                let left = self
+                    .tf
+                    .tau_at(b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL);
                 if self.tf.tau_at(b) > 0.0 || left > 0.0 {
                     return false;
                 }
