@@ -1,6 +1,7 @@
 //! The exact mode end to end: bluntfin (default field and TF), the
-//! hex_shell scene of `../shared/data/synthetic/README.md` (bench_tf.json,
-//! azimuth 20, elevation 35, zoom 1.25, perspective) and the generated
+//! hex_shell scene (`synthetic/hex_shell_zlib.vtu`: 250,047 curvilinear
+//! hexahedra in a twisted, C-shaped annular sector with nonplanar faces;
+//! bench_tf.json, azimuth 20, elevation 35, zoom 1.25, perspective) and the generated
 //! 1M-hex grid, at 512^2 and 1024^2, on every backend present (Vulkan
 //! lavapipe with f32 accumulation, GL llvmpipe with f16). For every case one
 //! frame is reported by stage (sort, project + integrals, GPU upload/draw,

@@ -1,7 +1,7 @@
 //! VTK XML readers and time collections.
 //!
-//! - Real files from `../shared/data` (skipped when absent): counts from the
-//!   data README, and every array's range checked against the
+//! - Real files from `../shared/data` (skipped when absent): their published
+//!   cell and point counts, and every array's range checked against the
 //!   `RangeMin`/`RangeMax` that VTK wrote into the file (an independent
 //!   oracle: magnitude range for vectors, value range for scalars).
 //! - Round trips: a small mixed mesh is written by an encoder in this file

@@ -31,7 +31,7 @@ const MAX: f64 = 2.0 / 255.0;
 const RMS: f64 = 2e-3;
 /// One optically thick cell filling the view: inside a region the glow
 /// colour `C/alpha` is interpolated, which is exact only for constant colour
-/// (math README 8.1); colour refinement bounds it, but a single cell seen
+/// (docs/math.md 8.1); colour refinement bounds it, but a single cell seen
 /// whole keeps up to 2.25e-2 (voxel and hexahedron, orthographic, default
 /// TF).
 const THICK_CELL_MAX: f64 = 2.5e-2;
@@ -192,7 +192,7 @@ fn single_cells_of_every_kind() {
         "hexagonal_prism",
     ] {
         // One optically thick cell filling the view: the interpolated C/alpha
-        // inside its regions errs up to ~1.2e-2 (math README 8.1) even after
+        // inside its regions errs up to ~1.2e-2 (docs/math.md 8.1) even after
         // colour refinement.
         check_file(
             &mesh_file(&format!("{name}.vtk")),

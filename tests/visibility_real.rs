@@ -1,5 +1,5 @@
 //! Exactness of the visibility order on the real datasets of
-//! `../shared/data` (README there): 20 random views each, both projections,
+//! `../shared/data`: 20 random views each, both projections,
 //! checked by the brute-force validator on sampled pixel centres.
 //!
 //! Each test skips cleanly when the data folder is absent; a file that is

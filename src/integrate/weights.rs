@@ -1,5 +1,5 @@
-//! Basis integrals of one linear sub-segment (a port of
-//! `shared/math/closed_form.py`, `segment_weights`).
+//! Basis integrals of one linear sub-segment: the closed form and regime
+//! selection of docs/math.md sections 3 and 4.
 //!
 //! A sub-segment of length `l` has extinction linear from `tau_f` (front) to
 //! `tau_b` (back); with `a = tau_f l`, `b = tau_b l`, `x in [0, 1]` and the
@@ -12,11 +12,11 @@
 //! glow:      C = c_f w_f + c_b w_b          emission:  C = l (E_f phi_f + E_b phi_b)
 //! ```
 //!
-//! Regimes (math README section 4.2):
+//! Regimes (docs/math.md section 4.2):
 //! * `max(a, b) <= 2`: 12-point Gauss-Legendre over positive integrands, no
 //!   cancellation at any depth down to subnormals (error ~5e-16); 8 points
 //!   for `max(a, b) <= 1/2`, where they are as accurate (a speed refinement of
-//!   `closed_form.py`, checked by the golden and stress tests);
+//!   the closed form there, checked by the golden and stress tests);
 //! * `a == b`: constant extinction, `expm1` forms;
 //! * `b > a`: scaled complementary error function `P = sqrt(pi) erfcx` and
 //!   `Q = 1 - uP`; `b < a`: `B = 2 Dawson`, `G = 1 - vB`. For arguments up to

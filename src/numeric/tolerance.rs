@@ -7,7 +7,8 @@
 
 /// Relative deviation (of the face's longer diagonal) of a quad face's fourth vertex
 /// from the plane of the other three above which `info` counts the face as
-/// nonplanar. Matches the figure used in `../shared/data/README.md`.
+/// nonplanar. The same threshold as the datasets' published nonplanar-face
+/// counts (`mesh::quality` reproduces them).
 pub const NONPLANAR_REPORT_REL: f64 = 1e-3;
 
 /// Cells whose |signed volume| is below this fraction of (bounding box
@@ -30,7 +31,7 @@ pub const EXP_TABLE_MAX_ABS_ERROR: f64 = 1.2e-4;
 /// Exact mode: a region edge is refined when (optical depth at its ends,
 /// capped at 1) x (largest glow-colour difference between its ends) exceeds
 /// this. Inside a region `C/alpha` is interpolated, which is exact only for
-/// constant glow colour; math README 8.1 measures errors up to ~7e-3 for
+/// constant glow colour; docs/math.md 8.1 measures errors up to ~7e-3 for
 /// depth <= 1 with colour spread 1. 0.02 left 0.06 on single pixels of
 /// coarse tet meshes seen up close (`tetraMesh`, 128 px, oblique
 /// orthographic view); 0.004 brings every pixel of the shared datasets
@@ -47,7 +48,7 @@ pub const COLOR_REFINE_MAX_DEPTH: u32 = 6;
 /// Integral-function table fills (`integrate::fast`): below this fraction of
 /// the table's scalar range, `|s_b - s_f|` is too small for the difference
 /// quotients `(T(s_b) - T(s_f)) / (s_b - s_f)` (they lose
-/// `log10(|T| / |T_b - T_f|)` digits, math README 8.4) and the point values
+/// `log10(|T| / |T_b - T_f|)` digits, docs/math.md 8.4) and the point values
 /// at the midpoint scalar are used instead (error O(ds) there).
 pub const INTEGRAL_FUNCTION_MIN_DS_REL: f64 = 1e-7;
 /// Projection (perspective): pieces are clipped at `near * NEAR_CLIP_SCALE`
