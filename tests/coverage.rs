@@ -29,10 +29,13 @@
 //! edge (measured: 0 to 87 such centres per view, most on `mixed.vtk`).
 //! Every mismatch must lie within [`SNAP_BAND_PX`] of a projected tet edge.
 
+mod render_util;
+use render_util::gpu_available;
+
 use glam::DVec3;
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::generate::{warped_hex_grid, Warp};
-use zoovr::gpu::{Context, DrawKind, GpuOptions};
+use zoovr::gpu::DrawKind;
 use zoovr::image::Image;
 use zoovr::io::{self, ReadOptions};
 use zoovr::mesh::tetra::tetrahedralize_cell;
@@ -49,16 +52,6 @@ use zoovr::tf::{EmissionModel, TransferFunction};
 /// most half a grid step of 1/256 px in x and in y, so every point of an
 /// edge between snapped corners by at most `sqrt(2) / 512` px.
 const SNAP_BAND_PX: f64 = std::f64::consts::SQRT_2 / 512.0;
-
-fn gpu_available() -> bool {
-    match Context::new(&GpuOptions::default()) {
-        Ok(_) => true,
-        Err(e) => {
-            eprintln!("skipping the GPU counts: no adapter ({e})");
-            false
-        }
-    }
-}
 
 /// Constant extinction and colour: no breakpoint (every tet is one piece)
 /// and no piece skipped for zero extinction.

@@ -11,16 +11,16 @@
 //! PNGs under target/test-output. Skips cleanly without a GPU adapter or
 //! without the shared data.
 
+mod render_util;
+use render_util::{gpu_available, options};
+
 use std::path::Path;
 
 use zoovr::camera::CameraParams;
-use zoovr::gpu::{Context, GpuOptions};
 use zoovr::image::{check_images_with, Bounds, Image};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
-use zoovr::render::{
-    Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
-};
+use zoovr::render::{Mode, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec};
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
@@ -48,16 +48,6 @@ const CAN_CRUSH: (f64, f64) = (0.15, 4e-3);
 /// established: PentaHexa 1.11e-2 (perspective), AngularSector 8.6e-3
 /// (orthographic, kinked TF).
 const OPEN_GAP: (f64, f64) = (1.2e-2, RMS);
-
-fn gpu_available() -> bool {
-    match Context::new(&GpuOptions::default()) {
-        Ok(_) => true,
-        Err(e) => {
-            eprintln!("skipping: no GPU adapter ({e})");
-            false
-        }
-    }
-}
 
 /// A TF over `range` whose extinction has kinks at 30 %, 50 % and 70 % of
 /// the range and whose colour varies.
@@ -90,16 +80,7 @@ fn render(scene: &Scene, mode: Mode, model: FieldModel, split_all: bool, ortho: 
             ortho,
             ..Default::default()
         },
-        mode,
-        projected: ProjectedOptions {
-            split_all,
-            ..Default::default()
-        },
-        reference: ReferenceOptions {
-            model,
-            ..Default::default()
-        },
-        ..Default::default()
+        ..options(mode, split_all, model)
     };
     let (img, _) = Renderer::new(scene.geometry())
         .render(&scene.shading(), &opts, |_, _| {})
