@@ -8,7 +8,7 @@ use zoovr::camera::Ray;
 use zoovr::integrate::{Material, RayMaterial, SegmentValue};
 use zoovr::mesh::tetra::tetrahedralize_cell;
 use zoovr::mesh::topology::Topology;
-use zoovr::mesh::{CellKind, Cells, Mesh};
+use zoovr::mesh::{lattice_hex, CellKind, Cells, Mesh};
 use zoovr::raycast::{FieldModel, RaycastOptions};
 
 /// Options for `model` with early ray termination off (exact comparisons).
@@ -145,19 +145,8 @@ pub fn grid(n: [usize; 3], map: impl Fn(f64, f64, f64) -> DVec3, perm: Option<&[
     for k in 0..n[2] {
         for j in 0..n[1] {
             for i in 0..n[0] {
-                cells.push(
-                    CellKind::Hexahedron,
-                    &[
-                        id(i, j, k),
-                        id(i + 1, j, k),
-                        id(i + 1, j + 1, k),
-                        id(i, j + 1, k),
-                        id(i, j, k + 1),
-                        id(i + 1, j, k + 1),
-                        id(i + 1, j + 1, k + 1),
-                        id(i, j + 1, k + 1),
-                    ],
-                );
+                let c = lattice_hex(px, py, [i, j, k]).map(|v| perm.map_or(v, |p| p[v as usize]));
+                cells.push(CellKind::Hexahedron, &c);
             }
         }
     }
