@@ -5,11 +5,11 @@
 
 use glam::DVec3;
 use zoovr::camera::Ray;
-use zoovr::integrate::{Material, RayMaterial, SegmentValue};
+use zoovr::integrate::{Material, RayAccumulator, RayMaterial, SegmentValue};
 use zoovr::mesh::tetra::tetrahedralize_cell;
 use zoovr::mesh::topology::Topology;
 use zoovr::mesh::{lattice_hex, CellKind, Cells, Mesh};
-use zoovr::raycast::{FieldModel, RaycastOptions};
+use zoovr::raycast::{FieldModel, RaycastOptions, Raycaster};
 
 /// Options for `model` with early ray termination off (exact comparisons).
 pub fn opts(model: FieldModel) -> RaycastOptions {
@@ -18,6 +18,17 @@ pub fn opts(model: FieldModel) -> RaycastOptions {
         early_termination: 0.0,
         ..Default::default()
     }
+}
+
+/// One ray traced by `rc` (built for `model`) from its origin, with fresh
+/// scratch and early termination off.
+pub fn trace_one(
+    rc: &Raycaster,
+    material: &impl RayMaterial,
+    ray: &Ray,
+    model: FieldModel,
+) -> RayAccumulator {
+    rc.trace(material, ray, 0.0, &opts(model), &mut Default::default())
 }
 
 /// Glow model with extinction and colour piecewise linear in `s` (nodes
