@@ -17,7 +17,7 @@ pub mod grid;
 mod segment;
 pub mod table2d;
 pub mod table3d;
-mod tables_sf;
+pub(crate) mod tables_sf;
 pub mod weights;
 
 pub use grid::TableError;

@@ -84,11 +84,19 @@ pub trait ProjectedMode: Sync {
     /// TF values at which pieces are sliced (empty: never sliced).
     fn split_points(&self, tf: &TransferFunction) -> Vec<f64>;
 
-    /// Binds the mode's stage for one frame (uniforms, tables).
-    fn bind(&self, gpu: &Context, length_unit: f32) -> Result<Stage, GpuError>;
+    /// Whether regions are refined in perspective views until linear
+    /// interpolation in screen space is within
+    /// [`crate::numeric::tolerance::PERSPECTIVE_INTERP_REL`] (a mode whose
+    /// payload interpolates exactly in perspective says no).
+    fn perspective_refine(&self) -> bool {
+        true
+    }
 
-    /// The CPU twin of the stage's fragment shader, for one frame.
-    fn twin(&self, length_unit: f32) -> Box<dyn CpuStage<Self::Vertex>>;
+    /// Binds the mode's stage for one frame (uniforms, tables) of `src`.
+    fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError>;
+
+    /// The CPU twin of the stage's fragment shader, for one frame of `src`.
+    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<Self::Vertex>>;
 
     /// Computes the payload of `part`'s projection at every vertex
     /// `used[i]` marks (a kept triangle uses it). It may refine
@@ -175,13 +183,14 @@ struct Worker<P> {
 }
 
 impl<P: Default> Worker<P> {
-    fn new(src: &PieceSource) -> Self {
+    fn new(src: &PieceSource, perspective_refine: bool) -> Self {
         let mut projector = Projector::new();
         // Pieces cut by the near plane reach ~1e9 pixels off screen: clip
         // their regions to the image so that screen-space interpolation
         // stays exact up to the perspective refinement's bound.
         projector.clip_to_image = true;
         projector.cull_to_pixels = src.cull;
+        projector.perspective_refine = perspective_refine;
         Worker {
             projector,
             parts: PartScratch::default(),
@@ -290,7 +299,7 @@ fn process_chunk<M: ProjectedMode>(
     pieces: &[Piece],
     mut out: ChunkOut<M::Vertex>,
 ) -> ChunkOut<M::Vertex> {
-    let mut w = Worker::<M::Payload>::new(src);
+    let mut w = Worker::<M::Payload>::new(src, mode.perspective_refine());
     for piece in pieces {
         let mut parts = std::mem::take(&mut w.parts);
         let done = src.parts(piece, &mut parts, |part| {
@@ -474,7 +483,6 @@ pub fn render_projected<M: ProjectedMode>(
         grid: PixelGrid::new(camera.width, camera.height),
     };
     let t_open = Instant::now();
-    let length_unit = scene.unit_distance as f32;
     let mut sink = match opts.projected.compositor {
         Compositor::Gpu => {
             if gpu.is_none() {
@@ -490,7 +498,7 @@ pub fn render_projected<M: ProjectedMode>(
             fopts.draw = opts.projected.draw;
             Sink::Gpu {
                 frame: Box::new(gpu.begin_frame_with(&fopts)?),
-                stage: mode.bind(gpu, length_unit)?,
+                stage: mode.bind(gpu, &src)?,
                 layer: gpu.bind_stage(&LAYER_STAGE, &[])?,
             }
         }
@@ -502,7 +510,7 @@ pub fn render_projected<M: ProjectedMode>(
             }
             Sink::Cpu {
                 frame: Box::new(f),
-                twin: mode.twin(length_unit),
+                twin: mode.twin(&src),
             }
         }
     };

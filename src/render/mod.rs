@@ -74,11 +74,12 @@ pub enum RenderError {
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Raycast(#[from] raycast::RaycastError),
-    #[error("the {mode} mode cannot draw {model:?} emission (it supports {supported}); use --mode raycast")]
+    #[error("the {mode} mode cannot draw {model:?} emission (it supports {supported}); modes that can: --mode {alternatives}")]
     Unsupported {
         mode: &'static str,
         model: crate::tf::EmissionModel,
         supported: String,
+        alternatives: String,
     },
 }
 
@@ -155,6 +156,12 @@ impl Renderer {
                 mode: info.name,
                 model,
                 supported: format!("{:?}", info.emission),
+                alternatives: Mode::ALL
+                    .iter()
+                    .filter(|m| m.info().emission.contains(&model))
+                    .map(|m| m.name())
+                    .collect::<Vec<_>>()
+                    .join(", --mode "),
             });
         }
         shading.check(&self.geometry)?;
@@ -164,6 +171,13 @@ impl Renderer {
             Mode::Exact => {
                 self.projected(&modes::exact::ExactMode, &scene, opts, camera, progress)?
             }
+            Mode::ExactFrag => self.projected(
+                &modes::exact_frag::ExactFragMode,
+                &scene,
+                opts,
+                camera,
+                progress,
+            )?,
             Mode::Raycast => {
                 let (img, s, setup) = modes::raycast::render(&scene, opts, camera, progress)?;
                 (img, ModeStats::Raycast(s), setup)

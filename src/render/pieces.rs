@@ -17,6 +17,7 @@
 use glam::DVec3;
 
 use crate::camera::Camera;
+use crate::integrate::RayMaterial;
 use crate::mesh::Mesh;
 use crate::numeric::tolerance::{LEFT_LIMIT_FLOOR, LEFT_LIMIT_REL};
 use crate::projection::coverage::PixelGrid;
@@ -295,20 +296,27 @@ impl PieceSource<'_> {
         band_values(self.levels, lo, hi)
     }
 
-    /// Whether extinction is zero over the whole scalar interval.
+    /// Whether the material is dark over the whole scalar interval: zero
+    /// extinction and (independent emission) zero emission at both ends and
+    /// on both sides of every transfer-function node inside, so (the
+    /// function being piecewise linear) everywhere. Every node is checked,
+    /// not only the mode's split points: a mode that slices at none still
+    /// skips only what is truly dark.
     pub fn invisible(&self, lo: f64, hi: f64) -> bool {
         if !(lo.is_finite() && hi.is_finite()) {
             return false;
         }
-        if self.tf.tau_at(lo) > 0.0 || self.tf.tau_at(hi) > 0.0 {
+        let dark = |s: f64| {
+            let m = self.tf.material(s);
+            m.tau == 0.0 && m.source == [0.0; 3]
+        };
+        if !dark(lo) || !dark(hi) {
             return false;
         }
-        for &b in self.breakpoints {
+        for &b in self.tf.breakpoints_slice() {
             if b >= lo && b <= hi {
-                let left = self
-                    .tf
-                    .tau_at(b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL);
-                if self.tf.tau_at(b) > 0.0 || left > 0.0 {
+                let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
+                if !dark(b) || !dark(left) {
                     return false;
                 }
             }

@@ -258,11 +258,12 @@ impl ProjectedMode for ExactMode {
         split_points(tf)
     }
 
-    fn bind(&self, gpu: &Context, length_unit: f32) -> Result<Stage, GpuError> {
-        bind_exact_stage(gpu, length_unit)
+    fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
+        bind_exact_stage(gpu, src.length_unit as f32)
     }
 
-    fn twin(&self, length_unit: f32) -> Box<dyn CpuStage<ExactVertex>> {
+    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<ExactVertex>> {
+        let length_unit = src.length_unit as f32;
         // The driver's unit is the scene's (positive, finite) unit distance.
         Box::new(ExactTwin::new(length_unit).unwrap_or(ExactTwin {
             length_unit: 1.0,

@@ -21,8 +21,11 @@
 //!    reference at its bounds, on the CPU twin and on the GPU.
 
 pub mod exact;
+pub mod exact_frag;
 pub mod exptable;
+pub mod integral;
 pub mod raycast;
+pub mod segment;
 
 use clap::ValueEnum;
 use serde::Serialize;
@@ -40,6 +43,9 @@ pub enum Mode {
     /// by wgpu.
     #[default]
     Exact,
+    /// Projection of convex pieces, the exact ray integral evaluated per
+    /// fragment by wgpu.
+    ExactFrag,
     /// The CPU reference ray caster.
     Raycast,
 }
@@ -80,12 +86,13 @@ pub struct ModeInfo {
 
 impl Mode {
     /// Every mode.
-    pub const ALL: &'static [Mode] = &[Mode::Exact, Mode::Raycast];
+    pub const ALL: &'static [Mode] = &[Mode::Exact, Mode::ExactFrag, Mode::Raycast];
 
     /// The registry entry of the mode.
     pub fn info(self) -> &'static ModeInfo {
         match self {
             Mode::Exact => &exact::INFO,
+            Mode::ExactFrag => &exact_frag::INFO,
             Mode::Raycast => &raycast::INFO,
         }
     }
@@ -129,5 +136,17 @@ impl std::str::FromStr for Mode {
 pub const SHADERS: &[(&str, &str)] = &[
     ("common.wgsl", crate::gpu::stage::COMMON_WGSL),
     ("exact.wgsl", exact::EXACT_STAGE.wgsl),
+    (
+        "exact_frag.wgsl",
+        include_str!("../../../shaders/exact_frag.wgsl"),
+    ),
+    (
+        "integral.wgsl",
+        include_str!("../../../shaders/integral.wgsl"),
+    ),
     ("layer.wgsl", LAYER_STAGE.wgsl),
+    (
+        "segment.wgsl",
+        include_str!("../../../shaders/segment.wgsl"),
+    ),
 ];

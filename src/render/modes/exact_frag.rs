@@ -1,0 +1,184 @@
+//! The exact-frag mode: every fragment evaluates the closed-form
+//! Williams–Max integral of its own ray segment through its piece, over
+//! every transfer-function piece between the segment's end scalars. There
+//! is no table (so no table error), no colour interpolation (so no colour
+//! refinement) and no slicing at breakpoints (so fewer, whole pieces).
+//!
+//! On the shared projected-cell driver ([`crate::render::driver`]) it
+//! supplies:
+//! - **split policy**: none (cells with a breakpoint in their scalar range
+//!   stay whole; the fragment loops over the breakpoints);
+//! - **payload**: the segment payload ([`super::segment`]): `s_f`, `s_b`
+//!   and `l` per region vertex, exact under linear interpolation in
+//!   orthographic views and, through `1/z`, in perspective views (so the
+//!   regions need no perspective refinement);
+//! - **stage** (`shaders/exact_frag.wgsl` behind `shaders/segment.wgsl` and
+//!   `shaders/integral.wgsl`, [`EXACT_FRAG_STAGE`]): per fragment
+//!   `integrate_segment(l, s_f, s_b)` in `f32`; [`ExactFragTwin`] is its CPU
+//!   twin ([`super::integral`]).
+//!
+//! Glow and independent emission are both exact (the fragment integrates
+//! the source the transfer function defines). Within a whole cell the
+//! scalar is linear along each ray between its entry and exit values (the
+//! ray caster's `faces` model); pieces the order splits into tets integrate
+//! the `tets` field.
+
+use crate::gpu::cpu::CpuStage;
+use crate::gpu::{Binding, ClipMapper, Context, GpuError, Resource, Stage, StageDesc};
+use crate::projection::{Polyhedron, Projected};
+use crate::raycast::FieldModel;
+use crate::render::driver::ProjectedMode;
+use crate::render::pieces::PieceSource;
+use crate::tf::{EmissionModel, TransferFunction};
+
+use super::integral::{closed_form_constants, TfBuffer};
+use super::segment::{segment_at, ScalarMap, SegmentPayload, SegmentVertex, SegmentView};
+use super::{Bounds, ModeInfo};
+
+/// The registry entry of the exact-frag mode.
+pub static INFO: ModeInfo = ModeInfo {
+    name: "exact-frag",
+    summary: "projection of convex pieces, the exact ray integral evaluated per fragment by wgpu",
+    gpu: true,
+    emission: &[EmissionModel::Glow, EmissionModel::Independent],
+    slices_at_breakpoints: false,
+    stage: Some(&EXACT_FRAG_STAGE),
+    bounds: Some(Bounds {
+        reference: FieldModel::Faces,
+        // Measured at most 2.1e-3 (tests/modes.rs scenes, both backends):
+        // f32 arithmetic and the snap of region corners to the sub-pixel
+        // grid.
+        split_max: 2.0 / 255.0,
+        // Measured 1.18e-2 (zoo_3x3x3, perspective), the same as the exact
+        // mode: the order splits cells with nonplanar faces into tets, whose
+        // field differs from the `faces` model there. Elsewhere whole cells
+        // integrate the `faces` field itself (within 5.4e-4).
+        whole_max: 0.02,
+    }),
+};
+
+/// The exact-frag stage: the segment vertex and view, the integral, and
+/// the fragment entry points.
+pub static EXACT_FRAG_STAGE: StageDesc = StageDesc {
+    name: "exact_frag.wgsl",
+    wgsl: concat!(
+        include_str!("../../../shaders/segment.wgsl"),
+        include_str!("../../../shaders/integral.wgsl"),
+        include_str!("../../../shaders/exact_frag.wgsl"),
+    ),
+    vertex: SegmentVertex::LAYOUT,
+    bindings: &[Binding::Uniform, Binding::Storage, Binding::Storage],
+};
+
+/// Binds the exact-frag stage for one frame: its view and transfer
+/// function (normalised as the vertices' scalars are).
+pub fn bind_exact_frag_stage(
+    gpu: &Context,
+    view: &SegmentView,
+    tf: &TfBuffer,
+) -> Result<Stage, GpuError> {
+    let consts = closed_form_constants();
+    gpu.bind_stage(
+        &EXACT_FRAG_STAGE,
+        &[
+            Resource::Uniform(bytemuck::bytes_of(view)),
+            Resource::Storage(&tf.bytes()),
+            Resource::Storage(bytemuck::cast_slice(&consts)),
+        ],
+    )
+}
+
+/// The CPU twin of `fs_main` in `shaders/exact_frag.wgsl`.
+pub struct ExactFragTwin {
+    view: SegmentView,
+    mapper: ClipMapper,
+    tf: TfBuffer,
+    consts: Vec<[f32; 4]>,
+}
+
+impl ExactFragTwin {
+    /// The twin for `tf` seen by `camera`.
+    pub fn new(tf: &TransferFunction, camera: &crate::camera::Camera) -> ExactFragTwin {
+        ExactFragTwin::with(
+            SegmentView::of(camera),
+            ClipMapper::for_camera(camera),
+            TfBuffer::new(tf, &ScalarMap::of(tf)),
+        )
+    }
+
+    /// The twin of a stage bound to `view` and `tf`, drawing through
+    /// `mapper`.
+    pub fn with(view: SegmentView, mapper: ClipMapper, tf: TfBuffer) -> ExactFragTwin {
+        ExactFragTwin {
+            view,
+            mapper,
+            tf,
+            consts: closed_form_constants(),
+        }
+    }
+}
+
+impl CpuStage<SegmentVertex> for ExactFragTwin {
+    fn shade(&self, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
+        let seg = segment_at(&self.view, &self.mapper, tri, bary);
+        if !seg.ok {
+            return None;
+        }
+        Some(
+            self.tf
+                .integrate_segment(&self.consts, seg.l, seg.s_f, seg.s_b),
+        )
+    }
+
+    fn describe(&self, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {
+        let seg = segment_at(&self.view, &self.mapper, tri, bary);
+        vec![("s_f", seg.s_f), ("s_b", seg.s_b), ("l", seg.l)]
+    }
+}
+
+/// The exact-frag mode on the projected-cell driver.
+pub struct ExactFragMode;
+
+impl ProjectedMode for ExactFragMode {
+    type Vertex = SegmentVertex;
+    type Payload = SegmentPayload;
+
+    fn split_points(&self, _tf: &TransferFunction) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn perspective_refine(&self) -> bool {
+        SegmentVertex::needs_perspective_refinement()
+    }
+
+    fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
+        let tf = TfBuffer::new(src.tf, &ScalarMap::of(src.tf));
+        bind_exact_frag_stage(gpu, &SegmentView::of(src.camera), &tf)
+    }
+
+    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {
+        Box::new(ExactFragTwin::new(src.tf, src.camera))
+    }
+
+    fn payload(
+        &self,
+        src: &PieceSource,
+        _part: &Polyhedron,
+        _proj: &mut Projected,
+        _used: &mut Vec<bool>,
+        payload: &mut SegmentPayload,
+        _refined: &mut usize,
+    ) {
+        payload.set(src);
+    }
+
+    fn vertex(
+        &self,
+        payload: &SegmentPayload,
+        proj: &Projected,
+        i: usize,
+        ndc: [f32; 2],
+    ) -> SegmentVertex {
+        SegmentVertex::of(proj, i, ndc, &payload.map, payload.ortho)
+    }
+}
