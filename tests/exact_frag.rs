@@ -13,6 +13,9 @@
 //! display resolution is 1/255 = 3.9e-3; the closed form in `f32` is good
 //! to about 1e-6 relative, the table-free GPU `exp` to a few ulp).
 
+mod golden_util;
+
+use golden_util::{f, golden, rgb};
 use serde_json::Value;
 use zoovr::gpu::{AccumFormat, ClipMapper, Context, FrameOptions, GpuOptions};
 use zoovr::render::modes::exact_frag::bind_exact_frag_stage;
@@ -21,21 +24,6 @@ use zoovr::render::modes::segment::{SegmentVertex, SegmentView};
 
 const REL: f64 = 1e-5;
 const ABS: f64 = 1e-6;
-
-fn golden() -> Value {
-    let p = zoovr::testdata::project_root().join("tests/data/golden.json");
-    let text = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-    serde_json::from_str(&text).expect("golden.json parses")
-}
-
-fn f(v: &Value) -> f64 {
-    v.as_f64().expect("number")
-}
-
-fn rgb(v: &Value) -> [f64; 3] {
-    let a = v.as_array().expect("array");
-    [f(&a[0]), f(&a[1]), f(&a[2])]
-}
 
 /// One golden case: a transfer function, the cells of its ray front to
 /// back `(l, s_f, s_b)`, and the expected premultiplied RGBA.

@@ -7,24 +7,12 @@
 // Channels are compared across parallel arrays by index.
 #![allow(clippy::needless_range_loop)]
 
+mod golden_util;
+
+use golden_util::{f, golden, rgb};
 use serde_json::Value;
 use zoovr::integrate::{self, weights};
 use zoovr::tf::{EmissionModel, Node, TransferFunction};
-
-fn golden() -> Value {
-    let p = zoovr::testdata::project_root().join("tests/data/golden.json");
-    let text = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-    serde_json::from_str(&text).expect("golden.json parses")
-}
-
-fn f(v: &Value) -> f64 {
-    v.as_f64().expect("number")
-}
-
-fn rgb(v: &Value) -> [f64; 3] {
-    let a = v.as_array().expect("array");
-    [f(&a[0]), f(&a[1]), f(&a[2])]
-}
 
 fn close(got: f64, exp: f64, what: &str, id: &str) {
     let tol = 1e-12 * exp.abs() + 1e-300;
