@@ -19,6 +19,7 @@ use std::time::Instant;
 use criterion::{criterion_group, Criterion};
 use rayon::prelude::*;
 use zoovr::io::{self, ReadOptions};
+use zoovr::mesh::lattice_hex;
 
 const N: usize = 100;
 const BLOCK: usize = 1 << 15;
@@ -73,22 +74,12 @@ fn million_hex_file() -> PathBuf {
             }
         }
     }
-    let id = |i: usize, j: usize, k: usize| (i + n1 * (j + n1 * k)) as i64;
     let mut conn = Vec::with_capacity(nc * 64);
     for k in 0..N {
         for j in 0..N {
             for i in 0..N {
-                for v in [
-                    id(i, j, k),
-                    id(i + 1, j, k),
-                    id(i + 1, j + 1, k),
-                    id(i, j + 1, k),
-                    id(i, j, k + 1),
-                    id(i + 1, j, k + 1),
-                    id(i + 1, j + 1, k + 1),
-                    id(i, j + 1, k + 1),
-                ] {
-                    conn.extend(v.to_le_bytes());
+                for v in lattice_hex(n1, n1, [i, j, k]) {
+                    conn.extend(i64::from(v).to_le_bytes());
                 }
             }
         }

@@ -1,8 +1,8 @@
-//! Ray caster benchmark: the `hex_shell` scene of
-//! `../shared/data/synthetic/README.md`, generated in memory with the same
-//! map and field as `../shared/peer/gen_meshes.py` (64^3 points, 250,047
-//! curvilinear hexahedra, twisted 270-degree annular sector, point scalar `f`
-//! normalised to [0, 1], coordinates rounded to f32 like the file), camera
+//! Ray caster benchmark: the `hex_shell` scene (the shared dataset
+//! `synthetic/hex_shell_zlib.vtu`), generated in memory with the same map
+//! and field as that file (64^3 points, 250,047 curvilinear hexahedra,
+//! twisted 270-degree annular sector, point scalar `f` normalised to
+//! [0, 1], coordinates rounded to f32 like the file), camera
 //! azimuth 20, elevation 35, zoom 1.25, 512 x 512, and the transfer function
 //! of `bench_tf.json` (extinction = opacity / 0.5, glow colour).
 //!
@@ -111,7 +111,7 @@ pub fn hex_shell() -> (Mesh, Vec<f64>) {
     (mesh, f)
 }
 
-/// `bench_tf.json` (the copy in `../shared/data/synthetic/`), embedded so
+/// `bench_tf.json` (the copy in the shared `synthetic/` data), embedded so
 /// the bench runs without the shared data: the real transfer function and
 /// its closed-form segment integral.
 const BENCH_TF: &str = r#"{

@@ -1,6 +1,8 @@
 //! Every GPU mode end to end (`RENDER_BENCH_MODES=exact,exact-frag` picks),
-//! with its error against the reference ray caster (`faces`, PNG values): bluntfin (default field and TF), the
-//! hex_shell scene of `../shared/data/synthetic/README.md` (bench_tf.json,
+//! with its error against the reference ray caster (`faces`, PNG values):
+//! bluntfin (default field and TF), the hex_shell scene
+//! (`synthetic/hex_shell_zlib.vtu`: 250,047 curvilinear hexahedra in a
+//! twisted, C-shaped annular sector with nonplanar faces; bench_tf.json,
 //! azimuth 20, elevation 35, zoom 1.25, perspective) and the generated
 //! 1M-hex grid, at 512^2 and 1024^2, on every backend present (Vulkan
 //! lavapipe with f32 accumulation, GL llvmpipe with f16). For every case one
@@ -112,7 +114,8 @@ fn bench(c: &mut Criterion) {
         })
         .collect();
     for (name, scene, cam) in scenes() {
-        let mut renderer = Renderer::new(&scene);
+        let mut renderer = Renderer::new(scene.geometry());
+        let shading = scene.shading();
         for size in [512u32, 1024] {
             let camera = CameraParams {
                 width: size,
@@ -128,7 +131,7 @@ fn bench(c: &mut Criterion) {
                     mode: Mode::Raycast,
                     ..Default::default()
                 };
-                Some(renderer.render(&opts, |_, _| {}).unwrap().0)
+                Some(renderer.render(&shading, &opts, |_, _| {}).unwrap().0)
             };
             for &(bname, gpu) in &backends {
                 for &mode in &modes {
@@ -139,8 +142,8 @@ fn bench(c: &mut Criterion) {
                         ..Default::default()
                     };
                     // The first frame builds the sorter and opens the device.
-                    let (_, first) = renderer.render(&opts, |_, _| {}).unwrap();
-                    let (img, s) = renderer.render(&opts, |_, _| {}).unwrap();
+                    let (_, first) = renderer.render(&shading, &opts, |_, _| {}).unwrap();
+                    let (img, s) = renderer.render(&shading, &opts, |_, _| {}).unwrap();
                     let e = s.projected().unwrap();
                     let err = reference
                         .as_ref()
@@ -172,7 +175,7 @@ fn bench(c: &mut Criterion) {
                         let mut g = c.benchmark_group(format!("{mode}/{name}/{bname}"));
                         g.sample_size(10).measurement_time(Duration::from_secs(8));
                         g.bench_function(format!("{size}"), |b| {
-                            b.iter(|| renderer.render(&opts, |_, _| {}).unwrap())
+                            b.iter(|| renderer.render(&shading, &opts, |_, _| {}).unwrap())
                         });
                         g.finish();
                     }

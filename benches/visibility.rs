@@ -5,6 +5,8 @@
 //! when the readers can load it. Fixed seeds; the views are fixed camera
 //! angles at 512x512.
 
+use std::sync::Arc;
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::topology::Topology;
@@ -22,13 +24,14 @@ fn camera(mesh: &Mesh, k: usize, ortho: bool) -> Camera {
     Camera::fit(mesh.bounds(), &p)
 }
 
-fn bench_mesh(c: &mut Criterion, name: &str, mesh: &Mesh) {
+fn bench_mesh(c: &mut Criterion, name: &str, mesh: Mesh) {
+    let mesh = Arc::new(mesh);
     let topo = Topology::build(&mesh.cells);
-    let mut sorter = Sorter::new(mesh, &topo);
+    let mut sorter = Sorter::new(mesh.clone(), topo);
     let policy = SplitPolicy::default();
     // One report line with the stats of a typical view.
     let o = sorter
-        .order(&camera(mesh, 0, false), &policy)
+        .order(&camera(&mesh, 0, false), &policy)
         .expect("order");
     let s = &o.stats;
     eprintln!(
@@ -53,7 +56,7 @@ fn bench_mesh(c: &mut Criterion, name: &str, mesh: &Mesh) {
     // CPU time of this thread per view (robust against a loaded machine);
     // the cameras are made first (fitting one reads every point).
     let views = 6;
-    let cameras: Vec<Camera> = (0..views).map(|k| camera(mesh, k, k % 2 == 1)).collect();
+    let cameras: Vec<Camera> = (0..views).map(|k| camera(&mesh, k, k % 2 == 1)).collect();
     let cpu0 = thread_cpu_seconds();
     let wall0 = std::time::Instant::now();
     let mut split = 0;
@@ -107,17 +110,13 @@ fn visibility(c: &mut Criterion) {
         jitter: 0.2,
         ..planar
     };
-    bench_mesh(
-        c,
-        "grid_convex_planar_faces",
-        &grid(&planar, |_, _, _| true),
-    );
-    bench_mesh(c, "grid_convex_warped", &grid(&warped, |_, _, _| true));
-    bench_mesh(c, "grid_nonconvex_planar_faces", &holed_grid(&planar));
-    bench_mesh(c, "grid_nonconvex_warped", &holed_grid(&warped));
+    bench_mesh(c, "grid_convex_planar_faces", grid(&planar, |_, _, _| true));
+    bench_mesh(c, "grid_convex_warped", grid(&warped, |_, _, _| true));
+    bench_mesh(c, "grid_nonconvex_planar_faces", holed_grid(&planar));
+    bench_mesh(c, "grid_nonconvex_warped", holed_grid(&warped));
     if let Some(path) = zoovr::testdata::shared_file("bluntfin/bluntfin_converted.vts") {
         match zoovr::io::read(&path, &Default::default()) {
-            Ok(mesh) => bench_mesh(c, "bluntfin", &mesh),
+            Ok(mesh) => bench_mesh(c, "bluntfin", mesh),
             Err(e) => eprintln!("skipping bluntfin: {e}"),
         }
     }

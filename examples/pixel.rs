@@ -55,7 +55,7 @@ fn main() -> Result<()> {
     };
     let mesh = io::read(std::path::Path::new(file), &ReadOptions::default())?;
     let scene = Scene::build(mesh, &SceneSpec::default())?;
-    let mut renderer = Renderer::new(&scene);
+    let mut renderer = Renderer::new(scene.geometry());
     let opts = RenderOptions {
         camera,
         mode,
@@ -68,7 +68,7 @@ fn main() -> Result<()> {
         },
         ..Default::default()
     };
-    let (img, stats) = renderer.render(&opts, |_, _| {})?;
+    let (img, stats) = renderer.render(&scene.shading(), &opts, |_, _| {})?;
     let model = if split_all {
         FieldModel::Tets
     } else {
@@ -82,7 +82,7 @@ fn main() -> Result<()> {
         },
         ..opts.clone()
     };
-    let (reference, _) = renderer.render(&ropts, |_, _| {})?;
+    let (reference, _) = renderer.render(&scene.shading(), &ropts, |_, _| {})?;
     let gopts = RenderOptions {
         projected: ProjectedOptions {
             compositor: Compositor::Gpu,
@@ -90,7 +90,7 @@ fn main() -> Result<()> {
         },
         ..opts.clone()
     };
-    match renderer.render(&gopts, |_, _| {}) {
+    match renderer.render(&scene.shading(), &gopts, |_, _| {}) {
         Ok((g, _)) => {
             println!("{mode} (gpu)      {:?}", g.get(i, j));
             let (d, _) = zoovr::image::compare_display(&g, &img, [0.0; 3])?;

@@ -7,6 +7,7 @@
 //! the brute-force validator. Time-capped runs: `.ci/fuzz`.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{DMat3, DVec3};
 
@@ -270,8 +271,9 @@ pub fn visibility(data: &[u8]) {
     if mesh.cells.is_empty() {
         return;
     }
+    let mesh = Arc::new(mesh);
     let topo = Topology::build(&mesh.cells);
-    let mut sorter = Sorter::new(&mesh, &topo);
+    let mut sorter = Sorter::new(mesh.clone(), topo);
     let policy = SplitPolicy {
         all: data[8] & 4 != 0,
         ..Default::default()

@@ -28,7 +28,7 @@
 use glam::DVec3;
 
 use crate::field::{ArrayData, DataArray};
-use crate::mesh::{CellKind, Mesh, SourceInfo};
+use crate::mesh::{lattice_hex, CellKind, Mesh, SourceInfo};
 
 /// Warp parameters for [`warped_hex_grid`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,12 +98,6 @@ fn finish(mut mesh: Mesh, t: f64) -> Mesh {
     mesh
 }
 
-/// Point index of grid node `(i, j, k)` with `nx + 1` by `ny + 1` nodes per layer.
-#[inline]
-fn node(nx: usize, ny: usize, i: usize, j: usize, k: usize) -> u32 {
-    (i + (nx + 1) * (j + (ny + 1) * k)) as u32
-}
-
 /// Grid points of the unit cube, warped.
 fn grid_points(nx: usize, ny: usize, nz: usize, w: &Warp) -> Vec<DVec3> {
     let mut pts = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
@@ -120,21 +114,6 @@ fn grid_points(nx: usize, ny: usize, nz: usize, w: &Warp) -> Vec<DVec3> {
         }
     }
     pts
-}
-
-/// The 8 corner ids of cube `(i, j, k)` in VTK hexahedron order.
-fn cube(nx: usize, ny: usize, i: usize, j: usize, k: usize) -> [u32; 8] {
-    let n = |a, b, c| node(nx, ny, a, b, c);
-    [
-        n(i, j, k),
-        n(i + 1, j, k),
-        n(i + 1, j + 1, k),
-        n(i, j + 1, k),
-        n(i, j, k + 1),
-        n(i + 1, j, k + 1),
-        n(i + 1, j + 1, k + 1),
-        n(i, j + 1, k + 1),
-    ]
 }
 
 /// An `n x n x n` warped hexahedral grid (see the module docs).
@@ -157,7 +136,9 @@ pub fn warped_hex_grid_dims(dims: [usize; 3], warp: &Warp) -> Mesh {
     for k in 0..nz {
         for j in 0..ny {
             for i in 0..nx {
-                cells.conn.extend_from_slice(&cube(nx, ny, i, j, k));
+                cells
+                    .conn
+                    .extend_from_slice(&lattice_hex(nx + 1, ny + 1, [i, j, k]));
             }
         }
     }
@@ -279,7 +260,7 @@ pub fn zoo_grid(n: usize, warp: &Warp) -> Mesh {
     for k in 0..n {
         for j in 0..n {
             for i in 0..n {
-                let c = cube(n, n, i, j, k);
+                let c = lattice_hex(n + 1, n + 1, [i, j, k]);
                 match block(i as isize, n) {
                     Some(Block::Hex) | None => mesh.cells.push(CellKind::Hexahedron, &c),
                     Some(Block::Wedges) => {
@@ -341,7 +322,8 @@ pub fn ring_grid(n: usize, warp: &Warp) -> Mesh {
                 if (lo..hi).contains(&i) && (lo..hi).contains(&j) {
                     continue;
                 }
-                mesh.cells.push(CellKind::Hexahedron, &cube(n, n, i, j, k));
+                mesh.cells
+                    .push(CellKind::Hexahedron, &lattice_hex(n + 1, n + 1, [i, j, k]));
             }
         }
     }

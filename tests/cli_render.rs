@@ -22,29 +22,37 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// Runs `zoovr render FILE -o OUT ARGS...`.
+fn render(file: &Path, out: &Path, args: &[&str]) -> Output {
+    let mut all = vec![
+        "render",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    all.extend(args);
+    zoovr(&all)
+}
+
+/// Whether a render failed only for want of a GPU adapter (the exact mode
+/// is then skipped).
+fn no_adapter(o: &Output) -> bool {
+    !o.status.success() && stderr(o).contains("adapter")
+}
+
 #[test]
 fn renders_png_and_exr_in_both_modes() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = mesh_file("hexahedron.vtk");
-    let mesh = mesh.to_str().unwrap();
+    let view = ["--size", "64x48", "--azimuth", "-30", "--elevation", "20"];
     let ray_png = dir.path().join("ray.png");
     let ray_exr = dir.path().join("ray.exr");
-    let o = zoovr(&[
-        "render",
-        mesh,
-        "-o",
-        ray_png.to_str().unwrap(),
-        "--float",
-        ray_exr.to_str().unwrap(),
-        "--size",
-        "64x48",
-        "--mode",
-        "raycast",
-        "--azimuth",
-        "-30",
-        "--elevation",
-        "20",
-    ]);
+    let exr = ray_exr.to_str().unwrap();
+    let o = render(
+        &mesh,
+        &ray_png,
+        &[&view[..], &["--float", exr, "--mode", "raycast"]].concat(),
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let img = Image::read(&ray_png).unwrap();
     assert_eq!((img.width, img.height), (64, 48));
@@ -52,19 +60,8 @@ fn renders_png_and_exr_in_both_modes() {
     assert!(exr.pixels.iter().any(|p| p[3] > 0.01), "nothing drawn");
 
     let exact_png = dir.path().join("exact.png");
-    let o = zoovr(&[
-        "render",
-        mesh,
-        "-o",
-        exact_png.to_str().unwrap(),
-        "--size",
-        "64x48",
-        "--azimuth",
-        "-30",
-        "--elevation",
-        "20",
-    ]);
-    if !o.status.success() && stderr(&o).contains("adapter") {
+    let o = render(&mesh, &exact_png, &view);
+    if no_adapter(&o) {
         eprintln!("skipping the exact mode: {}", stderr(&o));
         return;
     }
@@ -175,23 +172,13 @@ fn usage_errors_say_what_is_wrong() {
 #[test]
 fn raycast_stats_and_other_mode_flags() {
     let dir = tempfile::tempdir().unwrap();
-    let png = dir.path().join("r.png");
-    let mesh = mesh_file("hexahedron.vtk");
-    let o = zoovr(&[
-        "render",
-        mesh.to_str().unwrap(),
-        "-o",
-        png.to_str().unwrap(),
-        "--size",
-        "32x32",
-        "--mode",
-        "raycast",
-        "--model",
-        "tets",
-        "--split",
-        "all",
-        "--stats",
-    ]);
+    let o = render(
+        &mesh_file("hexahedron.vtk"),
+        &dir.path().join("r.png"),
+        &[
+            "--size", "32x32", "--mode", "raycast", "--model", "tets", "--split", "all", "--stats",
+        ],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let e = stderr(&o);
     assert!(
@@ -211,18 +198,11 @@ fn stats_as_json() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("j.png");
     let mesh = mesh_file("hexahedron.vtk");
-    let o = zoovr(&[
-        "render",
-        mesh.to_str().unwrap(),
-        "-o",
-        png.to_str().unwrap(),
-        "--size",
-        "24x24",
-        "--mode",
-        "raycast",
-        "--stats",
-        "--json",
-    ]);
+    let o = render(
+        &mesh,
+        &png,
+        &["--size", "24x24", "--mode", "raycast", "--stats", "--json"],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["mode"], "raycast");
@@ -231,13 +211,7 @@ fn stats_as_json() {
     assert!(v["total_s"].as_f64().unwrap() >= 0.0);
     assert!(v["load_s"].as_f64().unwrap() >= 0.0);
     // --json needs --stats.
-    let o = zoovr(&[
-        "render",
-        mesh.to_str().unwrap(),
-        "-o",
-        png.to_str().unwrap(),
-        "--json",
-    ]);
+    let o = render(&mesh, &png, &["--json"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
 
@@ -263,16 +237,11 @@ fn unwritable_outputs_fail_cleanly_and_leave_nothing() {
     let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert!(left.is_empty(), "left behind: {left:?}");
 
-    let o = zoovr(&[
-        "render",
-        mesh.to_str().unwrap(),
-        "-o",
-        "/dev/null/x.png",
-        "--size",
-        "16x16",
-        "--mode",
-        "raycast",
-    ]);
+    let o = render(
+        &mesh,
+        Path::new("/dev/null/x.png"),
+        &["--size", "16x16", "--mode", "raycast"],
+    );
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("/dev/null/x.png"), "{}", stderr(&o));
 }
@@ -371,25 +340,12 @@ fn hidden_cells_are_left_out_unless_show_hidden() {
     for mode in ["raycast", "exact"] {
         let run = |file: &Path, out: &str, extra: &[&str]| {
             let png = dir.path().join(format!("{mode}_{out}.png"));
-            let mut args = vec![
-                "render",
-                file.to_str().unwrap(),
-                "-o",
-                png.to_str().unwrap(),
-                "--size",
-                "48x48",
-                "--azimuth",
-                "30",
-                "--elevation",
-                "25",
-                "--mode",
-                mode,
-            ];
-            args.extend(extra);
-            (zoovr(&args), png)
+            let view = ["--size", "48x48", "--azimuth", "30", "--elevation", "25"];
+            let o = render(file, &png, &[&view[..], &["--mode", mode], extra].concat());
+            (o, png)
         };
         let (o, ghost_png) = run(&ghost, "ghost", &["--stats"]);
-        if mode == "exact" && !o.status.success() && stderr(&o).contains("adapter") {
+        if mode == "exact" && no_adapter(&o) {
             eprintln!("skipping the exact mode: {}", stderr(&o));
             continue;
         }
@@ -436,16 +392,7 @@ fn malformed_ghost_arrays_are_named() {
         m.cell_data[0].data = ArrayData::Int(vec![0; len]);
         let file = dir.path().join(name);
         write_vtu(&file, &m, Compression::None).unwrap();
-        let o = zoovr(&[
-            "render",
-            file.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--size",
-            "16x16",
-            "--mode",
-            "raycast",
-        ]);
+        let o = render(&file, &out, &["--size", "16x16", "--mode", "raycast"]);
         assert_eq!(o.status.code(), Some(1), "{name}: {}", stderr(&o));
         let e = stderr(&o);
         eprintln!("{name}: {e}");

@@ -33,17 +33,20 @@
 //! include the blocker quads of `render::ties` (a centre a piece's snapped
 //! triangle covers but its exact outline does not).
 
+mod render_util;
+use render_util::gpu_available;
+
 use glam::DVec3;
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::generate::{warped_hex_grid, Warp};
-use zoovr::gpu::{Context, DrawKind, GpuOptions};
+use zoovr::gpu::DrawKind;
 use zoovr::image::Image;
 use zoovr::io::{self, ReadOptions};
 use zoovr::mesh::tetra::tetrahedralize_cell;
 use zoovr::mesh::Mesh;
 use zoovr::raycast::{self, FieldModel, Raycaster};
 use zoovr::render::{
-    Compositor, ProjectedOptions, RenderOptions, Renderer, ScalarsRef, Scene, SceneSpec,
+    Compositor, ProjectedOptions, RenderOptions, Renderer, ScalarsRef, Scene, SceneSpec, Shading,
 };
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
@@ -53,16 +56,6 @@ use zoovr::tf::{EmissionModel, TransferFunction};
 /// most half a grid step of 1/256 px in x and in y, so every point of an
 /// edge between snapped corners by at most `sqrt(2) / 512` px.
 const SNAP_BAND_PX: f64 = std::f64::consts::SQRT_2 / 512.0;
-
-fn gpu_available() -> bool {
-    match Context::new(&GpuOptions::default()) {
-        Ok(_) => true,
-        Err(e) => {
-            eprintln!("skipping the GPU counts: no adapter ({e})");
-            false
-        }
-    }
-}
 
 /// Constant extinction and colour: no breakpoint (every tet is one piece)
 /// and no piece skipped for zero extinction.
@@ -79,6 +72,7 @@ fn flat_tf(range: (f64, f64)) -> TransferFunction {
 
 fn counts(
     renderer: &mut Renderer,
+    shading: &Shading,
     camera: &Camera,
     kind: DrawKind,
     compositor: Compositor,
@@ -93,7 +87,7 @@ fn counts(
         ..Default::default()
     };
     renderer
-        .render_with_camera(&opts, camera, |_, _| {})
+        .render_with_camera(shading, &opts, camera, |_, _| {})
         .unwrap()
         .0
 }
@@ -195,18 +189,21 @@ fn red(img: &Image) -> Vec<usize> {
 /// a piece (folds the depth test resolves).
 fn check_twin(
     renderer: &mut Renderer,
+    shading: &Shading,
     camera: &Camera,
     gpu: bool,
     tag: &str,
 ) -> (Vec<usize>, usize) {
     let pieces = red(&counts(
         renderer,
+        shading,
         camera,
         DrawKind::CountPieces,
         Compositor::Cpu,
     ));
     let tris = red(&counts(
         renderer,
+        shading,
         camera,
         DrawKind::CountTriangles,
         Compositor::Cpu,
@@ -216,7 +213,7 @@ fn check_twin(
             (DrawKind::CountPieces, &pieces),
             (DrawKind::CountTriangles, &tris),
         ] {
-            let got = red(&counts(renderer, camera, kind, Compositor::Gpu));
+            let got = red(&counts(renderer, shading, camera, kind, Compositor::Gpu));
             let bad: Vec<usize> = (0..got.len()).filter(|&k| got[k] != twin[k]).collect();
             assert!(
                 bad.is_empty(),
@@ -268,9 +265,9 @@ fn on_grid_meshes_are_covered_exactly_once() {
         let (mesh, camera) = on_grid(6, shear);
         let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
         scene.tf = flat_tf(scene.range);
-        let mut renderer = Renderer::new(&scene);
+        let mut renderer = Renderer::new(scene.geometry());
         let tag = format!("on-grid shear {shear}");
-        let (pieces, folds) = check_twin(&mut renderer, &camera, gpu, &tag);
+        let (pieces, folds) = check_twin(&mut renderer, &scene.shading(), &camera, gpu, &tag);
         let want = reference_counts(&scene, &camera);
         // No band: a single mismatch fails.
         check_mismatches(&scene, &camera, &pieces, &want, -1.0, &tag);
@@ -314,7 +311,7 @@ fn datasets_are_covered_exactly_once_in_random_views() {
         let mesh = io::read(&path, &ReadOptions::default()).unwrap();
         let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
         scene.tf = flat_tf(scene.range);
-        let mut renderer = Renderer::new(&scene);
+        let mut renderer = Renderer::new(scene.geometry());
         for view in 0..8 {
             let params = CameraParams {
                 width: 48 + (next() * 48.0) as u32,
@@ -327,7 +324,7 @@ fn datasets_are_covered_exactly_once_in_random_views() {
             };
             let camera = Camera::fit(scene.mesh.bounds(), &params);
             let tag = format!("{} view {view} {params:?}", path.display());
-            let (pieces, folds) = check_twin(&mut renderer, &camera, gpu, &tag);
+            let (pieces, folds) = check_twin(&mut renderer, &scene.shading(), &camera, gpu, &tag);
             let want = reference_counts(&scene, &camera);
             let snapped = check_mismatches(&scene, &camera, &pieces, &want, SNAP_BAND_PX, &tag);
             eprintln!("{tag}: {snapped} snap-band pixels, {folds} fold pixels");

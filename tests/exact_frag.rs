@@ -1,6 +1,6 @@
 //! The exact-frag stage's integral (`shaders/integral.wgsl`) against the
-//! golden vectors (mpmath, 50 digits; `../shared/math/golden.json`, skipped
-//! when absent): through its CPU twin (`render::modes::integral`) and on the
+//! golden vectors (mpmath, 50 digits; `tests/data/golden.json`, format in
+//! docs/math.md section 7): through its CPU twin (`render::modes::integral`) and on the
 //! GPU, where each case is one pixel drawn by the stage itself into an f32
 //! target (skipped without an adapter that blends f32).
 //!
@@ -13,6 +13,9 @@
 //! display resolution is 1/255 = 3.9e-3; the closed form in `f32` is good
 //! to about 1e-6 relative, the table-free GPU `exp` to a few ulp).
 
+mod golden_util;
+
+use golden_util::{f, golden, rgb};
 use serde_json::Value;
 use zoovr::gpu::{AccumFormat, ClipMapper, Context, FrameOptions, GpuOptions};
 use zoovr::render::modes::exact_frag::bind_exact_frag_stage;
@@ -21,24 +24,6 @@ use zoovr::render::modes::segment::{SegmentVertex, SegmentView};
 
 const REL: f64 = 1e-5;
 const ABS: f64 = 1e-6;
-
-fn golden() -> Option<Value> {
-    let p = zoovr::testdata::project_root().join("../shared/math/golden.json");
-    let Ok(text) = std::fs::read_to_string(&p) else {
-        eprintln!("skipping: {} not found", p.display());
-        return None;
-    };
-    Some(serde_json::from_str(&text).expect("golden.json parses"))
-}
-
-fn f(v: &Value) -> f64 {
-    v.as_f64().expect("number")
-}
-
-fn rgb(v: &Value) -> [f64; 3] {
-    let a = v.as_array().expect("array");
-    [f(&a[0]), f(&a[1]), f(&a[2])]
-}
 
 /// One golden case: a transfer function, the cells of its ray front to
 /// back `(l, s_f, s_b)`, and the expected premultiplied RGBA.
@@ -150,7 +135,7 @@ fn check(case: &Case, got: [f32; 4], how: &str) -> f64 {
 
 #[test]
 fn golden_through_the_twin() {
-    let Some(g) = golden() else { return };
+    let g = golden();
     let consts = closed_form_constants();
     let cases = cases(&g);
     assert_eq!(cases.len(), 418);
@@ -168,7 +153,7 @@ fn golden_through_the_twin() {
 
 #[test]
 fn golden_on_the_gpu() {
-    let Some(g) = golden() else { return };
+    let g = golden();
     let gpu = match Context::new(&GpuOptions::default()) {
         Ok(c) => c,
         Err(e) => {
@@ -264,7 +249,8 @@ fn independent_emission_matches_the_reference() {
         EmissionModel::Independent,
     )
     .unwrap();
-    let mut r = Renderer::new(&scene);
+    let mut r = Renderer::new(scene.geometry());
+    let shading = scene.shading();
     for ortho in [false, true] {
         let base = RenderOptions {
             camera: CameraParams {
@@ -286,7 +272,7 @@ fn independent_emission_matches_the_reference() {
             },
             ..base.clone()
         };
-        let (expected, _) = r.render(&reference, |_, _| {}).unwrap();
+        let (expected, _) = r.render(&shading, &reference, |_, _| {}).unwrap();
         assert!(expected.pixels.iter().any(|p| p[3] == 0.0 && p[0] > 0.01));
         let mut compositors = vec![Compositor::Cpu];
         if Context::new(&GpuOptions::default()).is_ok() {
@@ -301,7 +287,7 @@ fn independent_emission_matches_the_reference() {
                 },
                 ..base.clone()
             };
-            let (got, _) = r.render(&opts, |_, _| {}).unwrap();
+            let (got, _) = r.render(&shading, &opts, |_, _| {}).unwrap();
             assert_eq!(got.count_non_finite(), 0);
             let (d, _) = compare_display(&got, &expected, [0.0; 3]).unwrap();
             eprintln!("ortho {ortho} {compositor:?}: max {:.2e}", d.max_abs);
@@ -313,7 +299,10 @@ fn independent_emission_matches_the_reference() {
             mode: Mode::Exact,
             ..base.clone()
         };
-        let err = r.render(&exact, |_, _| {}).unwrap_err().to_string();
+        let err = r
+            .render(&shading, &exact, |_, _| {})
+            .unwrap_err()
+            .to_string();
         assert!(
             err.contains("exact-frag") && err.contains("Independent"),
             "{err}"

@@ -6,10 +6,12 @@
 //! the cells and points drawn, the ghost array survives the writers and
 //! readers, and malformed ghost arrays are errors that name the array.
 
+mod render_util;
+use render_util::gpu_available;
+
 use zoovr::camera::CameraParams;
 use zoovr::field::{ArrayData, Association, DataArray};
 use zoovr::generate::{ghost_grid, ghost_grid_flags, Warp, GHOST_GRID_HIDDEN_VALUE};
-use zoovr::gpu::{Context, GpuOptions};
 use zoovr::image::Image;
 use zoovr::io::writer::{write_legacy_ascii, write_vtu, Compression};
 use zoovr::io::{self, ReadOptions};
@@ -21,16 +23,6 @@ use zoovr::render::{
 };
 
 const N: usize = 4;
-
-fn gpu_available() -> bool {
-    match Context::new(&GpuOptions::default()) {
-        Ok(_) => true,
-        Err(e) => {
-            eprintln!("skipping the exact mode: no GPU adapter ({e})");
-            false
-        }
-    }
-}
 
 /// Whether cell `c` of the `N`-grid is drawn (flag computed from its grid
 /// position, not read from the array).
@@ -86,7 +78,9 @@ fn render(scene: &Scene, mode: Mode) -> Image {
         },
         ..Default::default()
     };
-    let (img, _) = Renderer::new(scene).render(&opts, |_, _| {}).unwrap();
+    let (img, _) = Renderer::new(scene.geometry())
+        .render(&scene.shading(), &opts, |_, _| {})
+        .unwrap();
     assert_eq!(img.count_non_finite(), 0);
     img
 }

@@ -1,32 +1,18 @@
-//! Every vector of `shared/math/golden.json` (mpmath reference, 50 digits):
+//! Every vector of `tests/data/golden.json` (mpmath reference, 50 digits;
+//! format in docs/math.md section 7):
 //! 200 segments (basis integrals, both emission models, through `weights`
 //! and through a two-node transfer function) and 10 whole rays, within the
-//! file's recommended tolerances. Skips when the shared folder is absent.
+//! file's recommended tolerances.
 
 // Channels are compared across parallel arrays by index.
 #![allow(clippy::needless_range_loop)]
 
+mod golden_util;
+
+use golden_util::{f, golden, rgb};
 use serde_json::Value;
 use zoovr::integrate::{self, weights};
 use zoovr::tf::{EmissionModel, Node, TransferFunction};
-
-fn golden() -> Option<Value> {
-    let p = zoovr::testdata::project_root().join("../shared/math/golden.json");
-    let Ok(text) = std::fs::read_to_string(&p) else {
-        eprintln!("skipping: {} not found", p.display());
-        return None;
-    };
-    Some(serde_json::from_str(&text).expect("golden.json parses"))
-}
-
-fn f(v: &Value) -> f64 {
-    v.as_f64().expect("number")
-}
-
-fn rgb(v: &Value) -> [f64; 3] {
-    let a = v.as_array().expect("array");
-    [f(&a[0]), f(&a[1]), f(&a[2])]
-}
 
 fn close(got: f64, exp: f64, what: &str, id: &str) {
     let tol = 1e-12 * exp.abs() + 1e-300;
@@ -39,7 +25,7 @@ fn close(got: f64, exp: f64, what: &str, id: &str) {
 
 #[test]
 fn golden_segments() {
-    let Some(g) = golden() else { return };
+    let g = golden();
     let segs = g["segments"].as_array().expect("segments");
     assert_eq!(segs.len(), 200);
     for seg in segs {
@@ -124,7 +110,7 @@ fn ray_tf(tf: &Value, model: EmissionModel) -> TransferFunction {
 
 #[test]
 fn golden_rays() {
-    let Some(g) = golden() else { return };
+    let g = golden();
     let rays = g["rays"].as_array().expect("rays");
     assert_eq!(rays.len(), 10);
     for ray in rays {
@@ -153,7 +139,7 @@ fn golden_rays() {
 
 #[test]
 fn golden_slices_match_the_slicing_rule() {
-    let Some(g) = golden() else { return };
+    let g = golden();
     // The optical depth of each cell equals the sum over the file's
     // `slices_double` (sub-segments of the slicing rule): tells a slicing bug
     // from an integration bug.

@@ -1,5 +1,5 @@
-//! Legacy VTK reader: real files (counts and ranges from
-//! `../shared/data/README.md`), a cross-check against `vtkio`, small
+//! Legacy VTK reader: real files from `../shared/data` (their published
+//! cell and point counts and ranges), a cross-check against `vtkio`, small
 //! hand-written files for every section kind, the corrupt corpus in
 //! `meshes/corrupt/`, and a seeded mutation test (no panic, bounded time).
 

@@ -43,7 +43,9 @@ fn five_million_hexes_at_512() {
         },
         ..Default::default()
     };
-    let (img, stats) = Renderer::new(&scene).render(&opts, |_, _| {}).unwrap();
+    let (img, stats) = Renderer::new(scene.geometry())
+        .render(&scene.shading(), &opts, |_, _| {})
+        .unwrap();
     assert_eq!(img.count_non_finite(), 0);
     assert!(img.pixels.iter().filter(|p| p[3] > 1e-3).count() > 10_000);
     let e = stats.projected().unwrap();

@@ -1,6 +1,6 @@
-//! `MeshReport` on the shared real datasets against the numbers in
-//! `../shared/data/README.md` (cells, "neg" = inverted cells in VTK node
-//! order, "vol/hull" to 0.01). Skips cleanly when the data is absent; needs
+//! `MeshReport` on the shared real datasets (`../shared/data`) against
+//! their published figures (cells, "neg" = inverted cells in VTK node
+//! order, "vol/hull" to 0.01), stated with each case below. Skips cleanly when the data is absent; needs
 //! the legacy and XML readers. can_crush's distorted hexahedra give
 //! inverted consistent tets: counted, never a failure.
 

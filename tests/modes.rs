@@ -10,8 +10,9 @@
 //! meshes with the default transfer function. The registry test fails when
 //! a mode lacks its stage (shader), its CPU twin or its bounds.
 
+mod render_util;
+
 use zoovr::camera::CameraParams;
-use zoovr::gpu::{Context, GpuOptions};
 use zoovr::image::{compare_display, Image};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
@@ -20,6 +21,8 @@ use zoovr::render::{
     Compositor, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
 };
 use zoovr::testdata::mesh_file;
+
+use render_util::gpu_available;
 
 fn scene(name: &str) -> Scene {
     let mesh = io::read(&mesh_file(name), &ReadOptions::default()).unwrap();
@@ -43,8 +46,8 @@ fn options(mode: Mode, ortho: bool) -> RenderOptions {
 }
 
 fn render(scene: &Scene, opts: &RenderOptions) -> Image {
-    let (img, _) = Renderer::new(scene)
-        .render(opts, |_, _| {})
+    let (img, _) = Renderer::new(scene.geometry())
+        .render(&scene.shading(), opts, |_, _| {})
         .unwrap_or_else(|e| panic!("{:?}: {e}", opts.mode));
     assert_eq!(img.count_non_finite(), 0);
     img
@@ -101,16 +104,6 @@ fn registry_is_complete() {
     }
     // The reference exists.
     assert!(Mode::ALL.iter().any(|m| m.info().bounds.is_none()));
-}
-
-fn gpu_available() -> bool {
-    match Context::new(&GpuOptions::default()) {
-        Ok(_) => true,
-        Err(e) => {
-            eprintln!("GPU comparisons skipped: no adapter ({e})");
-            false
-        }
-    }
 }
 
 #[test]

@@ -8,13 +8,12 @@ mod projection_util;
 use glam::{DMat3, DVec2, DVec3};
 use projection_util::*;
 use zoovr::camera::{Camera, CameraParams};
-use zoovr::mesh::{CellKind, Cells};
+use zoovr::mesh::{lattice_hex, CellKind, Cells};
 use zoovr::numeric::predicates::{orient2d, Side};
 use zoovr::projection::{Polyhedron, Projected, Projector};
 
 /// A structured block of `n` hexes, mapped by `m`, `t`.
 fn block(n: [usize; 3], m: DMat3, t: DVec3, rng: &mut Rng) -> (Vec<DVec3>, Cells, Vec<f64>) {
-    let id = |i: usize, j: usize, k: usize| (i + (n[0] + 1) * (j + (n[1] + 1) * k)) as u32;
     let mut pts = Vec::new();
     for k in 0..=n[2] {
         for j in 0..=n[1] {
@@ -29,16 +28,7 @@ fn block(n: [usize; 3], m: DMat3, t: DVec3, rng: &mut Rng) -> (Vec<DVec3>, Cells
             for i in 0..n[0] {
                 cells.push(
                     CellKind::Hexahedron,
-                    &[
-                        id(i, j, k),
-                        id(i + 1, j, k),
-                        id(i + 1, j + 1, k),
-                        id(i, j + 1, k),
-                        id(i, j, k + 1),
-                        id(i + 1, j, k + 1),
-                        id(i + 1, j + 1, k + 1),
-                        id(i, j + 1, k + 1),
-                    ],
+                    &lattice_hex(n[0] + 1, n[1] + 1, [i, j, k]),
                 );
             }
         }

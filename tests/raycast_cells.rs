@@ -322,13 +322,7 @@ fn native_trilinear_field_matches_independent_quadrature() {
             }
             depth += h * mat.tau;
         }
-        let acc = rc.trace(
-            &m,
-            &r,
-            0.0,
-            &opts(FieldModel::Native),
-            &mut Default::default(),
-        );
+        let acc = trace_one(&rc, &m, &r, FieldModel::Native);
         assert!(
             (acc.depth - depth).abs() < 1e-7 * (1.0 + depth),
             "{} vs {depth}",
@@ -341,13 +335,7 @@ fn native_trilinear_field_matches_independent_quadrature() {
                 acc.color
             );
         }
-        let f = faces.trace(
-            &m,
-            &r,
-            0.0,
-            &opts(FieldModel::Faces),
-            &mut Default::default(),
-        );
+        let f = trace_one(&faces, &m, &r, FieldModel::Faces);
         model_gap = model_gap.max((f.depth - depth).abs());
     }
     // The test discriminates: the faces field differs from the trilinear one.

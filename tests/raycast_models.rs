@@ -144,27 +144,9 @@ fn faces_and_tets_bound_the_same_volume_on_a_warped_grid() {
         for j in 0..32 {
             for i in 0..32 {
                 let r = cam.pixel_ray(i, j);
-                let a = faces.trace(
-                    &m,
-                    &r,
-                    0.0,
-                    &opts(FieldModel::Faces),
-                    &mut Default::default(),
-                );
-                let b = tets.trace(
-                    &m,
-                    &r,
-                    0.0,
-                    &opts(FieldModel::Tets),
-                    &mut Default::default(),
-                );
-                let c = native.trace(
-                    &m,
-                    &r,
-                    0.0,
-                    &opts(FieldModel::Native),
-                    &mut Default::default(),
-                );
+                let a = trace_one(&faces, &m, &r, FieldModel::Faces);
+                let b = trace_one(&tets, &m, &r, FieldModel::Tets);
+                let c = trace_one(&native, &m, &r, FieldModel::Native);
                 assert!(
                     (a.depth - b.depth).abs() < 1e-10 * (1.0 + a.depth),
                     "pixel {i},{j}"

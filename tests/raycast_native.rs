@@ -260,13 +260,7 @@ fn check_against_brute_force(name: &str, mesh: &Mesh, s: &[f64], rays: &[Ray]) -
         let t_mid = (lo + hi - r.origin * 2.0).dot(r.dir) * 0.5;
         let (t0, t1) = (t_mid - ext, t_mid + ext);
         let (depth, color, len) = brute_force(mesh, s, &m, r, t0, t1);
-        let acc = native.trace(
-            &m,
-            r,
-            0.0,
-            &opts(FieldModel::Native),
-            &mut Default::default(),
-        );
+        let acc = trace_one(&native, &m, r, FieldModel::Native);
         let segs = native.native_segments(r, 0.0);
         let nl: f64 = segs.iter().map(|s| s.t_out - s.t_in).sum();
         assert!(
@@ -285,13 +279,7 @@ fn check_against_brute_force(name: &str, mesh: &Mesh, s: &[f64], rays: &[Ray]) -
                 acc.color
             );
         }
-        let f = faces.trace(
-            &m,
-            r,
-            0.0,
-            &opts(FieldModel::Faces),
-            &mut Default::default(),
-        );
+        let f = trace_one(&faces, &m, r, FieldModel::Faces);
         gap = gap.max((f.depth - depth).abs());
         hit += (len > 0.0) as usize;
         let wl: f64 = faces
@@ -438,20 +426,8 @@ fn two_cells_sharing_a_bulging_face_equal_their_single_cell_union() {
     }
     let mut differ = 0;
     for r in &rays {
-        let a = nb.trace(
-            &m,
-            r,
-            0.0,
-            &opts(FieldModel::Native),
-            &mut Default::default(),
-        );
-        let b = ns.trace(
-            &m,
-            r,
-            0.0,
-            &opts(FieldModel::Native),
-            &mut Default::default(),
-        );
+        let a = trace_one(&nb, &m, r, FieldModel::Native);
+        let b = trace_one(&ns, &m, r, FieldModel::Native);
         assert!(
             (a.depth - b.depth).abs() < 1e-8 * (1.0 + b.depth),
             "block {} vs single {} for {r:?}",
@@ -480,13 +456,7 @@ fn two_cells_sharing_a_bulging_face_equal_their_single_cell_union() {
             .map(|s| s.t_out - s.t_in)
             .sum();
         assert!((lb - ls).abs() < 1e-12 * (1.0 + ls), "{lb} vs {ls}");
-        let f = fb.trace(
-            &m,
-            r,
-            0.0,
-            &opts(FieldModel::Faces),
-            &mut Default::default(),
-        );
+        let f = trace_one(&fb, &m, r, FieldModel::Faces);
         differ += ((f.depth - b.depth).abs() > 1e-6) as usize;
     }
     assert!(
@@ -497,13 +467,7 @@ fn two_cells_sharing_a_bulging_face_equal_their_single_cell_union() {
     for r in rays.iter().skip(30).step_by(8) {
         let t_mid = (centre - r.origin).dot(r.dir);
         let (depth, _, _) = brute_force(&block, &s, &m, r, t_mid - 6.0, t_mid + 6.0);
-        let a = nb.trace(
-            &m,
-            r,
-            0.0,
-            &opts(FieldModel::Native),
-            &mut Default::default(),
-        );
+        let a = trace_one(&nb, &m, r, FieldModel::Native);
         assert!(
             (a.depth - depth).abs() < 1e-6 * (1.0 + depth),
             "{} vs {depth}",
@@ -571,13 +535,7 @@ fn close_breakpoint_crossings_are_all_bracketed() {
         color: vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
     };
     let rc = Raycaster::new(scene, FieldModel::Native).unwrap();
-    let acc = rc.trace(
-        &m,
-        &r,
-        0.0,
-        &opts(FieldModel::Native),
-        &mut Default::default(),
-    );
+    let acc = trace_one(&rc, &m, &r, FieldModel::Native);
     let (depth, color, _) = brute_force(&mesh, &s, &m, &r, -0.5, 2.5);
     assert!(
         (acc.depth - depth).abs() < 1e-6 * (1.0 + depth),

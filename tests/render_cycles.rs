@@ -56,7 +56,7 @@ fn cameras(scene: &Scene) -> Vec<Camera> {
 #[test]
 fn interlocked_tets_are_ordered_by_plane_cuts() {
     let scene = scene();
-    let mut sorter = Sorter::shared(scene.mesh.clone(), scene.topology.clone());
+    let mut sorter = Sorter::new(scene.mesh.clone(), scene.topology.clone());
     for cam in cameras(&scene) {
         let order = sorter.order(&cam, &SplitPolicy::default()).unwrap();
         let st = &order.stats;
@@ -117,7 +117,7 @@ fn interlocked_tets_are_ordered_by_plane_cuts() {
 #[test]
 fn without_plane_cuts_interlocked_tets_form_a_group() {
     let scene = scene();
-    let mut sorter = Sorter::shared(scene.mesh.clone(), scene.topology.clone());
+    let mut sorter = Sorter::new(scene.mesh.clone(), scene.topology.clone());
     sorter.plane_split = false;
     for cam in cameras(&scene) {
         let order = sorter.order(&cam, &SplitPolicy::default()).unwrap();
@@ -142,7 +142,7 @@ fn cycles_render_like_the_ray_caster() {
     }
     let scene = scene();
     for plane_split in [true, false] {
-        let mut r = Renderer::new(&scene);
+        let mut r = Renderer::new(scene.geometry());
         r.sorter().plane_split = plane_split;
         for (k, cam) in cameras(&scene).iter().enumerate() {
             let opts = |mode| RenderOptions {
@@ -154,10 +154,10 @@ fn cycles_render_like_the_ray_caster() {
                 ..Default::default()
             };
             let (exact, stats) = r
-                .render_with_camera(&opts(Mode::Exact), cam, |_, _| {})
+                .render_with_camera(&scene.shading(), &opts(Mode::Exact), cam, |_, _| {})
                 .unwrap();
             let (reference, _) = r
-                .render_with_camera(&opts(Mode::Raycast), cam, |_, _| {})
+                .render_with_camera(&scene.shading(), &opts(Mode::Raycast), cam, |_, _| {})
                 .unwrap();
             let e = stats.projected().expect("exact stats").clone();
             let covered = reference.pixels.iter().filter(|p| p[3] > 1e-3).count();

@@ -46,8 +46,8 @@ fn every_shared_dataset_renders_exact_at_256_without_nan() {
             },
             ..Default::default()
         };
-        let (img, stats) = Renderer::new(&scene)
-            .render(&opts, |_, _| {})
+        let (img, stats) = Renderer::new(scene.geometry())
+            .render(&scene.shading(), &opts, |_, _| {})
             .unwrap_or_else(|e| panic!("{rel}: {e}"));
         assert_eq!(img.count_non_finite(), 0, "{rel}: non-finite pixels");
         let covered = img.pixels.iter().filter(|p| p[3] > 1e-3).count();
@@ -79,7 +79,9 @@ fn render_mesh(ctx_opts: GpuOptions, accum: AccumFormat) -> Option<Image> {
         accum,
         ..Default::default()
     };
-    let (img, _) = Renderer::new(&scene).render(&opts, |_, _| {}).unwrap();
+    let (img, _) = Renderer::new(scene.geometry())
+        .render(&scene.shading(), &opts, |_, _| {})
+        .unwrap();
     Some(img)
 }
 
@@ -158,19 +160,21 @@ fn pending_context_is_used_and_gives_the_same_image() {
         },
         ..Default::default()
     };
-    let (direct, _) = Renderer::new(&scene).render(&opts, |_, _| {}).unwrap();
-    let mut r = Renderer::new(&scene);
+    let (direct, _) = Renderer::new(scene.geometry())
+        .render(&scene.shading(), &opts, |_, _| {})
+        .unwrap();
+    let mut r = Renderer::new(scene.geometry());
     r.set_pending_gpu(Context::spawn(&opts.gpu));
-    let (img, stats) = r.render(&opts, |_, _| {}).unwrap();
+    let (img, stats) = r.render(&scene.shading(), &opts, |_, _| {}).unwrap();
     assert!(stats.gpu_adapter.is_some());
     assert_eq!(img.pixels, direct.pixels);
     // Options that differ from the render's: a context of its own.
-    let mut r = Renderer::new(&scene);
+    let mut r = Renderer::new(scene.geometry());
     let other = GpuOptions {
         cpu_adapter: !opts.gpu.cpu_adapter,
         ..opts.gpu
     };
     r.set_pending_gpu(Context::spawn(&other));
-    let (img, _) = r.render(&opts, |_, _| {}).unwrap();
+    let (img, _) = r.render(&scene.shading(), &opts, |_, _| {}).unwrap();
     assert_eq!(img.pixels, direct.pixels);
 }

@@ -11,16 +11,16 @@
 //! PNGs under target/test-output. Skips cleanly without a GPU adapter or
 //! without the shared data.
 
+mod render_util;
+use render_util::{gpu_available, options};
+
 use std::path::Path;
 
 use zoovr::camera::CameraParams;
-use zoovr::gpu::{Context, GpuOptions};
 use zoovr::image::{check_images_with, Bounds, Image};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
-use zoovr::render::{
-    Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
-};
+use zoovr::render::{Mode, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec};
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
@@ -31,7 +31,7 @@ const MAX: f64 = 2.0 / 255.0;
 const RMS: f64 = 2e-3;
 /// One optically thick cell filling the view: inside a region the glow
 /// colour `C/alpha` is interpolated, which is exact only for constant colour
-/// (math README 8.1); colour refinement bounds it, but a single cell seen
+/// (docs/math.md 8.1); colour refinement bounds it, but a single cell seen
 /// whole keeps up to 2.25e-2 (voxel and hexahedron, orthographic, default
 /// TF).
 const THICK_CELL_MAX: f64 = 2.5e-2;
@@ -48,16 +48,6 @@ const CAN_CRUSH: (f64, f64) = (0.15, 4e-3);
 /// established: PentaHexa 1.11e-2 (perspective), AngularSector 8.6e-3
 /// (orthographic, kinked TF).
 const OPEN_GAP: (f64, f64) = (1.2e-2, RMS);
-
-fn gpu_available() -> bool {
-    match Context::new(&GpuOptions::default()) {
-        Ok(_) => true,
-        Err(e) => {
-            eprintln!("skipping: no GPU adapter ({e})");
-            false
-        }
-    }
-}
 
 /// A TF over `range` whose extinction has kinks at 30 %, 50 % and 70 % of
 /// the range and whose colour varies.
@@ -90,18 +80,11 @@ fn render(scene: &Scene, mode: Mode, model: FieldModel, split_all: bool, ortho: 
             ortho,
             ..Default::default()
         },
-        mode,
-        projected: ProjectedOptions {
-            split_all,
-            ..Default::default()
-        },
-        reference: ReferenceOptions {
-            model,
-            ..Default::default()
-        },
-        ..Default::default()
+        ..options(mode, split_all, model)
     };
-    let (img, _) = Renderer::new(scene).render(&opts, |_, _| {}).unwrap();
+    let (img, _) = Renderer::new(scene.geometry())
+        .render(&scene.shading(), &opts, |_, _| {})
+        .unwrap();
     assert_eq!(img.count_non_finite(), 0, "non-finite pixels");
     img
 }
@@ -204,7 +187,7 @@ fn single_cells_of_every_kind() {
         "hexagonal_prism",
     ] {
         // One optically thick cell filling the view: the interpolated C/alpha
-        // inside its regions errs up to ~1.2e-2 (math README 8.1) even after
+        // inside its regions errs up to ~1.2e-2 (docs/math.md 8.1) even after
         // colour refinement.
         check_file(
             &mesh_file(&format!("{name}.vtk")),
@@ -297,7 +280,9 @@ fn coverage_culling_changes_no_pixel() {
                         },
                         ..Default::default()
                     };
-                    let (img, stats) = Renderer::new(&scene).render(&opts, |_, _| {}).unwrap();
+                    let (img, stats) = Renderer::new(scene.geometry())
+                        .render(&scene.shading(), &opts, |_, _| {})
+                        .unwrap();
                     triangles[k] = stats.projected().unwrap().gpu.triangles;
                     images.push(img);
                 }

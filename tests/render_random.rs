@@ -85,7 +85,7 @@ fn random_views_match_the_reference_on_every_pixel() {
             ..Default::default()
         };
         let tag = format!("case {case}: {name} {camera:?}");
-        let mut renderer = Renderer::new(scene);
+        let mut renderer = Renderer::new(scene.geometry());
         let exact = RenderOptions {
             camera,
             projected: ProjectedOptions {
@@ -95,7 +95,9 @@ fn random_views_match_the_reference_on_every_pixel() {
             },
             ..Default::default()
         };
-        let (img, _) = renderer.render(&exact, |_, _| {}).unwrap();
+        let (img, _) = renderer
+            .render(&scene.shading(), &exact, |_, _| {})
+            .unwrap();
         let reference = RenderOptions {
             mode: Mode::Raycast,
             reference: ReferenceOptions {
@@ -104,7 +106,9 @@ fn random_views_match_the_reference_on_every_pixel() {
             },
             ..exact.clone()
         };
-        let (want, _) = renderer.render(&reference, |_, _| {}).unwrap();
+        let (want, _) = renderer
+            .render(&scene.shading(), &reference, |_, _| {})
+            .unwrap();
         assert_eq!(img.count_non_finite(), 0, "{tag}: non-finite pixels");
         let (d, _) = compare_display(&img, &want, [0.0; 3]).unwrap();
         eprintln!("{tag}: max {:.2e} rms {:.2e}", d.max_abs, d.rms);
@@ -122,7 +126,9 @@ fn random_views_match_the_reference_on_every_pixel() {
                 },
                 ..exact.clone()
             };
-            let (_, stats) = renderer.render(&watch, |_, _| {}).unwrap();
+            let (_, stats) = renderer
+                .render(&scene.shading(), &watch, |_, _| {})
+                .unwrap();
             let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_random");
             let _ = std::fs::create_dir_all(&dir);
             let _ = crop(&img, i, j, 8).write_png(

@@ -12,16 +12,16 @@
 //! perspective with the eye close to and inside the mesh (near-plane
 //! clipping). Skips the GPU modes cleanly without an adapter.
 
+mod render_util;
+use render_util::{gpu_available, options};
+
 use glam::DVec3;
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::generate::{warped_hex_grid, zoo_grid, Warp};
-use zoovr::gpu::{Context, GpuOptions};
 use zoovr::image::{check_images_with, Bounds, Image};
 use zoovr::mesh::Mesh;
 use zoovr::raycast::FieldModel;
-use zoovr::render::{
-    Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
-};
+use zoovr::render::{Mode, Renderer, Scene, SceneSpec};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
 /// Bounds on 99.9 % of pixels, isolated edge pixels up to
@@ -29,16 +29,6 @@ use zoovr::tf::{EmissionModel, TransferFunction};
 const P999: f64 = 1e-2;
 const RMS: f64 = 2e-3;
 const OUTLIER_MAX: f64 = 0.15;
-
-fn gpu() -> bool {
-    match Context::new(&GpuOptions::default()) {
-        Ok(_) => true,
-        Err(e) => {
-            eprintln!("skipping the GPU modes: {e}");
-            false
-        }
-    }
-}
 
 /// A TF over `range` with extinction from 0 to `tau_max` (per unit length),
 /// a kink in the middle, and varying colour.
@@ -120,24 +110,13 @@ fn run(case: Case, gpu: bool) {
     let size = 96;
     let mut scene = Scene::build(case.mesh, &SceneSpec::default()).unwrap();
     scene.tf = tf(case.range, case.tau_max);
-    let mut r = Renderer::new(&scene);
+    let mut r = Renderer::new(scene.geometry());
     for (vi, &v) in case.views.iter().enumerate() {
         let cam = camera(&scene.mesh, v, size);
         let mut render = |mode: Mode, model: FieldModel, split_all: bool| -> Image {
-            let opts = RenderOptions {
-                mode,
-                projected: ProjectedOptions {
-                    split_all,
-                    ..Default::default()
-                },
-                reference: ReferenceOptions {
-                    model,
-                    ..Default::default()
-                },
-                ..Default::default()
-            };
+            let opts = options(mode, split_all, model);
             let (img, _) = r
-                .render_with_camera(&opts, &cam, |_, _| {})
+                .render_with_camera(&scene.shading(), &opts, &cam, |_, _| {})
                 .unwrap_or_else(|e| panic!("{} view {vi} {mode:?}: {e}", case.name));
             assert_eq!(
                 img.count_non_finite(),
@@ -278,7 +257,7 @@ fn oblique() -> Vec<View> {
 
 #[test]
 fn thin_cells_and_slivers() {
-    let gpu = gpu();
+    let gpu = gpu_available();
     // A warped grid squashed to 1e-12 of its size in z: every cell a sheet,
     // its tets slivers. Extinction scaled so the optical depth is ~1.
     let mut m = grid(4, 0.05);
@@ -314,7 +293,7 @@ fn thin_cells_and_slivers() {
 
 #[test]
 fn edge_on_faces_and_coincident_projections() {
-    let gpu = gpu();
+    let gpu = gpu_available();
     // An unwarped grid: looking down an axis (ortho and perspective) every
     // side face is edge-on and vertices project onto vertices; along a face
     // diagonal, vertices project onto edges.
@@ -338,7 +317,7 @@ fn edge_on_faces_and_coincident_projections() {
 
 #[test]
 fn extinction_up_to_1e6() {
-    let gpu = gpu();
+    let gpu = gpu_available();
     for (name, tau) in [("tau_0", 0.0), ("tau_1e3", 1e3), ("tau_1e6", 1e6)] {
         run(
             Case {
@@ -356,7 +335,7 @@ fn extinction_up_to_1e6() {
 
 #[test]
 fn scalar_ranges_1e_minus_12_and_1e12() {
-    let gpu = gpu();
+    let gpu = gpu_available();
     // 1 + 1e-12 f: the whole range is 1e-12 wide, far from zero.
     let mut m = grid(4, 0.05);
     map_field(&mut m, |f| 1.0 + 1e-12 * f);
@@ -388,7 +367,7 @@ fn scalar_ranges_1e_minus_12_and_1e12() {
 
 #[test]
 fn coordinates_far_from_the_origin() {
-    let gpu = gpu();
+    let gpu = gpu_available();
     // UTM-like: a unit-sized grid 1e7 away from the origin.
     let mut m = grid(4, 0.05);
     transform(&mut m, |p| p + DVec3::new(1e7, -3e6, 2e7));
@@ -407,7 +386,7 @@ fn coordinates_far_from_the_origin() {
 
 #[test]
 fn eye_close_to_and_inside_the_mesh() {
-    let gpu = gpu();
+    let gpu = gpu_available();
     // The fitted eye sits at ~3.9 bounding radii; 0.35 puts it just outside
     // the grid's corner region, 0.1 inside the mesh (cells cross the near
     // plane and are clipped; rays start at the eye).
@@ -440,7 +419,7 @@ fn eye_close_to_and_inside_the_mesh() {
 /// leaves the box, so both renderers are checked against a closed form.
 #[test]
 fn eye_inside_a_constant_block_matches_the_closed_form() {
-    let gpu = gpu();
+    let gpu = gpu_available();
     let mut mesh = grid(3, 0.0);
     map_field(&mut mesh, |_| 0.5);
     let tau = 1.3;
@@ -480,26 +459,17 @@ fn eye_inside_a_constant_block_matches_the_closed_form() {
             want.pixels[(j * size + i) as usize] = [0.9 * a, 0.6 * a, 0.3 * a, a].map(|v| v as f32);
         }
     }
-    let mut r = Renderer::new(&scene);
+    let mut r = Renderer::new(scene.geometry());
     let mut modes = vec![(Mode::Raycast, FieldModel::Faces, false)];
     if gpu {
         modes.push((Mode::Exact, FieldModel::Faces, false));
         modes.push((Mode::Exact, FieldModel::Faces, true));
     }
     for (mode, model, split_all) in modes {
-        let opts = RenderOptions {
-            mode,
-            projected: ProjectedOptions {
-                split_all,
-                ..Default::default()
-            },
-            reference: ReferenceOptions {
-                model,
-                ..Default::default()
-            },
-            ..Default::default()
-        };
-        let (img, _) = r.render_with_camera(&opts, &cam, |_, _| {}).unwrap();
+        let opts = options(mode, split_all, model);
+        let (img, _) = r
+            .render_with_camera(&scene.shading(), &opts, &cam, |_, _| {})
+            .unwrap();
         let d = check_images_with(
             &format!("stress_eye_inside_block_{mode:?}_{split_all}"),
             &img,
@@ -522,7 +492,7 @@ fn eye_inside_a_constant_block_matches_the_closed_form() {
 /// matters to projection or ray casting), zero-volume cells add nothing.
 #[test]
 fn geometry_faults_render_consistently() {
-    let gpu = gpu();
+    let gpu = gpu_available();
     let path = zoovr::testdata::mesh_file("degenerate.vtk");
     let mesh = zoovr::io::read(&path, &Default::default()).unwrap();
     let report = zoovr::mesh::report::MeshReport::compute(&mesh);
@@ -561,7 +531,7 @@ fn geometry_faults_render_consistently() {
 /// within 1e-2.
 #[test]
 fn constant_block_has_no_seams_or_double_cover() {
-    if !gpu() {
+    if !gpu_available() {
         return;
     }
     let mut mesh = grid(6, 0.06);
@@ -575,7 +545,7 @@ fn constant_block_has_no_seams_or_double_cover() {
         EmissionModel::Glow,
     )
     .unwrap();
-    let mut r = Renderer::new(&scene);
+    let mut r = Renderer::new(scene.geometry());
     for (vi, view) in [
         View::Fit(20.0, 35.0, false),
         View::Fit(-50.0, 10.0, true),
@@ -586,15 +556,10 @@ fn constant_block_has_no_seams_or_double_cover() {
     {
         let cam = camera(&scene.mesh, view, 128);
         let mut img = |mode, split_all| {
-            let opts = RenderOptions {
-                mode,
-                projected: ProjectedOptions {
-                    split_all,
-                    ..Default::default()
-                },
-                ..Default::default()
-            };
-            r.render_with_camera(&opts, &cam, |_, _| {}).unwrap().0
+            let opts = options(mode, split_all, FieldModel::default());
+            r.render_with_camera(&scene.shading(), &opts, &cam, |_, _| {})
+                .unwrap()
+                .0
         };
         let reference = img(Mode::Raycast, false);
         for split_all in [false, true] {

@@ -1,6 +1,8 @@
 //! Bookkeeping and input handling of the visibility sorter: subdivisions kept
 //! and restored across views, breakpoint splits, typed errors on bad input.
 
+use std::sync::Arc;
+
 use glam::DVec3;
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::topology::Topology;
@@ -34,9 +36,9 @@ fn cam(mesh: &Mesh, az: f64, el: f64, ortho: bool) -> Camera {
 
 #[test]
 fn splits_are_kept_restored_and_history_free() {
-    let mesh = warped();
-    let topo = Topology::build(&mesh.cells);
-    let mut s = Sorter::new(&mesh, &topo);
+    let mesh = Arc::new(warped());
+    let topo = Arc::new(Topology::build(&mesh.cells));
+    let mut s = Sorter::new(mesh.clone(), topo.clone());
     let pol = SplitPolicy::default();
     let a = cam(&mesh, 30.0, 20.0, false);
     let b = cam(&mesh, 200.0, -50.0, true);
@@ -61,9 +63,9 @@ fn splits_are_kept_restored_and_history_free() {
 
 #[test]
 fn breakpoint_cells_match_brute_force() {
-    let mesh = warped();
-    let topo = Topology::build(&mesh.cells);
-    let mut s = Sorter::new(&mesh, &topo);
+    let mesh = Arc::new(warped());
+    let topo = Arc::new(Topology::build(&mesh.cells));
+    let mut s = Sorter::new(mesh.clone(), topo.clone());
     let scalars: Vec<f64> = mesh.points.iter().map(|p| p.x + p.y * p.z).collect();
     let bps = [0.3, 0.75];
     let want = (0..mesh.cells.len())
@@ -129,9 +131,9 @@ fn clip_tet(q: [DVec3; 4], o: DVec3, d: DVec3) -> Option<(f64, f64)> {
 /// entry and exit says which bands it meets, front to back).
 #[test]
 fn slabs_are_listed_back_to_front() {
-    let mesh = warped();
-    let topo = Topology::build(&mesh.cells);
-    let mut s = Sorter::new(&mesh, &topo);
+    let mesh = Arc::new(warped());
+    let topo = Arc::new(Topology::build(&mesh.cells));
+    let mut s = Sorter::new(mesh.clone(), topo.clone());
     let scalars: Vec<f64> = mesh.points.iter().map(|p| p.x + p.y * p.z).collect();
     let bps = [0.75, 0.3, 0.5];
     let pol = SplitPolicy {
@@ -249,8 +251,8 @@ fn slabs_are_listed_back_to_front() {
 
 #[test]
 fn bad_input_is_a_typed_error() {
-    let mesh = warped();
-    let topo = Topology::build(&mesh.cells);
+    let mesh = Arc::new(warped());
+    let topo = Arc::new(Topology::build(&mesh.cells));
     let c = cam(&mesh, 0.0, 0.0, false);
     // Point id out of range.
     let mut bad = Mesh {
@@ -258,22 +260,22 @@ fn bad_input_is_a_typed_error() {
         ..Default::default()
     };
     bad.cells.push(CellKind::Tetra, &[0, 1, 2, 7]);
-    let bt = Topology::build(&bad.cells);
-    let err = Sorter::new(&bad, &bt).order(&c, &SplitPolicy::default());
+    let bt = Arc::new(Topology::build(&bad.cells));
+    let err = Sorter::new(bad, bt.clone()).order(&c, &SplitPolicy::default());
     assert!(matches!(
         err,
         Err(VisibilityError::PointOutOfRange { point: 7, .. })
     ));
     // Non-finite point.
-    let mut nan = mesh.clone();
+    let mut nan = (*mesh).clone();
     nan.points[5].y = f64::NAN;
-    let err = Sorter::new(&nan, &topo).order(&c, &SplitPolicy::default());
+    let err = Sorter::new(nan, topo.clone()).order(&c, &SplitPolicy::default());
     assert_eq!(err.unwrap_err(), VisibilityError::NonFinitePoint(5));
     // Topology of another mesh.
-    let err = Sorter::new(&mesh, &bt).order(&c, &SplitPolicy::default());
+    let err = Sorter::new(mesh.clone(), bt).order(&c, &SplitPolicy::default());
     assert!(matches!(err, Err(VisibilityError::TopologyMismatch { .. })));
     // Too few scalars; empty image.
-    let mut s = Sorter::new(&mesh, &topo);
+    let mut s = Sorter::new(mesh.clone(), topo.clone());
     let short = [1.0, 2.0];
     let pol = SplitPolicy {
         all: false,
@@ -293,7 +295,7 @@ fn bad_input_is_a_typed_error() {
     // An empty mesh sorts to nothing.
     let none = Mesh::default();
     let nt = Topology::build(&none.cells);
-    let o = Sorter::new(&none, &nt)
+    let o = Sorter::new(none, nt)
         .order(&c, &SplitPolicy::default())
         .unwrap();
     assert!(o.pieces.is_empty());

@@ -25,7 +25,7 @@ proptest! {
         let bps: Vec<f64> = breakpoint.into_iter().collect();
         let policy = SplitPolicy { all: false, breakpoints: &bps, point_scalars: Some(&scalars) };
         let topo = Topology::build(&mesh.cells);
-        let mut sorter = Sorter::new(&mesh, &topo);
+        let mut sorter = Sorter::new(mesh.clone(), topo);
         for (az, el, ortho) in views {
             let p = CameraParams { width: 32, height: 32, azimuth: az, elevation: el, ortho, ..Default::default() };
             let cam = Camera::fit(mesh.bounds(), &p);

@@ -1,11 +1,13 @@
 //! Exactness of the visibility order on the real datasets of
-//! `../shared/data` (README there): 20 random views each, both projections,
+//! `../shared/data`: 20 random views each, both projections,
 //! checked by the brute-force validator on sampled pixel centres.
 //!
 //! Each test skips cleanly when the data folder is absent; a file that is
 //! present must read. The full runs take seconds in release builds (CI's
 //! `cargo test --release`) and are ignored in debug builds, where they are
 //! slow.
+
+use std::sync::Arc;
 
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::topology::Topology;
@@ -48,8 +50,9 @@ fn check_with(
     let Some(mesh) = load(rel) else {
         return;
     };
+    let mesh = Arc::new(mesh);
     let topo = Topology::build(&mesh.cells);
-    let mut sorter = Sorter::new(&mesh, &topo);
+    let mut sorter = Sorter::new(mesh.clone(), topo);
     let mut rng = Rng(0x5EED ^ rel.len() as u64);
     let policy = SplitPolicy {
         all: split_all,

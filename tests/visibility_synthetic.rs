@@ -1,6 +1,8 @@
 //! Exactness of the visibility order on generated meshes, checked by the
 //! brute-force validator at every pixel centre of small images.
 
+use std::sync::Arc;
+
 use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::topology::Topology;
 use zoovr::mesh::Mesh;
@@ -55,7 +57,7 @@ fn check_cover(mesh: &Mesh, order: &Order) {
 
 fn run_views(mesh: &Mesh, views: usize, size: u32, seed: u64, policy: &SplitPolicy) -> usize {
     let topo = Topology::build(&mesh.cells);
-    let mut sorter = Sorter::new(mesh, &topo);
+    let mut sorter = Sorter::new(mesh.clone(), topo);
     let mut rng = Rng(seed);
     let mut split_seen = 0;
     for v in 0..views {
@@ -95,7 +97,7 @@ fn convex_warped_grid_is_exact() {
     };
     let mesh = grid(&spec, |_, _, _| true);
     let topo = Topology::build(&mesh.cells);
-    assert!(Sorter::new(&mesh, &topo).convex_boundary());
+    assert!(Sorter::new(mesh.clone(), topo).convex_boundary());
     let split = run_views(&mesh, 20, 48, 11, &SplitPolicy::default());
     assert!(split > 0, "the jittered grid should have problem cells");
 }
@@ -122,7 +124,7 @@ fn grid_with_hole_and_cavity_is_exact() {
     };
     let mesh = holed_grid(&spec);
     let topo = Topology::build(&mesh.cells);
-    assert!(!Sorter::new(&mesh, &topo).convex_boundary());
+    assert!(!Sorter::new(mesh.clone(), topo).convex_boundary());
     run_views(&mesh, 20, 48, 13, &SplitPolicy::default());
 }
 
@@ -163,9 +165,9 @@ fn validator_catches_wrong_orders() {
         seed: 2,
         planar_boundary: true,
     };
-    let mesh = notched_grid(&spec);
+    let mesh = Arc::new(notched_grid(&spec));
     let topo = Topology::build(&mesh.cells);
-    let mut sorter = Sorter::new(&mesh, &topo);
+    let mut sorter = Sorter::new(mesh.clone(), topo);
     let mut rng = Rng(77);
     let mut mpvo_only_failures = 0;
     let mut constraints = 0;

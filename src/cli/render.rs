@@ -11,8 +11,8 @@ use zoovr::gpu::{AccumFormat, Backend, GpuOptions};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::{FieldModel, Traversal};
 use zoovr::render::{
-    Mode, ProjectedOptions, ReferenceOptions, RenderOptions, RenderStats, Renderer, Scene,
-    SceneSpec,
+    Geometry, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, RenderStats, Renderer,
+    SceneSpec, Shading,
 };
 
 use super::args::{parse_finite, parse_positive, parse_range, parse_rgb, parse_size};
@@ -169,15 +169,20 @@ impl ViewArgs {
         None
     }
 
-    /// Reads the file and builds the scene.
-    pub fn load_scene(&self, file: &std::path::Path) -> Result<Scene> {
+    /// Reads the file and builds its geometry and shading.
+    pub fn load_scene(&self, file: &std::path::Path) -> Result<(Geometry, Shading)> {
         let mesh = io::read(
             file,
             &ReadOptions {
                 q_file: self.q.clone(),
             },
         )?;
-        Scene::build(mesh, &self.scene_spec()).with_context(|| format!("{}", file.display()))
+        let spec = self.scene_spec();
+        let geometry = Geometry::build(mesh, spec.show_hidden)
+            .with_context(|| format!("{}", file.display()))?;
+        let shading =
+            Shading::build(&geometry, &spec).with_context(|| format!("{}", file.display()))?;
+        Ok((geometry, shading))
     }
 }
 
@@ -246,9 +251,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .gpu
         .then(|| zoovr::gpu::Context::spawn(&opts.gpu));
     let t0 = std::time::Instant::now();
-    let scene = args.view.load_scene(&args.file)?;
+    let (geometry, shading) = args.view.load_scene(&args.file)?;
     let load_s = t0.elapsed().as_secs_f64();
-    let mut renderer = Renderer::new(&scene);
+    let ghost_cells = geometry.ghost_cells;
+    let mut renderer = Renderer::new(geometry);
     if let Some(p) = pending {
         renderer.set_pending_gpu(p);
     }
@@ -274,7 +280,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     let (image, stats) = renderer
-        .render(&opts, progress_bar("rendering"))
+        .render(&shading, &opts, progress_bar("rendering"))
         .with_context(|| format!("{}", args.file.display()))?;
     if let Some(out) = &args.output {
         image.write_png(out, args.view.background, args.view.alpha)?;
@@ -283,12 +289,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         image.write_exr(out)?;
     }
     if args.view.json {
-        print_stats_json(&stats, load_s, scene.ghost_cells)?;
+        print_stats_json(&stats, load_s, ghost_cells)?;
     } else if args.view.stats {
-        if scene.ghost_cells > 0 {
+        if ghost_cells > 0 {
             eprintln!(
                 "ghost cells  {} left out (hidden or duplicate in vtkGhostType; --show-hidden draws them)",
-                scene.ghost_cells
+                ghost_cells
             );
         }
         print_stats(&stats, load_s);
@@ -297,6 +303,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // the GPU device to the operating system instead of freeing them piece
     // by piece (tens of milliseconds on large meshes).
     std::mem::forget(renderer);
-    std::mem::forget(scene);
+    std::mem::forget(shading);
     Ok(())
 }

@@ -1,5 +1,5 @@
 //! The "cylindrical" 2D re-mapping of the 3D pre-integration table
-//! (Röttger, Ertl 2002, section 4, equations 9 and 10; math README 8.5).
+//! (Röttger, Ertl 2002, section 4, equations 9 and 10; docs/math.md 8.5).
 //!
 //! In normalised coordinates (`S_f, S_b` = scalar mapped from the table range
 //! onto [0, 1], `L = l / l_max`) every fragment of one projected tetrahedron

@@ -15,7 +15,7 @@
 //! ```
 //!
 //! `MeanGlow` is the extinction-weighted mean glow times the exact opacity
-//! (math README 8.4): exact for a constant glow colour, bounded by the colour
+//! (docs/math.md 8.4): exact for a constant glow colour, bounded by the colour
 //! range. Where `|s_b - s_f|` is below
 //! [`INTEGRAL_FUNCTION_MIN_DS_REL`](crate::numeric::tolerance::INTEGRAL_FUNCTION_MIN_DS_REL)
 //! times the table's scalar range, the difference quotients lose their digits

@@ -3,7 +3,7 @@
 //!
 //! A cell segment `(l, s_f, s_b)` (scalar linear from `s_f` at the front to
 //! `s_b` at the back) is sliced at every breakpoint strictly between `s_f` and
-//! `s_b` (math README section 2): each piece takes the transfer-function piece
+//! `s_b` (docs/math.md section 2): each piece takes the transfer-function piece
 //! that contains its *midpoint* scalar and evaluates it at the piece's end
 //! scalars (exact node values at breakpoints). Pieces are integrated with
 //! [`weights`] and composited front to back, accumulating optical depth.

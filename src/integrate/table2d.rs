@@ -1,5 +1,5 @@
 //! 2D pre-integration tables over `(s_f, s_b)` at a reference length
-//! (Röttger, Kraus, Ertl 2000, section 4; math README 8.2).
+//! (Röttger, Kraus, Ertl 2000, section 4; docs/math.md 8.2).
 //!
 //! Two variants, both filled from the exact integrals at `l_ref`:
 //! * [`Table2dKind::LinearInL`] (RKE): texel `(C, alpha)` at `l_ref`; a

@@ -1,5 +1,5 @@
-//! Constants of the portable special functions (generated from
-//! `shared/math/sf_tables.py` and `gl_nodes.py`; do not edit by hand).
+//! Constants of the portable special functions (docs/math.md section 4.3;
+//! generated with mpmath, do not edit by hand).
 //!
 //! `SF_TABLE[k]` holds, at the centre `x_k = k/16` (k = 0..=128), the values
 //! `[P, Q, B, G]` with `P = sqrt(pi) erfcx(x)`, `Q = 1 - x P`, `B = 2 Dawson(x)`,

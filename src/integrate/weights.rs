@@ -1,5 +1,5 @@
-//! Basis integrals of one linear sub-segment (a port of
-//! `shared/math/closed_form.py`, `segment_weights`).
+//! Basis integrals of one linear sub-segment: the closed form and regime
+//! selection of docs/math.md sections 3 and 4.
 //!
 //! A sub-segment of length `l` has extinction linear from `tau_f` (front) to
 //! `tau_b` (back); with `a = tau_f l`, `b = tau_b l`, `x in [0, 1]` and the
@@ -12,11 +12,11 @@
 //! glow:      C = c_f w_f + c_b w_b          emission:  C = l (E_f phi_f + E_b phi_b)
 //! ```
 //!
-//! Regimes (math README section 4.2):
+//! Regimes (docs/math.md section 4.2):
 //! * `max(a, b) <= 2`: 12-point Gauss-Legendre over positive integrands, no
 //!   cancellation at any depth down to subnormals (error ~5e-16); 8 points
 //!   for `max(a, b) <= 1/2`, where they are as accurate (a speed refinement of
-//!   `closed_form.py`, checked by the golden and stress tests);
+//!   the closed form there, checked by the golden and stress tests);
 //! * `a == b`: constant extinction, `expm1` forms;
 //! * `b > a`: scaled complementary error function `P = sqrt(pi) erfcx` and
 //!   `Q = 1 - uP`; `b < a`: `B = 2 Dawson`, `G = 1 - vB`. For arguments up to
@@ -25,14 +25,10 @@
 //!   never overflow (so `tau_f ~ tau_b` and depths of 1e6 are harmless).
 
 use super::tables_sf::{GL12, GL8, SF_TABLE};
-use crate::numeric::tolerance::{SERIES_SUM_FLOOR, SERIES_TRUNCATION_REL};
+use crate::numeric::tolerance::{
+    GAUSS_LEGENDRE_8_MAX_DEPTH, GAUSS_LEGENDRE_MAX_DEPTH, SERIES_SUM_FLOOR, SERIES_TRUNCATION_REL,
+};
 
-/// Segments with `max(a, b)` at or below this use the Gauss-Legendre rule.
-const SMALL_DEPTH: f64 = 2.0;
-/// At or below this `max(a, b)` 8 nodes suffice: their error against 12
-/// nodes is 1e-14 at depth 1 but falls like `max(a, b)^16`, to rounding
-/// level (< 1e-15, tested) at 1/2; two thirds of the cost of 12 nodes.
-const SMALL_DEPTH_GL8: f64 = 0.5;
 /// Above this argument the special functions use their asymptotic series.
 const ASYM_X: f64 = 8.0;
 /// Spacing of the tabulated centres.
@@ -218,12 +214,12 @@ pub fn weights(a: f64, b: f64) -> Weights {
     let a = sanitize(a);
     let b = sanitize(b);
     let d1 = 0.5 * (a + b);
-    if a.max(b) <= SMALL_DEPTH {
+    if a.max(b) <= GAUSS_LEGENDRE_MAX_DEPTH {
         // One transcendental: T = 1 - alpha is accurate here (T >= e^-2).
         let alpha = -(-d1).exp_m1();
         let t = 1.0 - alpha;
         // Positive integrands only: no cancellation for any a, b >= 0.
-        let rule: &[(f64, f64)] = if a.max(b) <= SMALL_DEPTH_GL8 {
+        let rule: &[(f64, f64)] = if a.max(b) <= GAUSS_LEGENDRE_8_MAX_DEPTH {
             &GL8
         } else {
             &GL12

@@ -38,8 +38,9 @@ const HEX_FACES: &[&[u8]] = &[
 ];
 // Positive wedges follow VTK's parametric coordinates (nodes 0, 1, 2 at
 // (0,0,0), (1,0,0), (0,1,0); 3, 4, 5 above them): the normal of (0, 1, 2)
-// points towards (3, 4, 5). With this orientation `../shared/data/README.md`
-// counts su2_sphere_hybrid's 7,950 and notch's 4 wedges as negative. VTK's own
+// points towards (3, 4, 5). With this orientation all 7,950 wedges of the
+// su2_sphere_hybrid dataset and the 4 of notch count as negative (as VTK's
+// cell quality filter counts them). VTK's own
 // wedge face table lists these faces inward; ours lists them outward.
 const WEDGE_FACES: &[&[u8]] = &[
     &[0, 2, 1],

@@ -8,7 +8,7 @@
 //! their own array of the same name in point data, with
 //! [`DUPLICATE_POINT`] (1) and [`HIDDEN_POINT`] (2). ParaView draws
 //! neither hidden nor duplicate cells, and neither does zoovr:
-//! `render::Scene::build` calls [`remove_ghost_cells`] before it merges
+//! `render::Geometry::build` calls [`remove_ghost_cells`] before it merges
 //! points and builds topology (unless `--show-hidden`), so every mode, the
 //! visibility order and the reference ray caster see only the cells left.
 //!

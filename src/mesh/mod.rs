@@ -38,6 +38,25 @@ use data::DataArray;
 /// Sentinel for "no cell" / "no face".
 pub const NONE: u32 = u32::MAX;
 
+/// The point ids of cube `(i, j, k)` of a structured lattice with `nx x ny`
+/// points per layer (point `(i, j, k)` is `i + nx (j + ny k)`), in VTK
+/// hexahedron node order: the bottom face counter-clockwise seen from
+/// above, then the top face.
+#[inline]
+pub fn lattice_hex(nx: usize, ny: usize, [i, j, k]: [usize; 3]) -> [u32; 8] {
+    let id = |i: usize, j: usize, k: usize| (i + nx * (j + ny * k)) as u32;
+    [
+        id(i, j, k),
+        id(i + 1, j, k),
+        id(i + 1, j + 1, k),
+        id(i, j + 1, k),
+        id(i, j, k + 1),
+        id(i + 1, j, k + 1),
+        id(i + 1, j + 1, k + 1),
+        id(i, j + 1, k + 1),
+    ]
+}
+
 /// The 3D cells of a mesh in CSR layout.
 #[derive(Clone, Debug, Default)]
 pub struct Cells {
@@ -53,6 +72,28 @@ pub struct Cells {
 }
 
 impl Cells {
+    /// The hexahedra of a structured lattice of `dims` points (every
+    /// `dims[d] >= 2`; the point count must fit in `u32`), `i` fastest,
+    /// each by [`lattice_hex`].
+    pub fn lattice(dims: [usize; 3]) -> Cells {
+        let [nx, ny, nz] = dims;
+        let n = (nx - 1) * (ny - 1) * (nz - 1);
+        let mut conn = Vec::with_capacity(8 * n);
+        for k in 0..nz - 1 {
+            for j in 0..ny - 1 {
+                for i in 0..nx - 1 {
+                    conn.extend_from_slice(&lattice_hex(nx, ny, [i, j, k]));
+                }
+            }
+        }
+        Cells {
+            kinds: vec![CellKind::Hexahedron; n],
+            offsets: (0..=n as u32).map(|c| 8 * c).collect(),
+            conn,
+            poly_faces: Default::default(),
+        }
+    }
+
     /// Number of cells.
     pub fn len(&self) -> usize {
         self.kinds.len()

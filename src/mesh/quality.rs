@@ -24,7 +24,7 @@
 //! face's longer diagonal against
 //! [`crate::numeric::tolerance::NONPLANAR_REPORT_REL`], for each quad face of
 //! each cell (a face shared by two cells counts twice). This reproduces the
-//! "np faces" column of `../shared/data/README.md` exactly: bluntfin 2,
+//! nonplanar-face counts of the real datasets exactly: bluntfin 2,
 //! disk_out_ref 2,316, angular_sector 0, can_crush 24,569 (the last step of
 //! `can_crush/series/`; `can.vtu`, a different state, gives 24,570: the
 //! 24,570th face sits 1.3e-6 above the threshold).

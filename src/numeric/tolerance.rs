@@ -7,7 +7,8 @@
 
 /// Relative deviation (of the face's longer diagonal) of a quad face's fourth vertex
 /// from the plane of the other three above which `info` counts the face as
-/// nonplanar. Matches the figure used in `../shared/data/README.md`.
+/// nonplanar. The same threshold as the datasets' published nonplanar-face
+/// counts (`mesh::quality` reproduces them).
 pub const NONPLANAR_REPORT_REL: f64 = 1e-3;
 
 /// Cells whose |signed volume| is below this fraction of (bounding box
@@ -30,7 +31,7 @@ pub const EXP_TABLE_MAX_ABS_ERROR: f64 = 1.2e-4;
 /// Exact mode: a region edge is refined when (optical depth at its ends,
 /// capped at 1) x (largest glow-colour difference between its ends) exceeds
 /// this. Inside a region `C/alpha` is interpolated, which is exact only for
-/// constant glow colour; math README 8.1 measures errors up to ~7e-3 for
+/// constant glow colour; docs/math.md 8.1 measures errors up to ~7e-3 for
 /// depth <= 1 with colour spread 1. 0.02 left 0.06 on single pixels of
 /// coarse tet meshes seen up close (`tetraMesh`, 128 px, oblique
 /// orthographic view); 0.004 brings every pixel of the shared datasets
@@ -47,7 +48,7 @@ pub const COLOR_REFINE_MAX_DEPTH: u32 = 6;
 /// Integral-function table fills (`integrate::fast`): below this fraction of
 /// the table's scalar range, `|s_b - s_f|` is too small for the difference
 /// quotients `(T(s_b) - T(s_f)) / (s_b - s_f)` (they lose
-/// `log10(|T| / |T_b - T_f|)` digits, math README 8.4) and the point values
+/// `log10(|T| / |T_b - T_f|)` digits, docs/math.md 8.4) and the point values
 /// at the midpoint scalar are used instead (error O(ds) there).
 pub const INTEGRAL_FUNCTION_MIN_DS_REL: f64 = 1e-7;
 /// Projection (perspective): pieces are clipped at `near * NEAR_CLIP_SCALE`
@@ -329,3 +330,46 @@ pub const FILTER_UNDERFLOW_BOUND: f64 = 1e-250;
 /// is 7.000001 eps times the permanent; 16 eps leaves ample room. Not a
 /// tolerance on the answer: only a larger number of exact evaluations.
 pub const ORIENT_DIR_FILTER_EPS: f64 = 16.0 * f64::EPSILON;
+
+/// Bounding-volume hierarchies of the ray caster (the walk's boundary
+/// triangles, the brute force's cells): every box is grown by this fraction
+/// of the scene's size (bounding radius plus the largest coordinate of its
+/// centre). A ray that grazes a box edge within rounding must still test
+/// what is inside; whether it crosses is then decided exactly, so the
+/// padding only costs a few extra tests, never a different answer.
+pub const BVH_PAD_REL: f64 = 1e-9;
+
+/// Ray tie basis (`raycast::geometry::tie_basis`): when the image's right
+/// direction, with its component along the ray removed, has a squared
+/// length below this (unit vectors: the right vector is within ~1e-6 rad of
+/// the ray), it no longer defines a direction on the image and the basis is
+/// taken from the ray's direction alone.
+pub const TIE_BASIS_DEGENERATE_SQ: f64 = 1e-12;
+
+/// Visibility rasterisation (`visibility::raster`): projected coordinates
+/// of magnitude above this (pixels) are not trusted by the float
+/// edge-function filter (points near the eye plane in perspective, whose
+/// coordinates carry errors of many pixels); such triangles go to the
+/// exact ray/triangle test at every pixel centre.
+pub const RASTER_FILTER_MAX_COORD_PX: f64 = 1e7;
+
+/// Culling of zero-extinction pieces (`render::pieces`): the transfer
+/// function's left limit at a breakpoint `b` is taken at
+/// `b - max(|b|, LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL`, a few ulps below `b`
+/// (so inside the piece left of it, whose extinction may be positive while
+/// the value at `b` is zero), and never at `b` itself when `b` is 0.
+pub const LEFT_LIMIT_REL: f64 = 1e-15;
+/// See [`LEFT_LIMIT_REL`].
+pub const LEFT_LIMIT_FLOOR: f64 = 1e-300;
+
+/// Segment integrals (`integrate::weights`): segments whose larger optical
+/// depth `max(a, b)` is at most this use 12-point Gauss-Legendre over the
+/// positive integrands, accurate to ~5e-16 up to this depth with no
+/// cancellation at any depth down to subnormals (docs/math.md section 4.2);
+/// deeper segments use the closed forms.
+pub const GAUSS_LEGENDRE_MAX_DEPTH: f64 = 2.0;
+/// Segment integrals: at or below this `max(a, b)` 8 Gauss-Legendre nodes
+/// suffice: their error against 12 nodes is 1e-14 at depth 1 but falls like
+/// `max(a, b)^16`, to rounding level (< 1e-15, tested) at 1/2; two thirds
+/// of the cost of 12 nodes.
+pub const GAUSS_LEGENDRE_8_MAX_DEPTH: f64 = 0.5;

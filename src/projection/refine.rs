@@ -30,7 +30,7 @@
 //!   square root or division per edge; [`perspective_split`] decides the
 //!   same way);
 //! - colour accuracy in the exact mode ([`refine`] with the caller's
-//!   predicate, e.g. optical depth times colour spread, math README 8.1).
+//!   predicate, e.g. optical depth times colour spread, docs/math.md 8.1).
 
 use glam::DVec2;
 

@@ -89,7 +89,7 @@ use crate::integrate::{RayAccumulator, RayMaterial};
 use crate::mesh::tetra::{tetrahedralize, tetrahedralize_cell};
 use crate::mesh::CellKind;
 use crate::numeric::predicates::{orient3d, Side};
-use crate::numeric::tolerance::BRUTE_OVERLAP_REPORT_REL;
+use crate::numeric::tolerance::{BRUTE_OVERLAP_REPORT_REL, BVH_PAD_REL};
 
 /// Counts of a brute-force render (summed over every ray traced so far).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -151,7 +151,7 @@ pub struct Brute<'a> {
     bvh: Bvh,
     center: DVec3,
     radius: f64,
-    /// Padding of the boxes (scene size x 1e-9, as the walk's BVH).
+    /// Padding of the boxes ([`BVH_PAD_REL`] x scene size, as the walk's BVH).
     pad: f64,
     flat: usize,
     counts: [AtomicU64; 3],
@@ -271,7 +271,7 @@ impl<'a> Brute<'a> {
             ids.push(c as u32);
             dboxes.push((plo, phi));
         }
-        let pad = 1e-9 * (radius + center.abs().max_element()).max(f64::MIN_POSITIVE);
+        let pad = BVH_PAD_REL * (radius + center.abs().max_element()).max(f64::MIN_POSITIVE);
         let mut bvh = Bvh::build(&dboxes, pad);
         let order = bvh.renumber_in_leaf_order();
         let ids: Vec<u32> = order.iter().map(|&k| ids[k as usize]).collect();

@@ -36,7 +36,7 @@ use glam::DVec3;
 
 use crate::camera::Ray;
 use crate::numeric::predicates::{orient3d, Side};
-use crate::numeric::tolerance::{EDGE_ON_CROSSING_K, PLUCKER_FILTER_K};
+use crate::numeric::tolerance::{EDGE_ON_CROSSING_K, PLUCKER_FILTER_K, TIE_BASIS_DEGENERATE_SQ};
 
 /// A vertex in a ray's frame.
 #[derive(Clone, Copy, Debug, Default)]
@@ -62,7 +62,7 @@ pub struct Proj {
 pub fn tie_basis(ray: &Ray) -> (DVec3, DVec3) {
     let d = ray.dir;
     let r = ray.right - d * ray.right.dot(d);
-    let u = if r.length_squared() > 1e-12 {
+    let u = if r.length_squared() > TIE_BASIS_DEGENERATE_SQ {
         r.normalize()
     } else {
         let helper = if d.x.abs() < 0.6 { DVec3::X } else { DVec3::Y };

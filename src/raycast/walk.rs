@@ -31,6 +31,7 @@ use super::geometry::{Proj, RayFrame};
 use crate::mesh::tetra::triangulate_face;
 use crate::mesh::topology::Topology;
 use crate::mesh::{CellKind, Cells, NONE};
+use crate::numeric::tolerance::BVH_PAD_REL;
 
 /// One cell's part of a ray: the walk cell, entry and exit depth, and the
 /// entry and exit points as barycentric weights of triangle vertices.
@@ -147,7 +148,7 @@ impl<'a> WalkMesh<'a> {
                 (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
             })
             .collect();
-        let pad = 1e-9 * (radius + center.abs().max_element()).max(f64::MIN_POSITIVE);
+        let pad = BVH_PAD_REL * (radius + center.abs().max_element()).max(f64::MIN_POSITIVE);
         let bvh = Bvh::build(&boxes, pad);
         WalkMesh {
             points,

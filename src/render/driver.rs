@@ -707,7 +707,7 @@ mod tests {
             breakpoints: &breakpoints,
             point_scalars,
         };
-        let mut sorter = Sorter::shared(scene.mesh.clone(), scene.topology.clone());
+        let mut sorter = Sorter::new(scene.mesh.clone(), scene.topology.clone());
         let order = sorter.order(&camera, &policy).unwrap();
         let ctx = test_ctx(&scene, &camera, &breakpoints, &order, false);
         // Piece by piece, up to the first one that makes such a sliver (the
@@ -770,7 +770,7 @@ mod tests {
             breakpoints: &breakpoints,
             point_scalars: None,
         };
-        let mut sorter = Sorter::shared(scene.mesh.clone(), scene.topology.clone());
+        let mut sorter = Sorter::new(scene.mesh.clone(), scene.topology.clone());
         let order = sorter.order(&camera, &policy).unwrap();
         let ctx = test_ctx(&scene, &camera, &breakpoints, &order, true);
         let chunk = 64;

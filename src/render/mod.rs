@@ -1,11 +1,16 @@
 //! Rendering a scene in one of the modes, the same way for every caller
 //! (CLI `render`, `animate`, `bench`, tests).
 //!
-//! [`Scene`] holds what does not depend on the view; [`Renderer`] holds what
-//! is reused between views of one scene (the visibility sorter with its
-//! planes and subdivisions, the GPU context, the ray caster's structures);
-//! [`Renderer::render`] makes one image with the mode of
-//! [`RenderOptions::mode`]. The modes and their registry are in [`modes`];
+//! A [`Renderer`] is built once from a [`Geometry`] (points, cells, face
+//! adjacency) and owns what is reused between frames: the geometry, the
+//! visibility sorter with its planes and subdivisions, and the GPU context
+//! once one is opened. [`Renderer::render`] makes one image of a
+//! [`Shading`] (field, range, transfer function) with the mode of
+//! [`RenderOptions::mode`]; the shading may change from frame to frame (the
+//! steps of a time series with fixed topology) without rebuilding the
+//! topology or the sorter. The ray caster's structures are built per frame
+//! (they hold the frame's scalars). [`Scene`] is a geometry and one shading
+//! together, for one-off renders and tests. The modes and their registry are in [`modes`];
 //! every projected-cell mode runs on one driver ([`driver`]), which turns
 //! pieces into polyhedra through [`pieces`] and draws cycle groups
 //! ([`group`]) through the mode-independent layer stage.
@@ -28,15 +33,14 @@ use thiserror::Error;
 use crate::camera::Camera;
 use crate::gpu::{Context, GpuError, PendingContext};
 use crate::image::Image;
-use crate::raycast::brute::Brute;
-use crate::raycast::{self, FieldModel, Raycaster};
+use crate::raycast;
 use crate::visibility::{Sorter, VisibilityError};
 
 pub use breakpoints::split_points;
 pub use modes::{Bounds, Mode, ModeInfo};
 pub use options::{Compositor, ProjectedOptions, ReferenceOptions, RenderOptions};
 pub use pieces::PieceError;
-pub use scene::{ScalarsRef, Scene, SceneSpec};
+pub use scene::{Geometry, ScalarsRef, Scene, SceneSpec, Shading};
 pub use stats::{ModeStats, ProjectedStats, RaycastStats, RenderStats};
 
 /// Errors of a render.
@@ -52,6 +56,13 @@ pub enum RenderError {
     Ghost(#[from] crate::mesh::ghost::GhostError),
     #[error(transparent)]
     Field(#[from] crate::field::FieldError),
+    #[error("field '{name}' has {got} values, but the geometry has {want} {per}")]
+    FieldLength {
+        name: String,
+        got: usize,
+        want: usize,
+        per: &'static str,
+    },
     #[error("{path}: {msg}")]
     Tf { path: String, msg: String },
     #[error(transparent)]
@@ -73,27 +84,30 @@ pub enum RenderError {
     },
 }
 
-/// Reusable state for rendering many views of one scene.
-pub struct Renderer<'s> {
-    pub(crate) scene: &'s Scene,
+/// State reused across frames of one geometry: the geometry itself, the
+/// visibility sorter (made on first use) and the GPU context (opened on
+/// first use, or handed over with [`Renderer::set_pending_gpu`]).
+pub struct Renderer {
+    geometry: Geometry,
     sorter: Option<Sorter>,
     gpu: Option<Context>,
     pending_gpu: Option<PendingContext>,
-    pub(crate) raycaster: Option<(FieldModel, Raycaster<'s>)>,
-    pub(crate) brute: Option<(FieldModel, Brute<'s>)>,
 }
 
-impl<'s> Renderer<'s> {
-    /// A renderer for `scene` (nothing is built until the first render).
-    pub fn new(scene: &'s Scene) -> Renderer<'s> {
+impl Renderer {
+    /// A renderer for `geometry` (nothing is built until the first render).
+    pub fn new(geometry: Geometry) -> Renderer {
         Renderer {
-            scene,
+            geometry,
             sorter: None,
             gpu: None,
             pending_gpu: None,
-            raycaster: None,
-            brute: None,
         }
+    }
+
+    /// The geometry it renders.
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
     }
 
     /// Hands over a GPU context that is still opening ([`Context::spawn`]);
@@ -105,37 +119,39 @@ impl<'s> Renderer<'s> {
         }
     }
 
-    /// The visibility sorter of the exact mode (made on first use), e.g. to
-    /// change its options ([`Sorter::plane_split`], [`Sorter::nonconvex`]).
+    /// The visibility sorter of the projected-cell modes (made on first
+    /// use), e.g. to change its options ([`Sorter::plane_split`],
+    /// [`Sorter::nonconvex`]).
     pub fn sorter(&mut self) -> &mut Sorter {
-        let scene = self.scene;
+        let g = &self.geometry;
         self.sorter
-            .get_or_insert_with(|| Sorter::shared(scene.mesh.clone(), scene.topology.clone()))
+            .get_or_insert_with(|| Sorter::new(g.mesh.clone(), g.topology.clone()))
     }
 
-    /// Renders one image with the camera of `opts.camera` (fitted to the
-    /// mesh bounds, docs/conventions.md Conventions).
+    /// Renders one image of `shading` with the camera of `opts.camera`
+    /// (fitted to the mesh bounds, docs/conventions.md Conventions).
     pub fn render(
         &mut self,
+        shading: &Shading,
         opts: &RenderOptions,
         progress: impl FnMut(usize, usize),
     ) -> Result<(Image, RenderStats), RenderError> {
-        let camera = Camera::fit(self.scene.mesh.bounds(), &opts.camera);
-        self.render_with_camera(opts, &camera, progress)
+        let camera = Camera::fit(self.geometry.mesh.bounds(), &opts.camera);
+        self.render_with_camera(shading, opts, &camera, progress)
     }
 
-    /// Renders one image from an explicit camera (e.g. an eye moved inside
-    /// the mesh); `opts.camera` is not used.
+    /// Renders one image of `shading` from an explicit camera (e.g. an eye
+    /// moved inside the mesh); `opts.camera` is not used.
     pub fn render_with_camera(
         &mut self,
+        shading: &Shading,
         opts: &RenderOptions,
         camera: &Camera,
         progress: impl FnMut(usize, usize),
     ) -> Result<(Image, RenderStats), RenderError> {
         let t0 = Instant::now();
-        let scene = self.scene;
         let info = opts.mode.info();
-        let model = scene.tf.model();
+        let model = shading.tf.model();
         if !info.emission.contains(&model) {
             return Err(RenderError::Unsupported {
                 mode: info.name,
@@ -149,13 +165,22 @@ impl<'s> Renderer<'s> {
                     .join(", --mode "),
             });
         }
+        shading.check(&self.geometry)?;
+        // The frame's scene: the geometry and the field shared, not copied.
+        let scene = Scene::new(self.geometry.clone(), shading.clone());
         let (image, detail, setup_s) = match opts.mode {
-            Mode::Exact => self.projected(&modes::exact::ExactMode, opts, camera, progress)?,
-            Mode::ExactFrag => {
-                self.projected(&modes::exact_frag::ExactFragMode, opts, camera, progress)?
+            Mode::Exact => {
+                self.projected(&modes::exact::ExactMode, &scene, opts, camera, progress)?
             }
+            Mode::ExactFrag => self.projected(
+                &modes::exact_frag::ExactFragMode,
+                &scene,
+                opts,
+                camera,
+                progress,
+            )?,
             Mode::Raycast => {
-                let (img, s, setup) = modes::raycast::render(self, opts, camera, progress)?;
+                let (img, s, setup) = modes::raycast::render(&scene, opts, camera, progress)?;
                 (img, ModeStats::Raycast(s), setup)
             }
         };
@@ -176,29 +201,27 @@ impl<'s> Renderer<'s> {
     fn projected<M: driver::ProjectedMode>(
         &mut self,
         mode: &M,
+        scene: &Scene,
         opts: &RenderOptions,
         camera: &Camera,
         progress: impl FnMut(usize, usize),
     ) -> Result<(Image, ModeStats, f64), RenderError> {
         let t0 = Instant::now();
-        let scene = self.scene;
-        let mut sorter = self
+        let g = &self.geometry;
+        let sorter = self
             .sorter
-            .take()
-            .unwrap_or_else(|| Sorter::shared(scene.mesh.clone(), scene.topology.clone()));
+            .get_or_insert_with(|| Sorter::new(g.mesh.clone(), g.topology.clone()));
         let sorter_s = t0.elapsed().as_secs_f64();
-        let result = driver::render_projected(
+        let (img, stats) = driver::render_projected(
             mode,
             scene,
-            &mut sorter,
+            sorter,
             &mut self.gpu,
             &mut self.pending_gpu,
             opts,
             camera,
             progress,
-        );
-        self.sorter = Some(sorter);
-        let (img, stats) = result?;
+        )?;
         let setup_s = sorter_s + stats.gpu_open_s;
         Ok((img, ModeStats::Projected(Box::new(stats)), setup_s))
     }

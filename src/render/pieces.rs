@@ -19,6 +19,7 @@ use glam::DVec3;
 use crate::camera::Camera;
 use crate::integrate::RayMaterial;
 use crate::mesh::Mesh;
+use crate::numeric::tolerance::{LEFT_LIMIT_FLOOR, LEFT_LIMIT_REL};
 use crate::projection::coverage::PixelGrid;
 use crate::projection::{ClipValue, Clipper, Polyhedron, ProjectionError};
 use crate::tf::TransferFunction;
@@ -314,7 +315,7 @@ impl PieceSource<'_> {
         }
         for &b in self.tf.breakpoints_slice() {
             if b >= lo && b <= hi {
-                let left = b - b.abs().max(1e-300) * 1e-15;
+                let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
                 if !dark(b) || !dark(left) {
                     return false;
                 }

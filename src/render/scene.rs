@@ -1,6 +1,12 @@
-//! A scene ready to render: mesh, topology, scalar field and transfer function.
+//! What a render draws, in two parts: the [`Geometry`] (points, cells, face
+//! adjacency: fixed across the steps of a time series with fixed topology)
+//! and the [`Shading`] (the scalar field, its range and the transfer
+//! function: changing per step). A [`crate::render::Renderer`] is built once
+//! from a geometry and renders any shading of it; a [`Scene`] is the two
+//! together, a convenience for one-off renders and tests.
 //!
-//! [`Scene::build`] applies the conventions of docs/conventions.md in one place, so every
+//! [`Geometry::build`] and [`Shading::build`] (or [`Scene::build`], both at
+//! once) apply the conventions of docs/conventions.md in one place, so every
 //! mode renders the same thing:
 //! - cells the file flags hidden or duplicate in its `vtkGhostType` cell
 //!   array are left out first, with their cell-data values and the points
@@ -34,7 +40,8 @@ use crate::tf::{presets, TransferFunction};
 
 use super::RenderError;
 
-/// How to pick the field and transfer function.
+/// How to pick the field and transfer function ([`SceneSpec::show_hidden`]:
+/// which cells the geometry keeps).
 #[derive(Clone, Debug, Default)]
 pub struct SceneSpec {
     /// `--field`.
@@ -60,31 +67,40 @@ pub enum ScalarsRef<'a> {
     Constant(f64),
 }
 
-/// Everything a render needs that does not depend on the view.
-#[derive(Debug)]
-pub struct Scene {
+impl ScalarsRef<'_> {
+    /// The scalars of `field` (`None`: constant scalar 0).
+    pub fn of(field: Option<&ScalarField>) -> ScalarsRef<'_> {
+        match field {
+            Some(f) if f.association == Association::Point => ScalarsRef::Point(&f.values),
+            Some(f) => ScalarsRef::Cell(&f.values),
+            None => ScalarsRef::Constant(0.0),
+        }
+    }
+}
+
+/// The part of a scene that stays fixed across the steps of a time series
+/// with fixed topology: the mesh (points, cells, and the data arrays read
+/// with them) after hidden cells are left out and coincident points merged,
+/// and its face adjacency. Cloning shares the mesh and topology.
+#[derive(Clone, Debug)]
+pub struct Geometry {
     pub mesh: Arc<Mesh>,
     pub topology: Arc<Topology>,
-    /// The field integrated (`None`: constant scalar 0).
-    pub field: Option<ScalarField>,
-    /// Scalar range the TF was mapped onto.
-    pub range: (f64, f64),
-    pub tf: TransferFunction,
-    /// Opacity unit distance in world units (length scale of the scene).
-    pub unit_distance: f64,
-    /// Points merged when building the scene.
+    /// Points merged when building the geometry.
     pub merged_points: usize,
     /// Cells left out because `vtkGhostType` flags them hidden or duplicate.
     pub ghost_cells: usize,
 }
 
-impl Scene {
-    /// Builds the scene from a freshly read mesh.
-    pub fn build(mut mesh: Mesh, spec: &SceneSpec) -> Result<Scene, RenderError> {
+impl Geometry {
+    /// Leaves out hidden and duplicate cells (unless `show_hidden`), merges
+    /// coincident points and builds the face adjacency of a freshly read
+    /// mesh.
+    pub fn build(mut mesh: Mesh, show_hidden: bool) -> Result<Geometry, RenderError> {
         if mesh.cells.is_empty() {
             return Err(RenderError::NoCells);
         }
-        let ghost_cells = if spec.show_hidden {
+        let ghost_cells = if show_hidden {
             0
         } else {
             remove_ghost_cells(&mut mesh)?
@@ -94,12 +110,47 @@ impl Scene {
         }
         let merged_points = merge_coincident_points(&mut mesh);
         let topology = Topology::build(&mesh.cells);
-        let diagonal = mesh.diagonal();
-        let default_unit = if diagonal.is_finite() && diagonal > 0.0 {
+        Ok(Geometry {
+            mesh: Arc::new(mesh),
+            topology: Arc::new(topology),
+            merged_points,
+            ghost_cells,
+        })
+    }
+
+    /// The default opacity unit distance: bounds diagonal / 10 (1 when the
+    /// bounds are degenerate).
+    pub fn default_unit(&self) -> f64 {
+        let diagonal = self.mesh.diagonal();
+        if diagonal.is_finite() && diagonal > 0.0 {
             diagonal / 10.0
         } else {
             1.0
-        };
+        }
+    }
+}
+
+/// The part of a scene that changes per step of a time series: the field
+/// integrated, its range and the transfer function. Cloning shares the
+/// field's values.
+#[derive(Clone, Debug)]
+pub struct Shading {
+    /// The field integrated (`None`: constant scalar 0); one value per
+    /// point or per cell of the geometry it is rendered with.
+    pub field: Option<Arc<ScalarField>>,
+    /// Scalar range the TF was mapped onto.
+    pub range: (f64, f64),
+    pub tf: TransferFunction,
+    /// Opacity unit distance in world units (length scale of the scene).
+    pub unit_distance: f64,
+}
+
+impl Shading {
+    /// Picks the field from the arrays of `geometry`'s mesh and the
+    /// transfer function, as `spec` asks (module docs).
+    pub fn build(geometry: &Geometry, spec: &SceneSpec) -> Result<Shading, RenderError> {
+        let mesh = &*geometry.mesh;
+        let default_unit = geometry.default_unit();
         let file_tf = match &spec.tf_file {
             Some(p) => Some(
                 TransferFunction::from_json_file(p, default_unit).map_err(|e| RenderError::Tf {
@@ -117,11 +168,11 @@ impl Scene {
             Some(s) => Some(FieldSpec::parse(s)?),
             None => None,
         };
-        let mut field = field::select_field(&mesh, field_spec.as_ref())?;
+        let mut field = field::select_field(mesh, field_spec.as_ref())?;
         if spec.cell_to_point {
             if let Some(f) = &field {
                 if f.association == Association::Cell {
-                    field = Some(field::cell_to_point(&mesh, f));
+                    field = Some(field::cell_to_point(mesh, f));
                 }
             }
         }
@@ -136,27 +187,109 @@ impl Scene {
                     path: format!("preset '{name}'"),
                     msg: e.to_string(),
                 })?,
-            (None, None) => TransferFunction::default_for(range, diagonal),
+            (None, None) => TransferFunction::default_for(range, mesh.diagonal()),
         };
         let unit_distance = tf.unit_distance.unwrap_or(default_unit);
-        Ok(Scene {
-            mesh: Arc::new(mesh),
-            topology: Arc::new(topology),
-            field,
+        Ok(Shading {
+            field: field.map(Arc::new),
             range,
             tf,
             unit_distance,
-            merged_points,
-            ghost_cells,
         })
     }
 
     /// The scalars as the renderers take them.
     pub fn scalars(&self) -> ScalarsRef<'_> {
-        match &self.field {
-            Some(f) if f.association == Association::Point => ScalarsRef::Point(&f.values),
-            Some(f) => ScalarsRef::Cell(&f.values),
-            None => ScalarsRef::Constant(0.0),
+        ScalarsRef::of(self.field.as_deref())
+    }
+
+    /// Checks that the field has one value per point or per cell of
+    /// `geometry`.
+    pub fn check(&self, geometry: &Geometry) -> Result<(), RenderError> {
+        let Some(f) = &self.field else {
+            return Ok(());
+        };
+        let (want, per) = match f.association {
+            Association::Point => (geometry.mesh.points.len(), "points"),
+            Association::Cell => (geometry.mesh.cells.len(), "cells"),
+        };
+        if f.values.len() == want {
+            Ok(())
+        } else {
+            Err(RenderError::FieldLength {
+                name: f.name.clone(),
+                got: f.values.len(),
+                want,
+                per,
+            })
         }
+    }
+}
+
+/// A geometry and one shading of it, flat: everything one render needs that
+/// does not depend on the view.
+#[derive(Debug)]
+pub struct Scene {
+    pub mesh: Arc<Mesh>,
+    pub topology: Arc<Topology>,
+    /// The field integrated (`None`: constant scalar 0).
+    pub field: Option<Arc<ScalarField>>,
+    /// Scalar range the TF was mapped onto.
+    pub range: (f64, f64),
+    pub tf: TransferFunction,
+    /// Opacity unit distance in world units (length scale of the scene).
+    pub unit_distance: f64,
+    /// Points merged when building the scene.
+    pub merged_points: usize,
+    /// Cells left out because `vtkGhostType` flags them hidden or duplicate.
+    pub ghost_cells: usize,
+}
+
+impl Scene {
+    /// Builds the scene from a freshly read mesh ([`Geometry::build`], then
+    /// [`Shading::build`]).
+    pub fn build(mesh: Mesh, spec: &SceneSpec) -> Result<Scene, RenderError> {
+        let geometry = Geometry::build(mesh, spec.show_hidden)?;
+        let shading = Shading::build(&geometry, spec)?;
+        Ok(Scene::new(geometry, shading))
+    }
+
+    /// The scene of `geometry` shaded by `shading`.
+    pub fn new(geometry: Geometry, shading: Shading) -> Scene {
+        Scene {
+            mesh: geometry.mesh,
+            topology: geometry.topology,
+            field: shading.field,
+            range: shading.range,
+            tf: shading.tf,
+            unit_distance: shading.unit_distance,
+            merged_points: geometry.merged_points,
+            ghost_cells: geometry.ghost_cells,
+        }
+    }
+
+    /// Its geometry (shared, not copied).
+    pub fn geometry(&self) -> Geometry {
+        Geometry {
+            mesh: self.mesh.clone(),
+            topology: self.topology.clone(),
+            merged_points: self.merged_points,
+            ghost_cells: self.ghost_cells,
+        }
+    }
+
+    /// Its shading (the field shared, not copied).
+    pub fn shading(&self) -> Shading {
+        Shading {
+            field: self.field.clone(),
+            range: self.range,
+            tf: self.tf.clone(),
+            unit_distance: self.unit_distance,
+        }
+    }
+
+    /// The scalars as the renderers take them.
+    pub fn scalars(&self) -> ScalarsRef<'_> {
+        ScalarsRef::of(self.field.as_deref())
     }
 }

@@ -19,7 +19,7 @@
 //! ```
 //!
 //! * `zoovr_tf`: format version, 1. May be omitted (files such as
-//!   `shared/data/synthetic/bench_tf.json` load as they are); any other
+//!   the benchmark's `bench_tf.json` load as they are); any other
 //!   value is an error.
 //! * `scalar` (optional): the field to colour by when `--field` is absent.
 //! * `emission` (optional): `"glow"` (default; source = extinction x colour)

@@ -24,7 +24,7 @@ use super::geometry::line_plane_t;
 use super::geometry::BoundaryTri;
 use crate::camera::Camera;
 use crate::numeric::predicates::{ray_triangle, RayHit};
-use crate::numeric::tolerance::RASTER_FILTER_PX;
+use crate::numeric::tolerance::{RASTER_FILTER_MAX_COORD_PX, RASTER_FILTER_PX};
 
 /// One boundary crossing of one pixel ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,10 +36,6 @@ pub struct Crossing {
     /// Index into the boundary triangle list.
     pub tri: u32,
 }
-
-/// Projected coordinates above this magnitude (pixels) are not trusted by the
-/// float filter (perspective points near the eye plane).
-const MAX_FILTER_COORD: f64 = 1e7;
 
 /// Boundary triangles per block of the parallel pass.
 const RASTER_BLOCK: usize = 1 << 11;
@@ -94,7 +90,9 @@ fn rasterize_one(
     let [a, b, c] = bt.verts.map(|v| points[v as usize]);
     let proj = [a, b, c].map(|p| camera.project(p));
     let filtered = proj.iter().all(|q| {
-        q.is_some_and(|(x, y, _)| x.abs() < MAX_FILTER_COORD && y.abs() < MAX_FILTER_COORD)
+        q.is_some_and(|(x, y, _)| {
+            x.abs() < RASTER_FILTER_MAX_COORD_PX && y.abs() < RASTER_FILTER_MAX_COORD_PX
+        })
     });
     let mut emit = |i_px: i64, j_px: i64| {
         let ray = camera.pixel_ray(i_px as u32, j_px as u32);

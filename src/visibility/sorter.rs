@@ -94,8 +94,7 @@ mod finish;
 /// Built once per geometry; call [`Sorter::order`] per view.
 #[derive(Clone, Debug)]
 pub struct Sorter {
-    /// The mesh and its topology, shared with the caller (never copied by
-    /// [`Sorter::shared`]).
+    /// The mesh and its topology, shared with the caller (never copied).
     pub(super) mesh: Arc<Mesh>,
     pub(super) topo: Arc<Topology>,
     pub(super) geom: Geometry,
@@ -140,23 +139,13 @@ struct RoundGraph {
 
 impl Sorter {
     /// Prepares the plane equations and adjacency of `mesh` (whose topology
-    /// is `topo`), copying the mesh's points and cells and the topology into
-    /// the sorter; [`Sorter::shared`] shares them instead. Invalid input
-    /// (point ids out of range, non-finite points, a topology of another
-    /// mesh) is reported by [`Sorter::order`].
-    pub fn new(mesh: &Mesh, topo: &Topology) -> Sorter {
-        let geo_mesh = Mesh {
-            points: mesh.points.clone(),
-            cells: mesh.cells.clone(),
-            ..Default::default()
-        };
-        Sorter::shared(Arc::new(geo_mesh), Arc::new(topo.clone()))
-    }
-
-    /// [`Sorter::new`] for a mesh and topology the caller shares: nothing is
-    /// copied, the sorter keeps the two `Arc`s for its lifetime (the
-    /// geometry must not change while it is in use; values may).
-    pub fn shared(mesh: Arc<Mesh>, topo: Arc<Topology>) -> Sorter {
+    /// is `topo`). Nothing is copied: the sorter keeps the two `Arc`s for
+    /// its lifetime (pass an owned `Mesh` or `Topology` to move it in, an
+    /// `Arc` to share it); the geometry must not change while it is in use,
+    /// the values may. Invalid input (point ids out of range, non-finite
+    /// points, a topology of another mesh) is reported by [`Sorter::order`].
+    pub fn new(mesh: impl Into<Arc<Mesh>>, topo: impl Into<Arc<Topology>>) -> Sorter {
+        let (mesh, topo) = (mesh.into(), topo.into());
         let n = mesh.cells.len();
         let invalid = super::input::check_input(&mesh, &topo);
         let (topo, geom) = if invalid.is_some() {

@@ -5,7 +5,7 @@
 
 use glam::DVec3;
 
-use crate::mesh::{CellKind, Mesh};
+use crate::mesh::{lattice_hex, CellKind, Mesh};
 
 /// A jittered structured grid.
 #[derive(Clone, Copy, Debug)]
@@ -59,7 +59,6 @@ pub fn grid(spec: &GridSpec, keep: impl Fn(usize, usize, usize) -> bool) -> Mesh
             }
         }
     }
-    let id = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
     for k in 0..nz {
         for j in 0..ny {
             for i in 0..nx {
@@ -68,16 +67,7 @@ pub fn grid(spec: &GridSpec, keep: impl Fn(usize, usize, usize) -> bool) -> Mesh
                 }
                 mesh.cells.push(
                     CellKind::Hexahedron,
-                    &[
-                        id(i, j, k),
-                        id(i + 1, j, k),
-                        id(i + 1, j + 1, k),
-                        id(i, j + 1, k),
-                        id(i, j, k + 1),
-                        id(i + 1, j, k + 1),
-                        id(i + 1, j + 1, k + 1),
-                        id(i, j + 1, k + 1),
-                    ],
+                    &lattice_hex(nx + 1, ny + 1, [i, j, k]),
                 );
             }
         }

@@ -5,11 +5,11 @@
 
 use glam::DVec3;
 use zoovr::camera::Ray;
-use zoovr::integrate::{Material, RayMaterial, SegmentValue};
+use zoovr::integrate::{Material, RayAccumulator, RayMaterial, SegmentValue};
 use zoovr::mesh::tetra::tetrahedralize_cell;
 use zoovr::mesh::topology::Topology;
-use zoovr::mesh::{CellKind, Cells, Mesh};
-use zoovr::raycast::{FieldModel, RaycastOptions};
+use zoovr::mesh::{lattice_hex, CellKind, Cells, Mesh};
+use zoovr::raycast::{FieldModel, RaycastOptions, Raycaster};
 
 /// Options for `model` with early ray termination off (exact comparisons).
 pub fn opts(model: FieldModel) -> RaycastOptions {
@@ -18,6 +18,17 @@ pub fn opts(model: FieldModel) -> RaycastOptions {
         early_termination: 0.0,
         ..Default::default()
     }
+}
+
+/// One ray traced by `rc` (built for `model`) from its origin, with fresh
+/// scratch and early termination off.
+pub fn trace_one(
+    rc: &Raycaster,
+    material: &impl RayMaterial,
+    ray: &Ray,
+    model: FieldModel,
+) -> RayAccumulator {
+    rc.trace(material, ray, 0.0, &opts(model), &mut Default::default())
 }
 
 /// Glow model with extinction and colour piecewise linear in `s` (nodes
@@ -145,19 +156,8 @@ pub fn grid(n: [usize; 3], map: impl Fn(f64, f64, f64) -> DVec3, perm: Option<&[
     for k in 0..n[2] {
         for j in 0..n[1] {
             for i in 0..n[0] {
-                cells.push(
-                    CellKind::Hexahedron,
-                    &[
-                        id(i, j, k),
-                        id(i + 1, j, k),
-                        id(i + 1, j + 1, k),
-                        id(i, j + 1, k),
-                        id(i, j, k + 1),
-                        id(i + 1, j, k + 1),
-                        id(i + 1, j + 1, k + 1),
-                        id(i, j + 1, k + 1),
-                    ],
-                );
+                let c = lattice_hex(px, py, [i, j, k]).map(|v| perm.map_or(v, |p| p[v as usize]));
+                cells.push(CellKind::Hexahedron, &c);
             }
         }
     }

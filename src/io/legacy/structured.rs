@@ -7,7 +7,7 @@
 //! less): its VTK cells are quads, lines or a vertex, which zoovr counts as
 //! ignored. The same builder serves the PLOT3D reader.
 
-use crate::mesh::{CellKind, Cells};
+use crate::mesh::Cells;
 
 /// Number of VTK cells of a structured grid (of whatever dimension).
 pub(crate) fn vtk_cell_count(dims: [usize; 3]) -> usize {
@@ -32,33 +32,10 @@ pub(crate) fn is_3d(dims: [usize; 3]) -> bool {
 /// The hexahedra of a 3D grid (none for a lower-dimensional one). The caller
 /// has checked that the point count `nx * ny * nz` fits in `u32`.
 pub(crate) fn hexahedra(dims: [usize; 3]) -> Cells {
-    let mut cells = Cells::default();
     if !is_3d(dims) {
-        return cells;
+        return Cells::default();
     }
-    let [nx, ny, nz] = dims;
-    let n = (nx - 1) * (ny - 1) * (nz - 1);
-    cells.kinds = vec![CellKind::Hexahedron; n];
-    cells.offsets = (0..=n).map(|c| (8 * c) as u32).collect();
-    cells.conn.reserve(8 * n);
-    let id = |i: usize, j: usize, k: usize| (i + nx * (j + ny * k)) as u32;
-    for k in 0..nz - 1 {
-        for j in 0..ny - 1 {
-            for i in 0..nx - 1 {
-                cells.conn.extend_from_slice(&[
-                    id(i, j, k),
-                    id(i + 1, j, k),
-                    id(i + 1, j + 1, k),
-                    id(i, j + 1, k),
-                    id(i, j, k + 1),
-                    id(i + 1, j, k + 1),
-                    id(i + 1, j + 1, k + 1),
-                    id(i, j + 1, k + 1),
-                ]);
-            }
-        }
-    }
-    cells
+    Cells::lattice(dims)
 }
 
 #[cfg(test)]

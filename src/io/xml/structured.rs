@@ -137,7 +137,7 @@ fn read_piece(
     let (pd, pa) = read_arrays(src, piece.child("PointData"), np, &mut notes)?;
     let (mut cd, ca) = read_arrays(src, piece.child("CellData"), file_cells, &mut notes)?;
     if solid {
-        mesh.cells = hexes(dims);
+        mesh.cells = Cells::lattice(dims);
         mesh.source
             .cells_by_type
             .insert(CellKind::Hexahedron.vtk_name().to_string(), file_cells);
@@ -151,36 +151,6 @@ fn read_piece(
     mesh.active_cell_scalars = ca;
     mesh.source.notes = notes;
     Ok(mesh)
-}
-
-/// The hexahedra of an `nx x ny x nz` lattice (all `n >= 2`).
-fn hexes(dims: [usize; 3]) -> Cells {
-    let [nx, ny, nz] = dims;
-    let n = (nx - 1) * (ny - 1) * (nz - 1);
-    let mut conn = Vec::with_capacity(8 * n);
-    let id = |i: usize, j: usize, k: usize| (i + nx * (j + ny * k)) as u32;
-    for k in 0..nz - 1 {
-        for j in 0..ny - 1 {
-            for i in 0..nx - 1 {
-                conn.extend_from_slice(&[
-                    id(i, j, k),
-                    id(i + 1, j, k),
-                    id(i + 1, j + 1, k),
-                    id(i, j + 1, k),
-                    id(i, j, k + 1),
-                    id(i + 1, j, k + 1),
-                    id(i + 1, j + 1, k + 1),
-                    id(i, j + 1, k + 1),
-                ]);
-            }
-        }
-    }
-    Cells {
-        kinds: vec![CellKind::Hexahedron; n],
-        offsets: (0..=n as u32).map(|c| 8 * c).collect(),
-        conn,
-        poly_faces: Default::default(),
-    }
 }
 
 fn rectilinear_points(

@@ -1,7 +1,8 @@
 //! The reference mode: the CPU ray caster ([`crate::raycast`]), walking by
 //! adjacency or, with [`Traversal::Brute`], testing every piece
-//! ([`crate::raycast::brute`]). Its acceleration structures are kept in the
-//! [`Renderer`] between views.
+//! ([`crate::raycast::brute`]). Its acceleration structures (the walk's
+//! boundary and bounding-volume hierarchy, or the brute force's pieces) are
+//! built per frame: they hold the frame's scalars.
 
 use std::time::Instant;
 
@@ -9,9 +10,9 @@ use crate::camera::Camera;
 use crate::image::Image;
 use crate::raycast::brute::Brute;
 use crate::raycast::{self, RaycastOptions, Raycaster, Traversal};
-use crate::render::scene::ScalarsRef;
+use crate::render::scene::{ScalarsRef, Scene};
 use crate::render::stats::RaycastStats;
-use crate::render::{RenderError, RenderOptions, Renderer};
+use crate::render::{RenderError, RenderOptions};
 use crate::tf::EmissionModel;
 
 use super::ModeInfo;
@@ -30,13 +31,12 @@ pub static INFO: ModeInfo = ModeInfo {
 /// Renders one image with the ray caster; returns it with its statistics
 /// and the seconds spent building the ray caster.
 pub(crate) fn render(
-    r: &mut Renderer,
+    scene: &Scene,
     opts: &RenderOptions,
     camera: &Camera,
     progress: impl FnMut(usize, usize),
 ) -> Result<(Image, RaycastStats, f64), RenderError> {
     let t0 = Instant::now();
-    let scene = r.scene;
     let scalars = match scene.scalars() {
         ScalarsRef::Point(v) => raycast::Scalars::Point(v),
         ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
@@ -62,27 +62,19 @@ pub(crate) fn render(
     let setup_s;
     let img = match opts.reference.traversal {
         Traversal::Walk => {
-            let rc = match r.raycaster.take() {
-                Some((m, rc)) if m == opts.reference.model => rc,
-                _ => Raycaster::new(rs, opts.reference.model)?,
-            };
+            let rc = Raycaster::new(rs, opts.reference.model)?;
             setup_s = t0.elapsed().as_secs_f64();
             let before = rc.native_stats();
             let img = rc.render_with_progress(&scene.tf, camera, &ro, progress);
             stats.native = rc.native_stats().since(&before);
-            r.raycaster = Some((opts.reference.model, rc));
             img
         }
         Traversal::Brute => {
-            let b = match r.brute.take() {
-                Some((m, b)) if m == opts.reference.model => b,
-                _ => Brute::new(rs, opts.reference.model)?,
-            };
+            let b = Brute::new(rs, opts.reference.model)?;
             setup_s = t0.elapsed().as_secs_f64();
             let before = b.stats();
             let img = b.render_with_progress(&scene.tf, camera, &ro, progress);
             stats.brute = b.stats().since(&before);
-            r.brute = Some((opts.reference.model, b));
             img
         }
     };

@@ -1,0 +1,120 @@
+//! One `Renderer` across frames: built once from a geometry, it renders
+//! one shading after another (the steps of a time series) and each image is
+//! the one a fresh renderer makes of that shading, bit for bit; a field of
+//! another mesh is a typed error, not a panic.
+//!
+//! The projected mode runs on its CPU twin, so no adapter is needed.
+
+use std::sync::Arc;
+
+use zoovr::camera::CameraParams;
+use zoovr::field::{Association, ScalarField};
+use zoovr::image::Image;
+use zoovr::io::{self, ReadOptions};
+use zoovr::render::{
+    Compositor, Geometry, Mode, ProjectedOptions, RenderError, RenderOptions, Renderer, SceneSpec,
+    Shading,
+};
+use zoovr::testdata::mesh_file;
+
+fn geometry() -> Geometry {
+    let mesh = io::read(&mesh_file("zoo_3x3x3.vtu"), &ReadOptions::default()).unwrap();
+    Geometry::build(mesh, false).unwrap()
+}
+
+fn options(mode: Mode) -> RenderOptions {
+    RenderOptions {
+        camera: CameraParams {
+            width: 64,
+            height: 48,
+            azimuth: 30.0,
+            elevation: 25.0,
+            ..Default::default()
+        },
+        mode,
+        projected: ProjectedOptions {
+            compositor: Compositor::Cpu,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+/// Step `k` of a synthetic series: a point field that changes per step,
+/// mapped by the shading of step 0 (the same transfer function and range).
+fn step(geometry: &Geometry, first: &Shading, k: usize) -> Shading {
+    let phase = k as f64 * 0.7;
+    let values: Vec<f64> = geometry
+        .mesh
+        .points
+        .iter()
+        .map(|p| (p.x * 1.3 + p.y * 0.4 + phase).sin() + p.z * 0.2)
+        .collect();
+    let lo = values.iter().cloned().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    Shading {
+        field: Some(Arc::new(ScalarField {
+            name: format!("step{k}"),
+            association: Association::Point,
+            values,
+            range: (lo, hi),
+        })),
+        ..first.clone()
+    }
+}
+
+fn fresh(geometry: &Geometry, shading: &Shading, opts: &RenderOptions) -> Image {
+    Renderer::new(geometry.clone())
+        .render(shading, opts, |_, _| {})
+        .unwrap()
+        .0
+}
+
+#[test]
+fn swapping_the_field_matches_a_fresh_renderer_bit_for_bit() {
+    let geometry = geometry();
+    let first = Shading::build(&geometry, &SceneSpec::default()).unwrap();
+    for mode in [Mode::Exact, Mode::Raycast] {
+        let opts = options(mode);
+        let mut renderer = Renderer::new(geometry.clone());
+        let mut images = Vec::new();
+        for k in 0..3 {
+            let shading = step(&geometry, &first, k);
+            let (img, _) = renderer.render(&shading, &opts, |_, _| {}).unwrap();
+            assert_eq!(img.count_non_finite(), 0);
+            let want = fresh(&geometry, &shading, &opts);
+            assert!(
+                img.pixels == want.pixels,
+                "{mode:?} step {k}: the reused renderer's image differs from a fresh one"
+            );
+            images.push(img);
+        }
+        // The steps differ, so the renderer did not keep an old field.
+        assert!(images[0].pixels != images[1].pixels, "{mode:?}");
+        assert!(images[1].pixels != images[2].pixels, "{mode:?}");
+        // The renderer kept its geometry: shared, not copied.
+        assert!(Arc::ptr_eq(&renderer.geometry().mesh, &geometry.mesh));
+    }
+}
+
+#[test]
+fn a_field_of_another_mesh_is_a_typed_error() {
+    let geometry = geometry();
+    let mut shading = Shading::build(&geometry, &SceneSpec::default()).unwrap();
+    let n = geometry.mesh.points.len();
+    shading.field = Some(Arc::new(ScalarField {
+        name: "short".into(),
+        association: Association::Point,
+        values: vec![0.0; n - 1],
+        range: (0.0, 0.0),
+    }));
+    for mode in [Mode::Exact, Mode::Raycast] {
+        let err = Renderer::new(geometry.clone())
+            .render(&shading, &options(mode), |_, _| {})
+            .unwrap_err();
+        assert!(
+            matches!(err, RenderError::FieldLength { got, want, .. } if got == n - 1 && want == n),
+            "{mode:?}: {err}"
+        );
+    }
+}
