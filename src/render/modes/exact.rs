@@ -14,7 +14,7 @@
 //!   ([`crate::integrate::vertex_values`]) gives the glow colour `C/alpha`
 //!   and the mean extinction `tau` along the vertex's ray of length `l`.
 //!   Region triangles whose vertices differ much in optical depth and glow
-//!   colour are refined (math README 8.1: `C/alpha` is interpolated inside a
+//!   colour are refined (docs/math.md 8.1: `C/alpha` is interpolated inside a
 //!   region), see [`COLOR_REFINE_TOL`]. Each piece's `l` and `tau` are
 //!   balanced for the table's axes ([`depth_balance`]);
 //! - **stage** (`shaders/exact.wgsl`, [`EXACT_STAGE`]): per fragment,
