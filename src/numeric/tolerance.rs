@@ -329,3 +329,10 @@ pub const FILTER_UNDERFLOW_BOUND: f64 = 1e-250;
 /// is 7.000001 eps times the permanent; 16 eps leaves ample room. Not a
 /// tolerance on the answer: only a larger number of exact evaluations.
 pub const ORIENT_DIR_FILTER_EPS: f64 = 16.0 * f64::EPSILON;
+
+/// Pre-integrated table modes: the longest tabulated length is the largest
+/// cell diameter (which bounds every segment through a piece) grown by this
+/// fraction, so that a segment of exactly that length, rounded to `f32` and
+/// rebuilt per fragment, still falls inside the table instead of being cut
+/// into two steps.
+pub const TABLE_LENGTH_MARGIN: f64 = 1e-3;

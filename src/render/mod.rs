@@ -33,7 +33,9 @@ use crate::visibility::{Sorter, VisibilityError};
 
 pub use breakpoints::split_points;
 pub use modes::{Bounds, Mode, ModeInfo};
-pub use options::{Compositor, ProjectedOptions, ReferenceOptions, RenderOptions};
+pub use options::{
+    Compositor, ProjectedOptions, ReferenceOptions, RenderOptions, TableBuild, TableOptions,
+};
 pub use pieces::PieceError;
 pub use scene::{ScalarsRef, Scene, SceneSpec};
 pub use stats::{ModeStats, ProjectedStats, RaycastStats, RenderStats};
@@ -63,6 +65,8 @@ pub enum RenderError {
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Raycast(#[from] raycast::RaycastError),
+    #[error(transparent)]
+    TableSize(#[from] modes::preint_tables::TableSizeError),
     #[error("the {mode} mode cannot draw {model:?} emission (it supports {supported}); use --mode raycast")]
     Unsupported {
         mode: &'static str,
@@ -145,6 +149,14 @@ impl<'s> Renderer<'s> {
             Mode::Exact => self.projected(&modes::exact::ExactMode, opts, camera, progress)?,
             Mode::ExactFrag => {
                 self.projected(&modes::exact_frag::ExactFragMode, opts, camera, progress)?
+            }
+            Mode::Preint3d | Mode::Preint2d | Mode::Preint2dCyl => {
+                let mode = modes::preint::PreintMode::for_mode(opts.mode, opts)?;
+                let (img, mut detail, setup) = self.projected(&mode, opts, camera, progress)?;
+                if let ModeStats::Projected(s) = &mut detail {
+                    s.table = mode.take_stats();
+                }
+                (img, detail, setup)
             }
             Mode::Raycast => {
                 let (img, s, setup) = modes::raycast::render(self, opts, camera, progress)?;
