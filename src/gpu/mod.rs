@@ -192,6 +192,8 @@ pub enum GpuError {
         value: u32,
         max: u32,
     },
+    #[error("{0}")]
+    TableTooLarge(String),
     #[error("index count {0} is not a multiple of 3")]
     NotTriangles(usize),
     #[error("index {index} out of range for {len} vertices")]

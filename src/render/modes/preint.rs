@@ -26,7 +26,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::camera::Camera;
 use crate::gpu::cpu::CpuStage;
-use crate::gpu::{ClipMapper, Context, GpuError, Resource, Stage, StageDesc};
+use crate::gpu::{ClipMapper, Context, GpuError, Resource, Stage, StageDesc, Table};
 use crate::projection::{Polyhedron, Projected};
 use crate::render::driver::ProjectedMode;
 use crate::render::pieces::PieceSource;
@@ -279,7 +279,12 @@ impl PreintMode {
         lookup: LookupFn,
         opts: &RenderOptions,
     ) -> Result<PreintMode, TableSizeError> {
-        TableSpec::new(kind, opts.tables.size, 1.0)?;
+        // Drawn on the GPU, the adapter's limits are checked first (at
+        // bind, naming the limit); on the CPU only zoovr's own.
+        match opts.projected.compositor {
+            Compositor::Cpu => TableSpec::new(kind, opts.tables.size, 1.0).map(|_| ())?,
+            Compositor::Gpu => TableSpec::check_small(kind, opts.tables.size)?,
+        }
         Ok(PreintMode {
             kind,
             stage,
@@ -320,13 +325,12 @@ impl PreintMode {
         }
     }
 
-    fn spec(&self, lengths: SceneLengths) -> TableSpec {
+    fn spec(&self, lengths: SceneLengths) -> Result<TableSpec, TableSizeError> {
         let l = match self.kind {
             TableKind::Flat => lengths.mean_thickness,
             _ => lengths.max_diameter,
         };
         TableSpec::new(self.kind, self.opts.size, l)
-            .unwrap_or_else(|e| unreachable!("checked by PreintMode::new: {e}"))
     }
 
     /// Binds the stage for one frame of `tf` seen by `camera`, with the
@@ -338,8 +342,12 @@ impl PreintMode {
         tf: &TransferFunction,
         camera: &Camera,
     ) -> Result<Stage, GpuError> {
+        let n = self.opts.size.unwrap_or(self.kind.default_size());
+        Table::check_size(gpu.limits(), self.kind.dim(), self.kind.extent(n))?;
         let cache = TableCache::of(gpu)?;
-        let spec = self.spec(cache.lengths(mesh));
+        let spec = self
+            .spec(cache.lengths(mesh))
+            .map_err(|e| GpuError::TableTooLarge(e.to_string()))?;
         let (table, stats) = cache.table(gpu, &spec, self.resolved_build(), tf)?;
         if let Ok(mut s) = self.stats.lock() {
             *s = Some(stats);
@@ -364,7 +372,9 @@ impl PreintMode {
         camera: &Camera,
     ) -> PreintTwin {
         let t0 = std::time::Instant::now();
-        let spec = self.spec(SceneLengths::of(mesh));
+        let spec = self
+            .spec(SceneLengths::of(mesh))
+            .unwrap_or_else(|e| unreachable!("checked by PreintMode::new: {e}"));
         let build = self.resolved_build();
         let mut data = vec![0.0; 4 * spec.texels()];
         let built = fill_cpu(

@@ -139,13 +139,20 @@ pub struct TableSpec {
 }
 
 impl TableSpec {
-    /// The table of `kind` for `--table n` (`None`: the default size).
-    pub fn new(kind: TableKind, n: Option<u32>, l_table: f64) -> Result<Self, TableSizeError> {
+    /// Refuses `--table n` below 2 samples.
+    pub fn check_small(kind: TableKind, n: Option<u32>) -> Result<(), TableSizeError> {
         let n = n.unwrap_or(kind.default_size());
-        let size = kind.extent(n);
         if n < 2 {
             return Err(TableSizeError::TooSmall(n));
         }
+        Ok(())
+    }
+
+    /// The table of `kind` for `--table n` (`None`: the default size).
+    pub fn new(kind: TableKind, n: Option<u32>, l_table: f64) -> Result<Self, TableSizeError> {
+        Self::check_small(kind, n)?;
+        let n = n.unwrap_or(kind.default_size());
+        let size = kind.extent(n);
         let texels = size.iter().map(|&v| v as u64).product::<u64>();
         if texels > MAX_TEXELS {
             return Err(TableSizeError::TooLarge {
