@@ -131,7 +131,10 @@ fn print_error_curve() {
             let (max, rms) = error(&tf, |sf, sb, l| {
                 t.lookup(sf as f64, sb as f64, l as f64).map(|v| v as f32)
             });
-            eprintln!("| {name} | RKE 2D linear in l | {n} | {} | {max:.2e} | {rms:.2e} |", n * n);
+            eprintln!(
+                "| {name} | RKE 2D linear in l | {n} | {} | {max:.2e} | {rms:.2e} |",
+                n * n
+            );
         }
     }
 }
@@ -155,11 +158,9 @@ fn builds(c: &mut Criterion) {
             let label = format!("{kind:?} {n}");
             for method in [TableBuild::Exact, TableBuild::Fast] {
                 let mut data = vec![0.0; 4 * spec.texels()];
-                g.bench_with_input(
-                    BenchmarkId::new(method.name(), &label),
-                    &spec,
-                    |b, spec| b.iter(|| fill_cpu(spec, &tf, method, all, &mut data)),
-                );
+                g.bench_with_input(BenchmarkId::new(method.name(), &label), &spec, |b, spec| {
+                    b.iter(|| fill_cpu(spec, &tf, method, all, &mut data))
+                });
             }
             if let Some(ctx) = &gpu {
                 let built = GpuBuilt::new(ctx, &spec).unwrap();

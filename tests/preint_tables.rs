@@ -159,7 +159,10 @@ fn local_updates_equal_full_rebuilds() {
     let TfChange::Range(a, b) = tf_change(&old, &new) else {
         panic!("{:?}", tf_change(&old, &new));
     };
-    assert!((a - 0.35).abs() < 1e-12 && (b - 0.8).abs() < 1e-12, "{a} {b}");
+    assert!(
+        (a - 0.35).abs() < 1e-12 && (b - 0.8).abs() < 1e-12,
+        "{a} {b}"
+    );
     assert_eq!(tf_change(&old, &old.clone()), TfChange::Same);
     let other = TransferFunction::from_nodes(&nodes[..6], EmissionModel::Glow).unwrap();
     assert_eq!(tf_change(&old, &other), TfChange::All);

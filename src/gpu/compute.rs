@@ -78,8 +78,7 @@ impl GpuBuffer {
     /// A zeroed buffer of `len` bytes (a multiple of 4, at least 16).
     pub fn new(ctx: &Context, label: &str, len: u64) -> Result<GpuBuffer, GpuError> {
         let len = len.max(16).next_multiple_of(4);
-        if len > ctx.limits().max_storage_buffer_binding_size as u64
-            || len > ctx.limits().max_buffer_size
+        if len > ctx.limits().max_storage_buffer_binding_size || len > ctx.limits().max_buffer_size
         {
             return Err(GpuError::BadOption(
                 "a compute buffer is larger than this adapter's storage buffers",

@@ -93,7 +93,11 @@ impl Table {
 
     /// Refuses a size the adapter cannot hold: any side zero, a side above
     /// the dimension's limit, more layers than the adapter allows.
-    pub fn check_size(limits: &wgpu::Limits, dim: TableDim, size: [u32; 3]) -> Result<(), GpuError> {
+    pub fn check_size(
+        limits: &wgpu::Limits,
+        dim: TableDim,
+        size: [u32; 3],
+    ) -> Result<(), GpuError> {
         let [w, h, d] = size;
         let (max_side, max_depth, depth_what) = match dim {
             TableDim::D2 => (limits.max_texture_dimension_2d, 1, "layers"),

@@ -32,9 +32,9 @@ pub struct RenderOptions {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum TableBuild {
-    /// The GPU compute build when drawing on the GPU, else the exact CPU
-    /// build (measured: the GPU build is the fastest where a device
-    /// exists, and both are exact).
+    /// The GPU compute build when drawing on a hardware GPU, else the
+    /// exact CPU build (measured faster than the compute pass on the
+    /// software adapters; both are exact).
     #[default]
     Auto,
     /// The exact integrals in `f64` on the CPU (all cores).

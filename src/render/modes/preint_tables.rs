@@ -460,7 +460,11 @@ impl GpuBuilt {
                 ComputeResource::Storage(bytemuck::cast_slice(&consts)),
                 ComputeResource::Buffer(&self.buffer),
             ],
-            [spec.size[0].div_ceil(8), spec.size[1].div_ceil(8), spec.size[2]],
+            [
+                spec.size[0].div_ceil(8),
+                spec.size[1].div_ceil(8),
+                spec.size[2],
+            ],
         )?;
         self.buffer.copy_to_table(ctx, table, self.row_texels * 16);
         ctx.check()
@@ -547,12 +551,15 @@ struct Entry {
     gpu: Option<GpuBuilt>,
 }
 
+/// A mesh by its address, cell count and point count.
+type MeshKey = (usize, usize, usize);
+
 /// Tables kept on one device (see the module docs).
 #[derive(Default)]
 pub struct TableCache {
     entries: Mutex<Vec<Entry>>,
     /// The lengths of the last mesh, by its address and counts.
-    lengths: Mutex<Option<((usize, usize, usize), SceneLengths)>>,
+    lengths: Mutex<Option<(MeshKey, SceneLengths)>>,
 }
 
 /// Tables kept per device (the least recently used goes first).
@@ -600,7 +607,8 @@ impl TableCache {
         let mut entry = match found {
             Some(i) => entries.remove(i),
             None => {
-                let table = Table::empty_rgba(ctx, "pre-integration table", spec.kind.dim(), spec.size)?;
+                let table =
+                    Table::empty_rgba(ctx, "pre-integration table", spec.kind.dim(), spec.size)?;
                 Entry {
                     spec: *spec,
                     build,
