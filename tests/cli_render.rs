@@ -403,3 +403,76 @@ fn malformed_ghost_arrays_are_named() {
         assert!(!out.exists());
     }
 }
+
+/// The table modes through the binary: `--table` and `--table-build` in
+/// `--help`, the table in `--stats --json`, and sizes no device holds
+/// refused with the limit named (exit 1).
+#[test]
+fn table_modes_flags_stats_and_refused_sizes() {
+    let o = zoovr(&["render", "--help"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    for flag in ["--table <N>", "--table-build", "preint3d", "preint2d-cyl"] {
+        assert!(text.contains(flag), "{flag}: {text}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("t.png");
+    let mesh = mesh_file("hexahedron.vtk");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            mesh.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+            "--size",
+            "24x24",
+        ];
+        args.extend_from_slice(extra);
+        zoovr(&args)
+    };
+    for (n, want) in [("0", "at least 2"), ("1", "at least 2"), ("1000", "4 GiB")] {
+        // 1000: within the adapter's 3D limit, but 16 GiB of texels.
+        let o = run(&["--mode", "preint3d", "--table", n]);
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{n}: {}", stderr(&o));
+    }
+    let probe = zoovr::gpu::Context::new(&Default::default());
+    let Ok(ctx) = probe else {
+        eprintln!("GPU parts skipped: no adapter");
+        return;
+    };
+    // A 3D table side above the adapter's 3D texture limit (the limit is
+    // checked before the size in memory).
+    let max3 = ctx.limits().max_texture_dimension_3d;
+    let big = (max3 + 1).to_string();
+    let o = run(&["--mode", "preint3d", "--table", &big]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&format!("3D texture (1..={max3})")),
+        "{}",
+        stderr(&o)
+    );
+    for (mode, kind) in [
+        ("preint3d", "cube"),
+        ("preint2d", "flat"),
+        ("preint2d-cyl", "cylinder"),
+    ] {
+        let o = run(&[
+            "--mode",
+            mode,
+            "--table",
+            "16",
+            "--table-build",
+            "exact",
+            "--stats",
+            "--json",
+        ]);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(v["mode"], mode);
+        let t = &v["detail"]["table"];
+        assert_eq!(t["kind"], kind, "{v}");
+        assert_eq!(t["size"][0], 16);
+        assert_eq!(t["build"], "exact");
+        assert!(t["texels_built"].as_u64().unwrap() > 0);
+    }
+}

@@ -6,6 +6,7 @@ use naga::{Binding, Interpolation, ScalarKind, ShaderStage, TypeInner, VectorSiz
 use zoovr::gpu::layer::LAYER_STAGE;
 use zoovr::gpu::stage::stage_source;
 use zoovr::gpu::StageDesc;
+use zoovr::render::modes::preint_tables::TABLE_BUILD;
 use zoovr::render::modes::SHADERS;
 use zoovr::render::Mode;
 
@@ -36,33 +37,40 @@ fn shaders_parse_and_validate() {
     listed.sort();
     assert_eq!(on_disk, listed);
 
+    // Programs: every stage and compute kernel, as compiled (behind
+    // shaders/common.wgsl). A file that is part of a program (concatenated
+    // behind shared files) is validated in it; every other file alone.
+    let mut programs: Vec<(&str, String)> = stages()
+        .iter()
+        .map(|s| (s.name, stage_source(s.wgsl)))
+        .collect();
+    programs.push((TABLE_BUILD.name, stage_source(TABLE_BUILD.wgsl)));
     for (name, src) in SHADERS {
         assert_eq!(
             *src,
             std::fs::read_to_string(dir.join(name)).unwrap(),
             "{name} differs from the embedded copy"
         );
-        // A file that ends a stage made of several files (a mode on the
-        // segment payload: shaders/segment.wgsl, integral.wgsl, then its
-        // own) is validated as that whole stage; the others alone.
-        let full = if *name == "common.wgsl" {
-            src.to_string()
-        } else if let Some(stage) = stages()
-            .into_iter()
-            .find(|s| s.name == *name && s.wgsl != *src && s.wgsl.ends_with(src))
-        {
-            stage_source(stage.wgsl)
-        } else {
-            stage_source(src)
-        };
-        let module = parse(name, &full);
-        let mut validator = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::empty(),
-        );
-        if let Err(e) = validator.validate(&module) {
-            panic!("{name}: {}", e.emit_to_string(&full));
+        let in_program = programs.iter().any(|(_, p)| p.contains(src));
+        if *name == "common.wgsl" {
+            validate(name, src);
+        } else if !in_program {
+            validate(name, &stage_source(src));
         }
+    }
+    for (name, full) in &programs {
+        validate(name, full);
+    }
+}
+
+fn validate(name: &str, full: &str) {
+    let module = parse(name, full);
+    let mut validator = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::empty(),
+    );
+    if let Err(e) = validator.validate(&module) {
+        panic!("{name}: {}", e.emit_to_string(full));
     }
 }
 

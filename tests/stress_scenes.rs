@@ -161,6 +161,12 @@ fn run(case: Case, gpu: bool) {
                 rms: RMS,
             }
         };
+        // The table modes: finite everywhere (render() checks), whole
+        // cells and split.
+        for mode in [Mode::Preint3d, Mode::Preint2d, Mode::Preint2dCyl] {
+            render(mode, FieldModel::Faces, false);
+            render(mode, FieldModel::Faces, true);
+        }
         let split = render(Mode::Exact, FieldModel::Faces, true);
         let d = check_images_with(
             &format!("stress_{}_{vi}_split", case.name),
@@ -464,6 +470,9 @@ fn eye_inside_a_constant_block_matches_the_closed_form() {
     if gpu {
         modes.push((Mode::Exact, FieldModel::Faces, false));
         modes.push((Mode::Exact, FieldModel::Faces, true));
+        for m in [Mode::Preint3d, Mode::Preint2d, Mode::Preint2dCyl] {
+            modes.push((m, FieldModel::Faces, false));
+        }
     }
     for (mode, model, split_all) in modes {
         let opts = options(mode, split_all, model);

@@ -12,7 +12,7 @@ use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::{FieldModel, Traversal};
 use zoovr::render::{
     Geometry, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, RenderStats, Renderer,
-    SceneSpec, Shading,
+    SceneSpec, Shading, TableBuild, TableOptions,
 };
 
 use super::args::{parse_finite, parse_positive, parse_range, parse_rgb, parse_size};
@@ -65,8 +65,10 @@ pub struct ViewArgs {
     /// Orthographic projection instead of perspective (30 degree view angle).
     #[arg(long)]
     pub ortho: bool,
-    /// Rendering mode: exact (projection + exact integrals, wgpu) or raycast
-    /// (CPU reference).
+    /// Rendering mode: exact (projection + exact vertex integrals, wgpu),
+    /// exact-frag (the exact integral per fragment), preint3d, preint2d,
+    /// preint2d-cyl (pre-integrated tables, see --table), or raycast (CPU
+    /// reference).
     #[arg(long, value_enum, default_value_t = Mode::Exact)]
     pub mode: Mode,
     /// Field model of the ray caster: faces (default), tets or native. The
@@ -90,6 +92,19 @@ pub struct ViewArgs {
     /// available with `--model native`.
     #[arg(long)]
     pub traversal: Option<Traversal>,
+    /// Pre-integrated table modes (preint3d, preint2d, preint2d-cyl):
+    /// samples per table axis (default 128 for preint3d and preint2d-cyl,
+    /// whose tables are N x N x N and N x N x 2N planes, 512 for preint2d).
+    /// At least 2; at most the adapter's texture limit (3D: 2048 on GL
+    /// llvmpipe, 4096 on lavapipe) and 2^28 texels.
+    #[arg(long, value_name = "N")]
+    pub table: Option<u32>,
+    /// How the pre-integrated tables are built: auto (the GPU compute pass
+    /// on a hardware GPU, else exact), exact (exact integrals on the CPU), fast
+    /// (integral functions on the CPU: exact opacity, approximate colour)
+    /// or gpu (exact integrals in a wgpu compute pass).
+    #[arg(long, value_enum, default_value_t = TableBuild::Auto)]
+    pub table_build: TableBuild,
     /// `--split all`: draw every cell as its consistent tetrahedra.
     #[arg(long, value_parser = ["all"])]
     pub split: Option<String>,
@@ -154,6 +169,10 @@ impl ViewArgs {
                 cpu_adapter: self.cpu_adapter,
             },
             accum: AccumFormat::Auto,
+            tables: TableOptions {
+                size: self.table,
+                build: self.table_build,
+            },
         }
     }
 

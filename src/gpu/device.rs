@@ -240,6 +240,12 @@ impl Context {
         }
     }
 
+    /// Waits until every submitted command has finished (benchmarks,
+    /// tests); returns the first error recorded.
+    pub fn finish(&self) -> Result<(), GpuError> {
+        self.wait(None)
+    }
+
     /// Returns the first error recorded by wgpu's callbacks, if any.
     pub fn check(&self) -> Result<(), GpuError> {
         if let Some(msg) = self.lost.lock().ok().and_then(|v| v.clone()) {

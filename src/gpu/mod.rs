@@ -46,6 +46,7 @@
 //! Errors never panic: wgpu's uncaptured-error and device-lost callbacks are
 //! captured and turned into [`GpuError`] at the next check.
 
+pub mod compute;
 pub mod cpu;
 mod device;
 mod frame;
@@ -60,7 +61,7 @@ pub use device::{Context, ContextInfo, PendingContext};
 pub use frame::{DrawKind, Frame, FrameOptions, FrameStats};
 pub use raster::{piece_depth, ClipMapper, GpuVertex, MAX_PIECES, SUBPIXEL};
 pub use stage::{Binding, Resource, Stage, StageDesc};
-pub use table::Table;
+pub use table::{Table, TableDim};
 
 use thiserror::Error;
 
@@ -181,6 +182,18 @@ pub enum GpuError {
     },
     #[error("image size {width}x{height} is not supported (each side 1..={max})")]
     BadSize { width: u32, height: u32, max: u32 },
+    #[error(
+        "table {what} {value} is not supported by this adapter's {dim} (1..={max}); choose a \
+         smaller --table"
+    )]
+    TableSize {
+        dim: &'static str,
+        what: &'static str,
+        value: u32,
+        max: u32,
+    },
+    #[error("{0}")]
+    TableTooLarge(String),
     #[error("index count {0} is not a multiple of 3")]
     NotTriangles(usize),
     #[error("index {index} out of range for {len} vertices")]

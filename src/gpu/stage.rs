@@ -27,7 +27,7 @@ use wgpu::util::DeviceExt;
 
 use super::device::Context;
 use super::frame::DrawKind;
-use super::table::Table;
+use super::table::{Table, TableDim};
 use super::{AccumFormat, GpuError};
 
 /// WGSL functions shared by every stage (`shaders/common.wgsl`).
@@ -50,6 +50,8 @@ pub enum Binding {
     Table2d,
     /// A 3D `texture_3d<f32>` read with `textureLoad` ([`Table`]).
     Table3d,
+    /// A `texture_2d_array<f32>` read with `textureLoad` ([`Table`]).
+    Table2dArray,
     /// A read-only storage buffer (fragment stage).
     Storage,
 }
@@ -141,8 +143,11 @@ impl Context {
             let usage = match (b, r) {
                 (Binding::Uniform, Resource::Uniform(_)) => wgpu::BufferUsages::UNIFORM,
                 (Binding::Storage, Resource::Storage(_)) => wgpu::BufferUsages::STORAGE,
-                (Binding::Table2d, Resource::Table(t)) if !t.is_3d() => continue,
-                (Binding::Table3d, Resource::Table(t)) if t.is_3d() => continue,
+                (Binding::Table2d, Resource::Table(t)) if t.dim() == TableDim::D2 => continue,
+                (Binding::Table3d, Resource::Table(t)) if t.dim() == TableDim::D3 => continue,
+                (Binding::Table2dArray, Resource::Table(t)) if t.dim() == TableDim::D2Array => {
+                    continue
+                }
                 _ => {
                     return Err(GpuError::BadOption(
                         "a stage's resource does not match its binding",
@@ -233,15 +238,17 @@ impl Context {
                         has_dynamic_offset: false,
                         min_binding_size: None,
                     },
-                    Binding::Table2d | Binding::Table3d => wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: if *b == Binding::Table3d {
-                            wgpu::TextureViewDimension::D3
-                        } else {
-                            wgpu::TextureViewDimension::D2
-                        },
-                        multisampled: false,
-                    },
+                    Binding::Table2d | Binding::Table3d | Binding::Table2dArray => {
+                        wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                            view_dimension: match b {
+                                Binding::Table3d => wgpu::TextureViewDimension::D3,
+                                Binding::Table2dArray => wgpu::TextureViewDimension::D2Array,
+                                _ => wgpu::TextureViewDimension::D2,
+                            },
+                            multisampled: false,
+                        }
+                    }
                 },
                 count: None,
             })

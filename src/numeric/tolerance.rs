@@ -373,3 +373,10 @@ pub const GAUSS_LEGENDRE_MAX_DEPTH: f64 = 2.0;
 /// `max(a, b)^16`, to rounding level (< 1e-15, tested) at 1/2; two thirds
 /// of the cost of 12 nodes.
 pub const GAUSS_LEGENDRE_8_MAX_DEPTH: f64 = 0.5;
+
+/// Pre-integrated table modes: the longest tabulated length is the largest
+/// cell diameter (which bounds every segment through a piece) grown by this
+/// fraction, so that a segment of exactly that length, rounded to `f32` and
+/// rebuilt per fragment, still falls inside the table instead of being cut
+/// into two steps.
+pub const TABLE_LENGTH_MARGIN: f64 = 1e-3;

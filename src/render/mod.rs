@@ -38,7 +38,9 @@ use crate::visibility::{Sorter, VisibilityError};
 
 pub use breakpoints::split_points;
 pub use modes::{Bounds, Mode, ModeInfo};
-pub use options::{Compositor, ProjectedOptions, ReferenceOptions, RenderOptions};
+pub use options::{
+    Compositor, ProjectedOptions, ReferenceOptions, RenderOptions, TableBuild, TableOptions,
+};
 pub use pieces::PieceError;
 pub use scene::{Geometry, ScalarsRef, Scene, SceneSpec, Shading};
 pub use stats::{ModeStats, ProjectedStats, RaycastStats, RenderStats};
@@ -75,6 +77,8 @@ pub enum RenderError {
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Raycast(#[from] raycast::RaycastError),
+    #[error(transparent)]
+    TableSize(#[from] modes::preint_tables::TableSizeError),
     #[error("the {mode} mode cannot draw {model:?} emission (it supports {supported}); modes that can: --mode {alternatives}")]
     Unsupported {
         mode: &'static str,
@@ -179,6 +183,15 @@ impl Renderer {
                 camera,
                 progress,
             )?,
+            Mode::Preint3d | Mode::Preint2d | Mode::Preint2dCyl => {
+                let mode = modes::preint::PreintMode::for_mode(opts.mode, opts)?;
+                let (img, mut detail, setup) =
+                    self.projected(&mode, &scene, opts, camera, progress)?;
+                if let ModeStats::Projected(s) = &mut detail {
+                    s.table = mode.take_stats();
+                }
+                (img, detail, setup)
+            }
             Mode::Raycast => {
                 let (img, s, setup) = modes::raycast::render(&scene, opts, camera, progress)?;
                 (img, ModeStats::Raycast(s), setup)

@@ -23,6 +23,59 @@ pub struct RenderOptions {
     pub projected: ProjectedOptions,
     /// Options of the reference ray caster.
     pub reference: ReferenceOptions,
+    /// Options of the pre-integrated table modes (`preint3d`, `preint2d`,
+    /// `preint2d-cyl`).
+    pub tables: TableOptions,
+}
+
+/// How the pre-integration tables are built (`--table-build`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum TableBuild {
+    /// The GPU compute build when drawing on a hardware GPU, else the
+    /// exact CPU build (measured faster than the compute pass on the
+    /// software adapters; both are exact).
+    #[default]
+    Auto,
+    /// The exact integrals in `f64` on the CPU (all cores).
+    Exact,
+    /// Integral functions on the CPU (EKE 3.5): exact opacity,
+    /// approximate colour, fastest on the CPU.
+    Fast,
+    /// The exact integrals in `f32` by a wgpu compute pass.
+    Gpu,
+}
+
+impl TableBuild {
+    /// The name `--table-build` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            TableBuild::Auto => "auto",
+            TableBuild::Exact => "exact",
+            TableBuild::Fast => "fast",
+            TableBuild::Gpu => "gpu",
+        }
+    }
+}
+
+/// Options of the pre-integrated table modes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct TableOptions {
+    /// `--table N`: samples along each table axis (`None`: the mode's
+    /// default, [`super::modes::preint_tables::TableKind::default_size`]).
+    pub size: Option<u32>,
+    /// `--table-build`.
+    pub build: TableBuild,
+}
+
+impl fmt::Display for TableOptions {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.size {
+            Some(n) => write!(f, "table size {n}")?,
+            None => write!(f, "default table size")?,
+        }
+        write!(f, ", build {}", self.build.name())
+    }
 }
 
 /// Where a projected-cell mode's triangles are drawn.

@@ -41,6 +41,9 @@ pub struct ProjectedStats {
     /// reading the image back.
     pub gpu_total_s: f64,
     pub order: OrderStats,
+    /// The table of a pre-integrated table mode: its size, how it was
+    /// built and what that cost this frame.
+    pub table: Option<crate::render::modes::preint_tables::TableStats>,
     /// CPU twin with [`super::ProjectedOptions::watch`]: the fragments drawn
     /// at the watched pixel, in drawing order.
     #[serde(skip)]
@@ -77,6 +80,20 @@ impl fmt::Display for ProjectedStats {
             "project+draw {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles, {} tie pixels)",
             e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles, e.tie_pixels
         )?;
+        if let Some(t) = &e.table {
+            writeln!(
+                f,
+                "table        {:.3} s  ({:?} {}x{}x{}, build {}, {} texels built, length {:.4e})",
+                t.build_s,
+                t.kind,
+                t.size[0],
+                t.size[1],
+                t.size[2],
+                t.build.name(),
+                t.texels_built,
+                t.l_table
+            )?;
+        }
         write!(
             f,
             "gpu finish   {:.3} s  (upload {:.3}, wait {:.3}, readback {:.3}, {} batches)",

@@ -24,6 +24,11 @@ pub mod exact;
 pub mod exact_frag;
 pub mod exptable;
 pub mod integral;
+pub mod preint;
+pub mod preint2d;
+pub mod preint2d_cyl;
+pub mod preint3d;
+pub mod preint_tables;
 pub mod raycast;
 pub mod segment;
 
@@ -46,6 +51,15 @@ pub enum Mode {
     /// Projection of convex pieces, the exact ray integral evaluated per
     /// fragment by wgpu.
     ExactFrag,
+    /// Projection of convex pieces, a 3D pre-integrated table looked up per
+    /// fragment by wgpu.
+    Preint3d,
+    /// Projection of convex pieces, a 2D pre-integrated table at the mean
+    /// cell thickness, scaled per fragment.
+    Preint2d,
+    /// Projection of convex pieces, the 3D table re-mapped into cylindrical
+    /// 2D planes.
+    Preint2dCyl,
     /// The CPU reference ray caster.
     Raycast,
 }
@@ -86,13 +100,23 @@ pub struct ModeInfo {
 
 impl Mode {
     /// Every mode.
-    pub const ALL: &'static [Mode] = &[Mode::Exact, Mode::ExactFrag, Mode::Raycast];
+    pub const ALL: &'static [Mode] = &[
+        Mode::Exact,
+        Mode::ExactFrag,
+        Mode::Preint3d,
+        Mode::Preint2d,
+        Mode::Preint2dCyl,
+        Mode::Raycast,
+    ];
 
     /// The registry entry of the mode.
     pub fn info(self) -> &'static ModeInfo {
         match self {
             Mode::Exact => &exact::INFO,
             Mode::ExactFrag => &exact_frag::INFO,
+            Mode::Preint3d => &preint3d::INFO,
+            Mode::Preint2d => &preint2d::INFO,
+            Mode::Preint2dCyl => &preint2d_cyl::INFO,
             Mode::Raycast => &raycast::INFO,
         }
     }
@@ -145,8 +169,25 @@ pub const SHADERS: &[(&str, &str)] = &[
         include_str!("../../../shaders/integral.wgsl"),
     ),
     ("layer.wgsl", LAYER_STAGE.wgsl),
+    ("preint.wgsl", include_str!("../../../shaders/preint.wgsl")),
+    (
+        "preint2d.wgsl",
+        include_str!("../../../shaders/preint2d.wgsl"),
+    ),
+    (
+        "preint2d_cyl.wgsl",
+        include_str!("../../../shaders/preint2d_cyl.wgsl"),
+    ),
+    (
+        "preint3d.wgsl",
+        include_str!("../../../shaders/preint3d.wgsl"),
+    ),
     (
         "segment.wgsl",
         include_str!("../../../shaders/segment.wgsl"),
+    ),
+    (
+        "table_build.wgsl",
+        include_str!("../../../shaders/table_build.wgsl"),
     ),
 ];

@@ -1,0 +1,35 @@
+// The preint2d stage's lookup: the 2D table at the mean cell thickness
+// l_table (Roettger, Kraus, Ertl 2000, section 4), texels (C, depth) at
+// l_table, filtered bilinearly in f32 (textureLoad). The optical depth is
+// exactly linear in l (depth = l * mean extinction over [s_f, s_b]), so the
+// opacity is exact up to interpolation; the colour is C scaled by
+// alpha(l) / alpha(l_table), which is RKE's l / l_table for thin segments
+// and exact for homogeneous ones.
+//
+// Twin: src/render/modes/preint2d.rs `lookup`.
+
+@group(0) @binding(1) var table2d: texture_2d<f32>;
+
+fn table_rgba(sf: f32, sb: f32, l: f32) -> vec4<f32> {
+    let a = axis(sf, pre.ns);
+    let b = axis(sb, pre.ns);
+    let i = i32(a.x);
+    let j = i32(b.x);
+    let r0 = lerp4(
+        textureLoad(table2d, vec2<i32>(i, j), 0),
+        textureLoad(table2d, vec2<i32>(i + 1, j), 0),
+        a.y,
+    );
+    let r1 = lerp4(
+        textureLoad(table2d, vec2<i32>(i, j + 1), 0),
+        textureLoad(table2d, vec2<i32>(i + 1, j + 1), 0),
+        a.y,
+    );
+    let t = lerp4(r0, r1, b.y);
+    let r = l / pre.l_table;
+    let depth_ref = max(t.w, 0.0);
+    let depth = min(depth_ref * r, 1e30);
+    let alpha = depth * one_minus_exp_over(depth);
+    let scale = r * (one_minus_exp_over(depth) / one_minus_exp_over(depth_ref));
+    return vec4<f32>(min(t.xyz * scale, vec3<f32>(1e30)), alpha);
+}

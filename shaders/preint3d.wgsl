@@ -1,0 +1,32 @@
+// The preint3d stage's lookup: the 3D pre-integrated table (Roettger, Kraus,
+// Ertl 2000, section 3) over (s_f, s_b, l), RGBA = premultiplied colour and
+// opacity, filtered trilinearly in f32 (textureLoad). Axes: s_f along x,
+// s_b along y over [0, 1]; l along z over [0, l_table].
+//
+// Twin: src/render/modes/preint3d.rs `lookup`.
+
+@group(0) @binding(1) var table3d: texture_3d<f32>;
+
+fn table_rgba(sf: f32, sb: f32, l: f32) -> vec4<f32> {
+    let a = axis(sf, pre.ns);
+    let b = axis(sb, pre.ns);
+    let c = axis(l / pre.l_table, pre.nz);
+    let i = i32(a.x);
+    let j = i32(b.x);
+    let k = i32(c.x);
+    var plane: array<vec4<f32>, 2>;
+    for (var z = 0; z < 2; z++) {
+        let r0 = lerp4(
+            textureLoad(table3d, vec3<i32>(i, j, k + z), 0),
+            textureLoad(table3d, vec3<i32>(i + 1, j, k + z), 0),
+            a.y,
+        );
+        let r1 = lerp4(
+            textureLoad(table3d, vec3<i32>(i, j + 1, k + z), 0),
+            textureLoad(table3d, vec3<i32>(i + 1, j + 1, k + z), 0),
+            a.y,
+        );
+        plane[z] = lerp4(r0, r1, b.y);
+    }
+    return lerp4(plane[0], plane[1], c.y);
+}

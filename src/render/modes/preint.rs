@@ -1,0 +1,459 @@
+//! What the pre-integrated table modes share (`preint3d`, `preint2d`,
+//! `preint2d-cyl`): the segment payload of [`super::segment`] (so no
+//! slicing at breakpoints and no perspective refinement), a table
+//! ([`super::preint_tables`]), and one fragment program around each mode's
+//! lookup (`shaders/preint.wgsl`, [`preint_segment`] its twin):
+//!
+//! 1. the fragment rebuilds its segment `(s_f, s_b, l)` exactly
+//!    (`segment_at`);
+//! 2. the parts of the segment below 0 or above 1 (outside the transfer
+//!    function's node range, where it is constant) are homogeneous and
+//!    integrated in closed form; the part inside goes to the table, so data
+//!    beyond the transfer function's range costs no table resolution;
+//! 3. a part longer than the table's longest length is cut into equal
+//!    steps composited front to back (at most 16; it never happens when
+//!    the table spans the largest cell diameter, as it does here);
+//! 4. the mode's lookup filters the table by hand in `f32`
+//!    (`textureLoad`, so the CPU twin filters identically and GL, which
+//!    cannot filter `f32` textures, works too).
+//!
+//! [`PreintMode`] is the [`ProjectedMode`] of all three; a mode file gives
+//! its registry entry, its stage and its lookup's twin.
+
+use std::sync::{Arc, Mutex};
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::camera::Camera;
+use crate::gpu::cpu::CpuStage;
+use crate::gpu::{ClipMapper, Context, GpuError, Resource, Stage, StageDesc, Table};
+use crate::projection::{Polyhedron, Projected};
+use crate::render::driver::ProjectedMode;
+use crate::render::pieces::PieceSource;
+use crate::render::{Compositor, RenderOptions, TableBuild, TableOptions};
+use crate::tf::{EmissionModel, TransferFunction};
+
+use super::preint_tables::{
+    fill_cpu, SceneLengths, TableCache, TableKind, TableSizeError, TableSpec, TableStats,
+};
+use super::segment::{segment_at, SegmentPayload, SegmentVertex, SegmentView};
+
+/// Most steps a segment is cut into (`MAX_STEPS` in the shader).
+const MAX_STEPS: u32 = 16;
+
+/// The parameters of the table stages. Keep in sync with `PreintParams` in
+/// `shaders/preint.wgsl`.
+#[repr(C)]
+#[derive(Pod, Zeroable, Clone, Copy, Debug, Default, PartialEq)]
+pub struct PreintParams {
+    /// `(colour or emission, tau)` below the node range.
+    pub below: [f32; 4],
+    /// `(colour or emission, tau)` above it.
+    pub above: [f32; 4],
+    pub ns: u32,
+    pub nz: u32,
+    /// 0: glow, 1: independent emission.
+    pub model: u32,
+    pub _pad0: u32,
+    pub l_table: f32,
+    pub l_step: f32,
+    pub _pad1: [f32; 2],
+}
+
+impl PreintParams {
+    /// The parameters of `spec` for `tf`.
+    pub fn new(tf: &TransferFunction, spec: &TableSpec) -> PreintParams {
+        let n = tf.s.len() - 1;
+        let ext = |i: usize| {
+            let c = tf.col[i];
+            [c[0] as f32, c[1] as f32, c[2] as f32, tf.tau[i] as f32]
+        };
+        let l_table = spec.l_table as f32;
+        PreintParams {
+            below: ext(0),
+            above: ext(n),
+            ns: spec.size[0],
+            nz: spec.size[2],
+            model: (tf.model() == EmissionModel::Independent) as u32,
+            _pad0: 0,
+            l_table,
+            l_step: if spec.kind == TableKind::Flat {
+                f32::MAX
+            } else {
+                l_table
+            },
+            _pad1: [0.0; 2],
+        }
+    }
+}
+
+/// A table's texels on the CPU (RGBA, x fastest), for the twins.
+#[derive(Clone, Debug)]
+pub struct CpuTable {
+    pub size: [u32; 3],
+    pub data: Vec<f32>,
+}
+
+impl CpuTable {
+    /// Texel `(i, j, k)` (`textureLoad`).
+    #[inline]
+    pub fn load(&self, i: usize, j: usize, k: usize) -> [f32; 4] {
+        let [w, h, _] = self.size.map(|v| v as usize);
+        let o = 4 * ((k * h + j) * w + i);
+        [
+            self.data[o],
+            self.data[o + 1],
+            self.data[o + 2],
+            self.data[o + 3],
+        ]
+    }
+}
+
+/// A mode's lookup twin: `table_rgba` of its shader.
+pub type LookupFn = fn(&PreintParams, &CpuTable, f32, f32, f32) -> [f32; 4];
+
+/// `(1 - exp(-x)) / x`, stable at 0 (twin of `one_minus_exp_over`).
+#[inline]
+pub fn one_minus_exp_over(x: f32) -> f32 {
+    if x < 1e-3 {
+        return 1.0 - 0.5 * x + x * x / 6.0;
+    }
+    (1.0 - (-x).exp()) / x
+}
+
+/// A segment of length `l` in constant material `m` (`homogeneous`).
+fn homogeneous(p: &PreintParams, m: [f32; 4], l: f32) -> [f32; 4] {
+    let x = (m[3] * l).min(1e30);
+    let f = l * one_minus_exp_over(x);
+    let alpha = x * one_minus_exp_over(x);
+    if p.model == 0 {
+        return [m[0] * alpha, m[1] * alpha, m[2] * alpha, alpha];
+    }
+    [
+        (m[0] * f).min(1e30),
+        (m[1] * f).min(1e30),
+        (m[2] * f).min(1e30),
+        alpha,
+    ]
+}
+
+/// `back` behind `front` (`over`).
+#[inline]
+fn over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
+    let t = 1.0 - front[3];
+    [
+        front[0] + t * back[0],
+        front[1] + t * back[1],
+        front[2] + t * back[2],
+        front[3] + t * back[3],
+    ]
+}
+
+/// Lower sample and weight of `x` on an axis of `n` samples over [0, 1]
+/// (`axis`).
+#[inline]
+pub fn axis(x: f32, n: u32) -> (usize, f32) {
+    let top = (n - 1) as f32;
+    let c = x * top;
+    // WGSL clamp of NaN is implementation-defined; inputs here are finite.
+    let c = c.max(0.0).min(top);
+    let i = c.floor().min(top - 1.0);
+    (i as usize, c - i)
+}
+
+/// `a + (b - a) w` per channel (`lerp4`).
+#[inline]
+pub fn lerp4(a: [f32; 4], b: [f32; 4], w: f32) -> [f32; 4] {
+    std::array::from_fn(|k| a[k] + (b[k] - a[k]) * w)
+}
+
+fn table_steps(
+    p: &PreintParams,
+    t: &CpuTable,
+    lookup: LookupFn,
+    sf: f32,
+    sb: f32,
+    l: f32,
+) -> [f32; 4] {
+    let mut n = 1u32;
+    if l > p.l_step {
+        n = (l / p.l_step).ceil().min(MAX_STEPS as f32) as u32;
+    }
+    if n <= 1 {
+        return lookup(p, t, sf, sb, l);
+    }
+    let dl = l / n as f32;
+    let mut acc = [0.0f32; 4];
+    for k in 0..n {
+        let s0 = sf + (sb - sf) * (k as f32 / n as f32);
+        let s1 = sf + (sb - sf) * ((k + 1) as f32 / n as f32);
+        acc = over(acc, lookup(p, t, s0, s1, dl));
+    }
+    acc
+}
+
+fn extension(p: &PreintParams, s: f32) -> [f32; 4] {
+    if s < 0.5 {
+        p.below
+    } else {
+        p.above
+    }
+}
+
+/// Twin of `preint_segment`: the premultiplied colour and opacity of the
+/// segment `(s_f, s_b, l)` (normalised scalars).
+pub fn preint_segment(
+    p: &PreintParams,
+    t: &CpuTable,
+    lookup: LookupFn,
+    sf: f32,
+    sb: f32,
+    l: f32,
+) -> [f32; 4] {
+    let d = sb - sf;
+    let (mut ta, mut tb) = (0.0f32, 1.0f32);
+    if d != 0.0 {
+        let t0 = (0.0 - sf) / d;
+        let t1 = (1.0 - sf) / d;
+        ta = t0.min(t1).clamp(0.0, 1.0);
+        tb = t0.max(t1).clamp(0.0, 1.0);
+    } else if !(0.0..=1.0).contains(&sf) {
+        ta = 1.0;
+    }
+    if ta >= tb {
+        return homogeneous(p, extension(p, sf), l);
+    }
+    let mut acc = [0.0f32; 4];
+    if ta > 0.0 {
+        acc = homogeneous(p, extension(p, sf), l * ta);
+    }
+    let s0 = (sf + d * ta).clamp(0.0, 1.0);
+    let s1 = (sf + d * tb).clamp(0.0, 1.0);
+    acc = over(acc, table_steps(p, t, lookup, s0, s1, l * (tb - ta)));
+    if tb < 1.0 {
+        acc = over(acc, homogeneous(p, extension(p, sb), l * (1.0 - tb)));
+    }
+    acc
+}
+
+/// The CPU twin of a table stage's `fs_main`.
+pub struct PreintTwin {
+    view: SegmentView,
+    mapper: ClipMapper,
+    params: PreintParams,
+    table: Arc<CpuTable>,
+    lookup: LookupFn,
+}
+
+impl CpuStage<SegmentVertex> for PreintTwin {
+    fn shade(&self, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
+        let seg = segment_at(&self.view, &self.mapper, tri, bary);
+        if !seg.ok {
+            return None;
+        }
+        Some(preint_segment(
+            &self.params,
+            &self.table,
+            self.lookup,
+            seg.s_f,
+            seg.s_b,
+            seg.l,
+        ))
+    }
+
+    fn describe(&self, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {
+        let seg = segment_at(&self.view, &self.mapper, tri, bary);
+        vec![("s_f", seg.s_f), ("s_b", seg.s_b), ("l", seg.l)]
+    }
+}
+
+/// A table mode on the projected-cell driver (see the module docs).
+pub struct PreintMode {
+    kind: TableKind,
+    stage: &'static StageDesc,
+    lookup: LookupFn,
+    opts: TableOptions,
+    stats: Mutex<Option<TableStats>>,
+}
+
+impl PreintMode {
+    /// The mode of `kind` with `stage` and `lookup`, for a render with
+    /// `opts`; a `--table` size no device could hold is refused here.
+    pub fn new(
+        kind: TableKind,
+        stage: &'static StageDesc,
+        lookup: LookupFn,
+        opts: &RenderOptions,
+    ) -> Result<PreintMode, TableSizeError> {
+        // Drawn on the GPU, the adapter's limits are checked first (at
+        // bind, naming the limit); on the CPU only zoovr's own.
+        match opts.projected.compositor {
+            Compositor::Cpu => TableSpec::new(kind, opts.tables.size, 1.0).map(|_| ())?,
+            Compositor::Gpu => TableSpec::check_small(kind, opts.tables.size)?,
+        }
+        Ok(PreintMode {
+            kind,
+            stage,
+            lookup,
+            opts: opts.tables,
+            stats: Mutex::new(None),
+        })
+    }
+
+    /// The table mode `mode` (one of preint3d, preint2d, preint2d-cyl) for a
+    /// render with `opts`.
+    pub fn for_mode(mode: super::Mode, opts: &RenderOptions) -> Result<PreintMode, TableSizeError> {
+        use super::{preint2d, preint2d_cyl, preint3d, Mode};
+        let (kind, stage, lookup): (TableKind, &'static StageDesc, LookupFn) = match mode {
+            Mode::Preint2d => (TableKind::Flat, &preint2d::PREINT2D_STAGE, preint2d::lookup),
+            Mode::Preint2dCyl => (
+                TableKind::Cylinder,
+                &preint2d_cyl::PREINT2D_CYL_STAGE,
+                preint2d_cyl::lookup,
+            ),
+            _ => (TableKind::Cube, &preint3d::PREINT3D_STAGE, preint3d::lookup),
+        };
+        PreintMode::new(kind, stage, lookup, opts)
+    }
+
+    /// What the last frame's table build did.
+    pub fn take_stats(&self) -> Option<TableStats> {
+        self.stats.lock().ok().and_then(|mut s| s.take())
+    }
+
+    /// The build method `Auto` resolves to on `gpu` (`None`: drawn on the
+    /// CPU): the GPU build on a hardware adapter, else the exact CPU build
+    /// (measured on lavapipe, 128^3: 1.7 s exact on the CPU against 4.5 s
+    /// for the compute pass, benches/tables.rs).
+    pub fn resolved_build(&self, gpu: Option<&Context>) -> TableBuild {
+        match (self.opts.build, gpu) {
+            (TableBuild::Auto, Some(g)) if g.info().device_type != "Cpu" => TableBuild::Gpu,
+            (TableBuild::Auto, _) => TableBuild::Exact,
+            (b, _) => b,
+        }
+    }
+
+    fn spec(&self, lengths: SceneLengths) -> Result<TableSpec, TableSizeError> {
+        let l = match self.kind {
+            TableKind::Flat => lengths.mean_thickness,
+            _ => lengths.max_diameter,
+        };
+        TableSpec::new(self.kind, self.opts.size, l)
+    }
+
+    /// Binds the stage for one frame of `tf` seen by `camera`, with the
+    /// device's cached table.
+    fn bind_stage(
+        &self,
+        gpu: &Context,
+        mesh: &crate::mesh::Mesh,
+        tf: &TransferFunction,
+        camera: &Camera,
+    ) -> Result<Stage, GpuError> {
+        let n = self.opts.size.unwrap_or(self.kind.default_size());
+        Table::check_size(gpu.limits(), self.kind.dim(), self.kind.extent(n))?;
+        let cache = TableCache::of(gpu)?;
+        let spec = self
+            .spec(cache.lengths(mesh))
+            .map_err(|e| GpuError::TableTooLarge(e.to_string()))?;
+        let (table, stats) = cache.table(gpu, &spec, self.resolved_build(Some(gpu)), tf)?;
+        if let Ok(mut s) = self.stats.lock() {
+            *s = Some(stats);
+        }
+        let view = SegmentView::of(camera);
+        let params = PreintParams::new(tf, &spec);
+        gpu.bind_stage(
+            self.stage,
+            &[
+                Resource::Uniform(bytemuck::bytes_of(&view)),
+                Resource::Table(&table),
+                Resource::Uniform(bytemuck::bytes_of(&params)),
+            ],
+        )
+    }
+
+    /// The CPU twin for one frame (its table built on the CPU, not cached).
+    pub fn twin_for(
+        &self,
+        mesh: &crate::mesh::Mesh,
+        tf: &TransferFunction,
+        camera: &Camera,
+    ) -> PreintTwin {
+        let t0 = std::time::Instant::now();
+        let spec = self
+            .spec(SceneLengths::of(mesh))
+            .unwrap_or_else(|e| unreachable!("checked by PreintMode::new: {e}"));
+        let build = self.resolved_build(None);
+        let mut data = vec![0.0; 4 * spec.texels()];
+        let built = fill_cpu(
+            &spec,
+            tf,
+            build,
+            (f64::NEG_INFINITY, f64::INFINITY),
+            &mut data,
+        );
+        if let Ok(mut s) = self.stats.lock() {
+            *s = Some(TableStats {
+                kind: spec.kind,
+                size: spec.size,
+                build,
+                l_table: spec.l_table,
+                texels_built: built,
+                build_s: t0.elapsed().as_secs_f64(),
+            });
+        }
+        PreintTwin {
+            view: SegmentView::of(camera),
+            mapper: ClipMapper::for_camera(camera),
+            params: PreintParams::new(tf, &spec),
+            table: Arc::new(CpuTable {
+                size: spec.size,
+                data,
+            }),
+            lookup: self.lookup,
+        }
+    }
+}
+
+impl ProjectedMode for PreintMode {
+    type Vertex = SegmentVertex;
+    type Payload = SegmentPayload;
+
+    fn split_points(&self, _tf: &TransferFunction) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn perspective_refine(&self) -> bool {
+        SegmentVertex::needs_perspective_refinement()
+    }
+
+    fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
+        self.bind_stage(gpu, src.mesh, src.tf, src.camera)
+    }
+
+    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {
+        Box::new(self.twin_for(src.mesh, src.tf, src.camera))
+    }
+
+    fn payload(
+        &self,
+        src: &PieceSource,
+        _part: &Polyhedron,
+        _proj: &mut Projected,
+        _used: &mut Vec<bool>,
+        payload: &mut SegmentPayload,
+        _refined: &mut usize,
+    ) {
+        payload.set(src);
+    }
+
+    fn vertex(
+        &self,
+        payload: &SegmentPayload,
+        proj: &Projected,
+        i: usize,
+        ndc: [f32; 2],
+    ) -> SegmentVertex {
+        SegmentVertex::of(proj, i, ndc, &payload.map, payload.ortho)
+    }
+}
