@@ -322,12 +322,16 @@ fn exact_frag_single_cells_and_project_meshes() {
         let path = mesh_file(&format!("{name}.vtk"));
         check_mode(Mode::ExactFrag, &path, name, (MAX, RMS), (MAX, RMS));
     }
+    // Whole cells: cells with nonplanar faces are drawn as their tets (the
+    // `tets` field) against `faces` (measured 1.02e-2, curvilinear_4x4x4,
+    // perspective, kinked TF; 1.18e-2 on zoo_3x3x3 in tests/modes.rs).
+    const PROBLEM_CELLS: (f64, f64) = (2e-2, RMS);
     for name in ["curvilinear_4x4x4.vtu", "ring_hole.vtu", "zoo_3x3x3.vtu"] {
         check_mode(
             Mode::ExactFrag,
             &mesh_file(name),
             name,
-            (MAX, RMS),
+            PROBLEM_CELLS,
             (MAX, RMS),
         );
     }
