@@ -323,9 +323,10 @@ fn exact_frag_single_cells_and_project_meshes() {
         check_mode(Mode::ExactFrag, &path, name, (MAX, RMS), (MAX, RMS));
     }
     // Whole cells: cells with nonplanar faces are drawn as their tets (the
-    // `tets` field) against `faces` (measured 1.02e-2, curvilinear_4x4x4,
-    // perspective, kinked TF; 1.18e-2 on zoo_3x3x3 in tests/modes.rs).
-    const PROBLEM_CELLS: (f64, f64) = (2e-2, RMS);
+    // `tets` field) against `faces`: the model difference of MODEL_DIFF
+    // (measured 2.22e-2 on ring_hole, perspective, kinked TF, p99.9
+    // 1.75e-2; 1.18e-2 on zoo_3x3x3 in tests/modes.rs).
+    const PROBLEM_CELLS: (f64, f64) = MODEL_DIFF;
     // With the same field, one isolated pixel of curvilinear_4x4x4
     // (perspective, kinked TF, pixel (193, 217)) measures 1.02e-2 in both
     // comparisons; every other pixel is within 2/255 (p99.9 2.4e-4). Cause
