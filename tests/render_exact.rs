@@ -208,6 +208,16 @@ fn project_meshes() {
     }
 }
 
+/// The shared datasets both modes are compared on (skipped when absent).
+const SHARED: [&str; 6] = [
+    "bluntfin/bluntfin_converted.vts",
+    "su2_sphere_hybrid/sphere_hybrid_converted.vtu",
+    "angular_sector/AngularSector.vtk",
+    "prisms_zoo/PentaHexa.vtk",
+    "fea_bracket_qtet/kiefer_bracket.vtu",
+    "can_crush/can.vtu",
+];
+
 /// Shared datasets. Whole-cell comparisons include the cells
 /// the exact mode splits into tets (problem and breakpoint cells), where the
 /// `faces` reference integrates a different field (MODEL_DIFF).
@@ -216,14 +226,7 @@ fn shared_datasets() {
     if !gpu_available() {
         return;
     }
-    for rel in [
-        "bluntfin/bluntfin_converted.vts",
-        "su2_sphere_hybrid/sphere_hybrid_converted.vtu",
-        "angular_sector/AngularSector.vtk",
-        "prisms_zoo/PentaHexa.vtk",
-        "fea_bracket_qtet/kiefer_bracket.vtu",
-        "can_crush/can.vtu",
-    ] {
+    for rel in SHARED {
         let Some(path) = shared_file(rel) else {
             continue;
         };
@@ -354,14 +357,7 @@ fn exact_frag_shared_datasets() {
     if !gpu_available() {
         return;
     }
-    for rel in [
-        "bluntfin/bluntfin_converted.vts",
-        "su2_sphere_hybrid/sphere_hybrid_converted.vtu",
-        "angular_sector/AngularSector.vtk",
-        "prisms_zoo/PentaHexa.vtk",
-        "fea_bracket_qtet/kiefer_bracket.vtu",
-        "can_crush/can.vtu",
-    ] {
+    for rel in SHARED {
         let Some(path) = shared_file(rel) else {
             continue;
         };
