@@ -187,6 +187,24 @@ impl RayFrame {
         }
     }
 
+    /// [`RayFrame::edge`] for points without ids: the canonical direction
+    /// of the edge is from the lexicographically smaller point (x, then y,
+    /// then z) to the larger, so polyhedra that share an edge's two points
+    /// see opposite signs on their two sides of it whatever their local
+    /// numbering. 0 for a zero-length edge or one on the ray's line.
+    #[inline]
+    pub fn edge_by_position(&self, a: DVec3, pa: &Proj, b: DVec3, pb: &Proj) -> f64 {
+        let lex =
+            a.x.total_cmp(&b.x)
+                .then(a.y.total_cmp(&b.y))
+                .then(a.z.total_cmp(&b.z));
+        match lex {
+            std::cmp::Ordering::Less => self.edge_canonical(a, pa, b, pb),
+            std::cmp::Ordering::Greater => -self.edge_canonical(b, pb, a, pa),
+            std::cmp::Ordering::Equal => 0.0,
+        }
+    }
+
     #[inline]
     fn edge_canonical(&self, a: DVec3, pa: &Proj, b: DVec3, pb: &Proj) -> f64 {
         let val = pa.x * pb.y - pa.y * pb.x;

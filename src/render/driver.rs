@@ -52,6 +52,7 @@ use std::time::Instant;
 use crate::camera::Camera;
 use crate::gpu::cpu::{CpuFrame, CpuStage};
 use crate::gpu::layer::{LayerTwin, LayerVertex, LAYER_STAGE};
+use crate::gpu::raster::BLOCKER_Z;
 use crate::gpu::{
     ClipMapper, Context, Frame, FrameOptions, FrameStats, GpuError, GpuVertex, PendingContext,
     Stage, MAX_PIECES,
@@ -66,7 +67,7 @@ use super::group::composite_group;
 use super::pieces::{PartScratch, PieceError, PieceSource};
 use super::scene::{ScalarsRef, Scene};
 use super::stats::ProjectedStats;
-use super::ties::{fix_ties, PartTriangles, TieScratch};
+use super::ties::{decide_ties, PartTriangles, TieRays, TieScratch};
 use super::workers::run_ordered;
 use super::{Compositor, RenderError, RenderOptions};
 
@@ -98,12 +99,10 @@ pub trait ProjectedMode: Sync {
     }
 
     /// Whether centres next to a part's outline are decided on the exact
-    /// geometry ([`super::ties`]). Off for every mode for now: it removes
-    /// the snap-band coverage mismatches of tests/coverage.rs and fixes
-    /// AngularSector's worst pixel, but breaks the axis-aligned edge-on
-    /// stress scene (0.49 at one pixel, cause not yet established).
+    /// geometry ([`super::ties`]): on for every mode (a mode whose stage
+    /// cannot draw a tie quad may say no).
     fn decides_ties(&self) -> bool {
-        false
+        true
     }
 
     /// Binds the mode's stage for one frame (uniforms, tables) of `src`.
@@ -203,7 +202,7 @@ struct Worker<P, V> {
     /// of the centres next to the outline ([`super::ties`]).
     drawn: Vec<([u32; 3], [[i64; 2]; 3])>,
     ties: TieScratch,
-    quad_vertices: Vec<V>,
+    _vertex: std::marker::PhantomData<V>,
 }
 
 impl<P: Default, V> Worker<P, V> {
@@ -225,7 +224,7 @@ impl<P: Default, V> Worker<P, V> {
             grid: Vec::new(),
             drawn: Vec::new(),
             ties: TieScratch::default(),
-            quad_vertices: Vec::new(),
+            _vertex: std::marker::PhantomData,
         }
     }
 }
@@ -305,36 +304,87 @@ fn draw_part<M: ProjectedMode>(
         width: src.camera.width,
         height: src.camera.height,
     };
-    let vertices = &out.vertices;
-    let remap = &w.remap;
-    let mut quad_v = std::mem::take(&mut w.quad_vertices);
-    quad_v.clear();
-    let mut quad_i = Vec::new();
-    out.tie_pixels += if !mode.decides_ties() {
-        0
-    } else {
-        fix_ties(
-            &part_tris,
-            &mapper,
-            |i| {
-                let r = remap[i as usize];
-                (r != u32::MAX).then(|| vertices[r as usize])
-            },
-            piece,
-            &mut w.ties,
-            &mut quad_v,
-            &mut quad_i,
-        )
-    };
-    let base = out.vertices.len() as u32;
-    out.vertices.extend_from_slice(&quad_v);
-    out.indices.extend(quad_i.iter().map(|&i| i + base));
-    w.quad_vertices = quad_v;
+    if mode.decides_ties() {
+        decide_ties(&part_tris, part, &src.ties, &mut w.ties);
+        out.tie_pixels += emit_tie_quads(mode, src, part, piece, &mapper, w, out);
+    }
     for (t, _) in w.drawn.iter() {
         out.indices
             .extend_from_slice(&t.map(|i| w.remap[i as usize]));
     }
     Ok(())
+}
+
+/// Draws the pixel quads of the part's tie decisions (`w.ties`, see
+/// [`super::ties`]) into `out`, before the part's triangles: the mode's
+/// payload of the exact segment at the centre, or a transparent blocker.
+/// Returns the number of quads.
+fn emit_tie_quads<M: ProjectedMode>(
+    mode: &M,
+    src: &PieceSource,
+    part: &Polyhedron,
+    piece: u32,
+    mapper: &ClipMapper,
+    w: &mut Worker<M::Payload, M::Vertex>,
+    out: &mut ChunkOut<M::Vertex>,
+) -> usize {
+    let ties = &mut w.ties;
+    if ties.decisions.is_empty() {
+        return 0;
+    }
+    // The segments' payload, as the mode computes it for region vertices
+    // (the part's own vertices are emitted already: the payload scratch is
+    // free).
+    let values = &mut ties.values;
+    values.clear();
+    values.view = w.proj.view;
+    values
+        .vertices
+        .extend(ties.decisions.iter().filter_map(|d| d.value));
+    let mut used = std::mem::take(&mut w.used);
+    used.clear();
+    used.resize(values.vertices.len(), true);
+    let mut refined = 0;
+    if !values.vertices.is_empty() {
+        mode.payload(src, part, values, &mut used, &mut w.payload, &mut refined);
+    }
+    w.used = used;
+    // A blocker is any vertex of the part, emptied.
+    let blocker = w
+        .drawn
+        .first()
+        .map(|(t, _)| out.vertices[w.remap[t[0] as usize] as usize].transparent());
+    let mut quads = 0;
+    let mut k = 0;
+    for d in &ties.decisions {
+        let (value, z) = match d.value {
+            Some(_) => {
+                k += 1;
+                (mode.vertex(&w.payload, values, k - 1, [0.0, 0.0]), 0.5)
+            }
+            None => match blocker {
+                Some(b) => (b, BLOCKER_Z),
+                None => continue,
+            },
+        };
+        let (i, j) = d.pixel;
+        let base = out.vertices.len() as u32;
+        for (di, dj) in [(0, 0), (1, 0), (1, 1), (0, 1)] {
+            let Some((ndc, _)) = mapper.ndc((i + di) as f64, (j + dj) as f64) else {
+                continue;
+            };
+            out.vertices
+                .push(value.with_clip([ndc[0], ndc[1], z, 1.0]).with_piece(piece));
+        }
+        if out.vertices.len() as u32 == base + 4 {
+            out.indices
+                .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+            quads += 1;
+        } else {
+            out.vertices.truncate(base as usize);
+        }
+    }
+    quads
 }
 
 /// Whether the GPU sees the triangle `a, b, c` (region triangles are CCW in
@@ -549,6 +599,7 @@ pub fn render_projected<M: ProjectedMode>(
         length_unit: scene.unit_distance as f32 as f64,
         cull: opts.projected.cull_to_pixels,
         grid: PixelGrid::new(camera.width, camera.height),
+        ties: TieRays::new(camera, scene.mesh.bounds()),
     };
     let t_open = Instant::now();
     let mut sink = match opts.projected.compositor {
@@ -675,6 +726,7 @@ mod tests {
             length_unit: scene.unit_distance,
             cull,
             grid: PixelGrid::new(camera.width, camera.height),
+            ties: TieRays::new(camera, scene.mesh.bounds()),
         }
     }
 

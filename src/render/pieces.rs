@@ -14,6 +14,7 @@
 //!   nor absorb in the glow model. The tet of consecutive slabs is built
 //!   once ([`PartScratch`]).
 
+use super::ties::TieRays;
 use glam::DVec3;
 
 use crate::camera::Camera;
@@ -70,6 +71,9 @@ pub struct PieceSource<'a> {
     /// ([`crate::projection::coverage`]).
     pub cull: bool,
     pub grid: PixelGrid,
+    /// The frame's pixel rays for the exact decisions next to outlines
+    /// ([`super::ties`]).
+    pub ties: TieRays,
 }
 
 /// Scratch of [`PieceSource::parts`], reused from piece to piece.
