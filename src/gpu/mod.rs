@@ -46,6 +46,7 @@
 //! Errors never panic: wgpu's uncaptured-error and device-lost callbacks are
 //! captured and turned into [`GpuError`] at the next check.
 
+pub mod common;
 pub mod compute;
 pub mod cpu;
 mod device;

@@ -21,6 +21,8 @@ use bytemuck::Pod;
 
 use crate::camera::Camera;
 
+pub use super::common::{piece_depth, BLOCKER_Z, MAX_PIECES};
+
 /// A vertex a stage draws: the Rust mirror of a shader's `VertexIn`
 /// (`#[repr(C)]`, [`Pod`]), with what the frame and the CPU twin need to
 /// know of every vertex type.
@@ -44,26 +46,6 @@ pub trait GpuVertex: Pod + Send + Sync {
     /// (premultiplied colour and opacity 0) but still pass the depth test.
     fn transparent(self) -> Self;
 }
-
-/// The depth key of piece number `piece` in drawing order (CPU twin of
-/// `piece_depth` in `shaders/common.wgsl`): the `f32` just below 1 for piece
-/// 0 and one representable value lower for each later piece, so that a
-/// strict less-than depth test passes later pieces and stops a second
-/// fragment of the same piece at a pixel. Keys stay in `(0, 1)` for pieces
-/// below [`MAX_PIECES`].
-pub fn piece_depth(piece: u32) -> f32 {
-    f32::from_bits(0x3F7F_FFFF - piece.min(MAX_PIECES - 1))
-}
-
-/// Pieces one frame can number ([`piece_depth`] stays positive); the frame
-/// refuses more.
-pub const MAX_PIECES: u32 = 0x3F7F_FFFF;
-
-/// Clip z of the corners of a blocker quad ([`crate::render::ties`]): a
-/// pixel quad that takes a pixel for its piece without colouring or
-/// counting it (`count_of` in `shaders/common.wgsl`). Everything else is
-/// drawn at z = 0.5.
-pub const BLOCKER_Z: f32 = 0.25;
 
 /// Sub-pixel grid of the rasteriser: positions are snapped to 1/`SUBPIXEL`
 /// pixel (8 bits, what lavapipe, llvmpipe and the desktop drivers use).
