@@ -58,9 +58,10 @@ pub mod stage;
 pub mod table;
 mod target;
 
+pub use common::{piece_depth, MAX_PIECES};
 pub use device::{Context, ContextInfo, PendingContext};
 pub use frame::{DrawKind, Frame, FrameOptions, FrameStats};
-pub use raster::{piece_depth, ClipMapper, GpuVertex, MAX_PIECES, SUBPIXEL};
+pub use raster::{ClipMapper, GpuVertex, SUBPIXEL};
 pub use stage::{Binding, Resource, Stage, StageDesc};
 pub use table::{Table, TableDim};
 

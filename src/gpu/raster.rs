@@ -1,6 +1,7 @@
 //! The rasteriser's geometry, common to every stage: the pixel ->
-//! clip-space mapping, the sub-pixel grid, the piece keys, and the
-//! [`GpuVertex`] trait every stage's vertex implements.
+//! clip-space mapping, the sub-pixel grid, and the [`GpuVertex`] trait
+//! every stage's vertex implements (the piece keys are in
+//! [`super::common`]).
 //!
 //! [`ClipMapper`] builds clip-space positions from continuous pixel
 //! coordinates `(px, py)` (row 0 at the top, pixel centres at `i + 0.5`, as in
@@ -21,8 +22,6 @@ use bytemuck::Pod;
 
 use crate::camera::Camera;
 
-pub use super::common::{piece_depth, BLOCKER_Z, MAX_PIECES};
-
 /// A vertex a stage draws: the Rust mirror of a shader's `VertexIn`
 /// (`#[repr(C)]`, [`Pod`]), with what the frame and the CPU twin need to
 /// know of every vertex type.
@@ -30,7 +29,7 @@ pub trait GpuVertex: Pod + Send + Sync {
     /// Clip-space position (x, y, z, w); see [`ClipMapper`].
     fn clip(&self) -> [f32; 4];
     /// The piece this vertex's triangles belong to, numbered in drawing
-    /// order ([`piece_depth`]).
+    /// order ([`super::common::piece_depth`]).
     fn piece(&self) -> u32;
     /// This vertex in piece `piece`.
     fn with_piece(self, piece: u32) -> Self;

@@ -10,6 +10,8 @@
 //! cells, each crossed whole or as its tets with the same crossing
 //! predicate, no adjacency), the reference
 //! for meshes whose adjacency cannot be trusted (`faces` and `tets` only).
+//! Both traversals are [`RayTracer`]s: each integrates one ray, and the
+//! trait renders an image from them in parallel tiles.
 //! Field models:
 //! - [`FieldModel::Faces`] (default): entry and exit on the cell's face
 //!   triangles, the scalar linear on each triangle (barycentric) and along the

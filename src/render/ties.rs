@@ -29,7 +29,7 @@
 
 use glam::DVec2;
 
-use crate::gpu::raster::BLOCKER_Z;
+use crate::gpu::common::BLOCKER_Z;
 use crate::gpu::{ClipMapper, GpuVertex, SUBPIXEL};
 use crate::numeric::predicates::{orient2d, Side};
 use crate::projection::Projected;
