@@ -13,6 +13,10 @@
 //! the wall time on `k` idle cores is about that divided by `k`. Off Unix
 //! both fall back to wall time.
 
+mod common;
+
+use common::{jump_tf, Rng};
+
 use std::time::Instant;
 
 use criterion::measurement::{Measurement, ValueFormatter, WallTime};
@@ -20,39 +24,7 @@ use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criteri
 use zoovr::integrate::fast::FastColour;
 use zoovr::integrate::table3d::Table3d;
 use zoovr::integrate::{self, cylinder::CylinderTable, weights};
-use zoovr::tf::{EmissionModel, Node, TransferFunction};
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-fn jump_tf() -> TransferFunction {
-    let n = |s, tau, c: [f64; 3]| Node {
-        s,
-        tau,
-        color: c,
-        emission: [0.0; 3],
-    };
-    TransferFunction::from_nodes(
-        &[
-            n(0.0, 0.0, [1.0, 0.0, 0.0]),
-            n(0.2, 2.0, [1.0, 0.5, 0.0]),
-            n(0.35, 5.0, [1.0, 1.0, 0.0]),
-            n(0.35, 0.5, [0.0, 1.0, 0.0]),
-            n(0.6, 8.0, [0.0, 1.0, 1.0]),
-            n(0.8, 1.0, [0.0, 0.0, 1.0]),
-            n(1.0, 0.0, [1.0, 0.0, 1.0]),
-        ],
-        EmissionModel::Glow,
-    )
-    .expect("valid")
-}
+use zoovr::tf::TransferFunction;
 
 const BATCH: usize = 4096;
 

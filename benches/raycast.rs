@@ -22,7 +22,7 @@ use zoovr::camera::{Camera, CameraParams};
 use zoovr::mesh::topology::Topology;
 use zoovr::mesh::{CellKind, Cells, Mesh};
 use zoovr::raycast::brute::Brute;
-use zoovr::raycast::{FieldModel, RaycastOptions, Raycaster, Scalars, Scene};
+use zoovr::raycast::{FieldModel, RayTracer, RaycastOptions, Raycaster, Scalars, Scene};
 use zoovr::tf::TransferFunction;
 
 const N: usize = 64;

@@ -12,6 +12,10 @@
 //! `l in [0, l_max]`, against `integrate::segment` in `f64`: the max and
 //! RMS over the four premultiplied channels.
 
+mod common;
+
+use common::{jump_tf, Rng};
+
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
@@ -22,39 +26,7 @@ use zoovr::render::modes::preint::{preint_segment, CpuTable, LookupFn, PreintPar
 use zoovr::render::modes::preint_tables::{fill_cpu, GpuBuilt, TableKind, TableSpec};
 use zoovr::render::modes::{preint2d, preint2d_cyl, preint3d};
 use zoovr::render::TableBuild;
-use zoovr::tf::{EmissionModel, Node, TransferFunction};
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-fn jump_tf() -> TransferFunction {
-    let n = |s, tau, c: [f64; 3]| Node {
-        s,
-        tau,
-        color: c,
-        emission: [0.0; 3],
-    };
-    TransferFunction::from_nodes(
-        &[
-            n(0.0, 0.0, [1.0, 0.0, 0.0]),
-            n(0.2, 2.0, [1.0, 0.5, 0.0]),
-            n(0.35, 5.0, [1.0, 1.0, 0.0]),
-            n(0.35, 0.5, [0.0, 1.0, 0.0]),
-            n(0.6, 8.0, [0.0, 1.0, 1.0]),
-            n(0.8, 1.0, [0.0, 0.0, 1.0]),
-            n(1.0, 0.0, [1.0, 0.0, 1.0]),
-        ],
-        EmissionModel::Glow,
-    )
-    .unwrap()
-}
+use zoovr::tf::TransferFunction;
 
 const L_MAX: f64 = 1.0;
 
@@ -98,9 +70,9 @@ fn mode_error(tf: &TransferFunction, kind: TableKind, n: u32) -> (f64, f64) {
     };
     let p = PreintParams::new(tf, &spec);
     let lookup: LookupFn = match kind {
-        TableKind::Cube => preint3d::lookup,
-        TableKind::Flat => preint2d::lookup,
-        TableKind::Cylinder => preint2d_cyl::lookup,
+        TableKind::Cube => preint3d::table_rgba,
+        TableKind::Flat => preint2d::table_rgba,
+        TableKind::Cylinder => preint2d_cyl::table_rgba,
     };
     error(tf, |sf, sb, l| preint_segment(&p, &t, lookup, sf, sb, l))
 }

@@ -1,8 +1,9 @@
 // Functions every stage of zoovr shares; src/gpu/stage.rs puts this file in
-// front of each stage's own file.
+// front of each stage's own file. Twin: gpu::common, function for function
+// (src/render/modes/twins.rs lists every twin).
 
 // The depth key of piece number `piece` in drawing order (twin:
-// gpu::raster::piece_depth): the f32 just below 1.0 for piece 0, and one
+// gpu::common::piece_depth): the f32 just below 1.0 for piece 0, and one
 // representable value lower for each later piece, so later pieces pass a
 // strict less-than test against earlier ones while a second fragment of the
 // same piece at the same pixel fails it. Flat and written per fragment, the
@@ -19,7 +20,7 @@ fn finite(x: f32) -> bool {
 
 // Clip z of the corners of a blocker quad (src/render/ties.rs: a pixel the
 // snapped triangles of a piece would take but its exact outline does not;
-// twin: gpu::raster::BLOCKER_Z). Other geometry is drawn at z = 0.5.
+// twin: gpu::common::BLOCKER_Z). Other geometry is drawn at z = 0.5.
 const BLOCKER_Z: f32 = 0.25;
 
 // What a counting fragment adds (fs_count): 1 to red, except for a blocker

@@ -4,8 +4,8 @@
 // and the number of the piece (convex polyhedron) the triangle belongs to.
 // (`piece_depth` and `finite` come from shaders/common.wgsl.)
 // Per fragment: alpha = 1 - exp(-l tau) from the 2D exponential table
-// (src/render/modes/exptable.rs documents range, warp and clamping; its `sample` is the
-// CPU twin of `alpha_of` below), colour = glow * alpha, premultiplied. The
+// (src/render/modes/exact/exptable.rs documents range, warp and clamping;
+// its `ExpTable::alpha_of` is the CPU twin of `alpha_of` below), colour = glow * alpha, premultiplied. The
 // pipeline blends with src + (1 - src.a) * dst on all channels, and tests
 // depth (less, write) against the piece's key: a pixel centre that two
 // triangles of one piece both cover (a sliver folded over by the rounding of
@@ -71,7 +71,7 @@ fn vs_main(v: VertexIn) -> VertexOut {
     return out;
 }
 
-// ln(1 + z) keeping relative accuracy for tiny z (twin: exptable::log1p_f32).
+// ln(1 + z) keeping relative accuracy for tiny z (twin: exact::exptable::log1p_).
 fn log1p_(z: f32) -> f32 {
     if z < 1e-3 {
         return z * (1.0 - z * (0.5 - z * (1.0 / 3.0)));
@@ -79,7 +79,7 @@ fn log1p_(z: f32) -> f32 {
     return log(1.0 + z);
 }
 
-// Continuous texel coordinate in [0, n - 1] (twin: exptable::coord).
+// Continuous texel coordinate in [0, n - 1] (twin: exact::exptable::coord).
 // Negative and NaN inputs map to 0; beyond the axis range clamps.
 fn coord(x: f32) -> f32 {
     let xs = select(0.0, x, x > 0.0);
@@ -87,7 +87,7 @@ fn coord(x: f32) -> f32 {
     return min(s, 1.0) * f32(params.n - 1u);
 }
 
-// Bilinear lookup with f32 weights (twin: ExpTable::sample).
+// Bilinear lookup with f32 weights (twin: ExpTable::alpha_of).
 fn alpha_of(l: f32, tau: f32) -> f32 {
     let u = coord(l);
     let v = coord(tau);
@@ -116,7 +116,7 @@ fn fs_main(f: VertexOut) -> FragOut {
         && finite(f.glow.z)) {
         discard;
     }
-    // Twin: render::modes::exact::ExactTwin.
+    // Twin: render::modes::exact::fs_main.
     let alpha = alpha_of(f.thickness, f.tau);
     var out: FragOut;
     out.color = vec4<f32>(f.glow * alpha, alpha);

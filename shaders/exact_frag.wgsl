@@ -4,7 +4,7 @@
 // between them). No table, no colour interpolation, no slicing at
 // breakpoints. Output premultiplied, blended src + (1 - src.a) dst.
 //
-// Twin: render::modes::exact_frag::ExactFragTwin.
+// Twin: render::modes::exact_frag::fs_main.
 
 @fragment
 fn fs_main(f: VertexOut) -> FragOut {

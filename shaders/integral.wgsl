@@ -4,7 +4,7 @@
 // and 4.2). Used by the fragment stage of the exact-frag mode and by the GPU
 // build of pre-integration tables.
 //
-// Twin: src/render/modes/integral.rs, function for function, same names.
+// Twin: render::modes::integral, function for function, same names.
 //
 // Bindings it declares (a stage that includes this file keeps them free):
 // 1: the transfer function (`TfBuffer`, nodes normalised as

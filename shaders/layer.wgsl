@@ -1,7 +1,7 @@
 // The layer stage of zoovr: premultiplied colours computed on the CPU (the
 // per-pixel layers of cycle groups, src/render/group.rs), drawn as they are
 // at their place in the drawing order, whatever the mode. Twin:
-// gpu::layer::LayerTwin.
+// gpu::layer::fs_main.
 
 // Keep in sync with `LayerVertex` in src/gpu/layer.rs.
 struct VertexIn {

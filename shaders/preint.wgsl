@@ -10,7 +10,7 @@
 // cylindrical tables cover lengths up to their largest sample) is cut into
 // equal steps, composited front to back.
 //
-// Twin: src/render/modes/preint.rs, function for function.
+// Twin: render::modes::preint, function for function.
 
 // Keep in sync with `PreintParams` in src/render/modes/preint.rs.
 struct PreintParams {

@@ -6,7 +6,7 @@
 // alpha(l) / alpha(l_table), which is RKE's l / l_table for thin segments
 // and exact for homogeneous ones.
 //
-// Twin: src/render/modes/preint2d.rs `lookup`.
+// Twin: render::modes::preint2d::table_rgba.
 
 @group(0) @binding(1) var table2d: texture_2d<f32>;
 

@@ -4,7 +4,7 @@
 // layers of a 2D-array texture over (u, v); the lookup is bilinear in each of
 // the two nearest planes and linear between them, in f32 (textureLoad).
 //
-// Twin: src/render/modes/preint2d_cyl.rs `lookup`.
+// Twin: render::modes::preint2d_cyl::table_rgba.
 
 @group(0) @binding(1) var planes: texture_2d_array<f32>;
 

@@ -3,7 +3,7 @@
 // opacity, filtered trilinearly in f32 (textureLoad). Axes: s_f along x,
 // s_b along y over [0, 1]; l along z over [0, l_table].
 //
-// Twin: src/render/modes/preint3d.rs `lookup`.
+// Twin: render::modes::preint3d::table_rgba.
 
 @group(0) @binding(1) var table3d: texture_3d<f32>;
 

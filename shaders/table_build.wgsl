@@ -10,9 +10,10 @@
 // Texels whose scalar interval misses [lo, hi] (a transfer-function edit
 // confined there) are left as they are.
 //
-// Twin: src/render/modes/preint_tables.rs `gpu_texel`.
+// Twin: render::modes::table_build (`build_main` per texel, `optical_depth`;
+// `cyl_to_table` is integrate::cylinder::cyl_to_table).
 
-// Keep in sync with `BuildParams` in src/render/modes/preint_tables.rs.
+// Keep in sync with `BuildParams` in src/render/modes/table_build.rs.
 struct BuildParams {
     kind: u32,
     ns: u32,

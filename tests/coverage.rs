@@ -91,14 +91,15 @@ fn counts(
         .0
 }
 
-/// Tets met by each pixel's reference ray.
-fn reference_counts(scene: &Scene, camera: &Camera) -> Vec<usize> {
+/// The reference ray caster of `scene` (the `tets` walk), built once per
+/// scene for all its views.
+fn reference(scene: &Scene) -> Raycaster<'_> {
     let scalars = match scene.scalars() {
         ScalarsRef::Point(v) => raycast::Scalars::Point(v),
         ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
         ScalarsRef::Constant(c) => raycast::Scalars::Constant(c),
     };
-    let rc = Raycaster::new(
+    Raycaster::new(
         raycast::Scene {
             mesh: &scene.mesh,
             topology: &scene.topology,
@@ -106,7 +107,11 @@ fn reference_counts(scene: &Scene, camera: &Camera) -> Vec<usize> {
         },
         FieldModel::Tets,
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// Tets met by each pixel's reference ray ([`reference`]).
+fn reference_counts(rc: &Raycaster, camera: &Camera) -> Vec<usize> {
     let t_near = if camera.ortho { 0.0 } else { camera.near };
     let mut out = Vec::new();
     for j in 0..camera.height {
@@ -117,11 +122,10 @@ fn reference_counts(scene: &Scene, camera: &Camera) -> Vec<usize> {
     out
 }
 
-/// Distance in pixels from centre `(i, j)` to the nearest projected tet
-/// edge of `mesh`.
-fn distance_to_edges(mesh: &Mesh, camera: &Camera, i: u32, j: u32) -> f64 {
-    let c = glam::DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
-    let mut best = f64::INFINITY;
+/// The tet edges of `mesh` projected into the image of `camera` (both ends
+/// in front of the camera), in pixels.
+fn projected_edges(mesh: &Mesh, camera: &Camera) -> Vec<(glam::DVec2, glam::DVec2)> {
+    let mut edges = Vec::new();
     let mut tets = Vec::new();
     for cell in 0..mesh.cells.len() {
         tets.clear();
@@ -139,13 +143,24 @@ fn distance_to_edges(mesh: &Mesh, camera: &Camera, i: u32, j: u32) -> f64 {
             for a in 0..4 {
                 for b in a + 1..4 {
                     if let (Some(pa), Some(pb)) = (p[a], p[b]) {
-                        let d = pb - pa;
-                        let s = ((c - pa).dot(d) / d.length_squared().max(1e-300)).clamp(0.0, 1.0);
-                        best = best.min((pa + d * s - c).length());
+                        edges.push((pa, pb));
                     }
                 }
             }
         }
+    }
+    edges
+}
+
+/// Distance in pixels from centre `(i, j)` to the nearest of `edges`
+/// ([`projected_edges`]).
+fn distance_to_edges(edges: &[(glam::DVec2, glam::DVec2)], i: u32, j: u32) -> f64 {
+    let c = glam::DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+    let mut best = f64::INFINITY;
+    for &(pa, pb) in edges {
+        let d = pb - pa;
+        let s = ((c - pa).dot(d) / d.length_squared().max(1e-300)).clamp(0.0, 1.0);
+        best = best.min((pa + d * s - c).length());
     }
     best
 }
@@ -161,12 +176,14 @@ fn check_mismatches(
     tag: &str,
 ) -> usize {
     let mut ties = 0;
+    let mut edges = None;
     for k in 0..want.len() {
         if want[k] == pieces[k] {
             continue;
         }
         let (i, j) = (k as u32 % camera.width, k as u32 / camera.width);
-        let d = distance_to_edges(&scene.mesh, camera, i, j);
+        let edges = edges.get_or_insert_with(|| projected_edges(&scene.mesh, camera));
+        let d = distance_to_edges(edges, i, j);
         assert!(
             d <= band,
             "{tag}: pixel ({i}, {j}) drawn by {} pieces, the ray meets {} tets, \
@@ -267,14 +284,15 @@ fn on_grid_meshes_are_covered_exactly_once() {
         let mut renderer = Renderer::new(scene.geometry());
         let tag = format!("on-grid shear {shear}");
         let (pieces, folds) = check_twin(&mut renderer, &scene.shading(), &camera, gpu, &tag);
-        let want = reference_counts(&scene, &camera);
+        let want = reference_counts(&reference(&scene), &camera);
         // No band: a single mismatch fails.
         check_mismatches(&scene, &camera, &pieces, &want, -1.0, &tag);
         assert!(want.iter().any(|&c| c > 0), "{tag}: nothing covered");
+        let edges = projected_edges(&scene.mesh, &camera);
         let on_edges = (0..want.len())
             .filter(|&k| {
                 let (i, j) = (k as u32 % camera.width, k as u32 / camera.width);
-                distance_to_edges(&scene.mesh, &camera, i, j) == 0.0
+                distance_to_edges(&edges, i, j) == 0.0
             })
             .count();
         eprintln!("{tag}: {on_edges} centres on projected edges, all decided alike");
@@ -311,6 +329,7 @@ fn datasets_are_covered_exactly_once_in_random_views() {
         let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
         scene.tf = flat_tf(scene.range);
         let mut renderer = Renderer::new(scene.geometry());
+        let rc = reference(&scene);
         for view in 0..8 {
             let params = CameraParams {
                 width: 48 + (next() * 48.0) as u32,
@@ -324,7 +343,7 @@ fn datasets_are_covered_exactly_once_in_random_views() {
             let camera = Camera::fit(scene.mesh.bounds(), &params);
             let tag = format!("{} view {view} {params:?}", path.display());
             let (pieces, folds) = check_twin(&mut renderer, &scene.shading(), &camera, gpu, &tag);
-            let want = reference_counts(&scene, &camera);
+            let want = reference_counts(&rc, &camera);
             let snapped = check_mismatches(&scene, &camera, &pieces, &want, SNAP_BAND_PX, &tag);
             eprintln!("{tag}: {snapped} snap-band pixels, {folds} fold pixels");
         }

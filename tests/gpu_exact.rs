@@ -6,8 +6,8 @@ use zoovr::gpu::GpuVertex;
 use zoovr::gpu::{AccumFormat, Backend, ClipMapper, Context, FrameOptions, GpuError, GpuOptions};
 use zoovr::image::Image;
 use zoovr::numeric::tolerance::EXP_TABLE_MAX_ABS_ERROR;
+use zoovr::render::modes::exact::exptable::{exact_alpha, ExpTable, TABLE_N};
 use zoovr::render::modes::exact::{bind_exact_stage, ExactVertex};
-use zoovr::render::modes::exptable::{exact_alpha, ExpTable, TABLE_N};
 use zoovr::testdata::Rng;
 
 fn open(backend: Option<Backend>) -> Option<Context> {
@@ -78,7 +78,7 @@ fn constant_triangle_gives_glow_times_alpha() {
         let img = frame.finish().unwrap();
         assert_eq!(img.count_non_finite(), 0);
         let alpha = exact_alpha(l as f64, tau as f64);
-        let twin = table.sample(l, tau) as f64;
+        let twin = table.alpha_of(l, tau) as f64;
         assert!((twin - alpha).abs() <= EXP_TABLE_MAX_ABS_ERROR);
         let mut inside = 0;
         for j in 0..h {
@@ -178,7 +178,7 @@ fn thin_layers_on(ctx: &Context, backend: Backend) {
     let n = 1000;
     let exact_a = 1.0 - (1.0 - a).powi(n);
     // With the table's own alpha, to separate accumulation from table error.
-    let at = ExpTable::new(TABLE_N).sample(1.0, tau as f32) as f64;
+    let at = ExpTable::new(TABLE_N).alpha_of(1.0, tau as f32) as f64;
     let table_a = 1.0 - (1.0 - at).powi(n);
     let mut formats = vec![AccumFormat::F16];
     if ctx.resolve_format(AccumFormat::F32).is_ok() {
@@ -476,7 +476,7 @@ fn gpu_table_lookup_matches_twin_and_exact() {
         for j in 0..n {
             for i in 0..n {
                 let got = img.get(i, j)[3] as f64;
-                let twin = table.sample(val(i), val(j)) as f64;
+                let twin = table.alpha_of(val(i), val(j)) as f64;
                 // f16 storage: within 1 ulp (2^-10 relative); llvmpipe (GL)
                 // rounds towards zero (measured), lavapipe to nearest.
                 let store = if fmt == AccumFormat::F32 {

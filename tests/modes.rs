@@ -8,7 +8,8 @@
 //! the ray caster's `faces` model (a model difference inside the cells the
 //! mode splits), in perspective and orthographic views, on the project's own
 //! meshes with the default transfer function. The registry test fails when
-//! a mode lacks its stage (shader), its CPU twin or its bounds.
+//! a mode lacks its stage (shader), its CPU twin or its bounds, or a shader
+//! function lacks its same-named twin (`render::modes::twins`).
 
 mod render_util;
 
@@ -16,6 +17,7 @@ use zoovr::camera::CameraParams;
 use zoovr::image::{compare_display, Image};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
+use zoovr::render::modes::twins::missing_twins;
 use zoovr::render::modes::SHADERS;
 use zoovr::render::{
     Compositor, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
@@ -45,8 +47,10 @@ fn options(mode: Mode, ortho: bool) -> RenderOptions {
     }
 }
 
-fn render(scene: &Scene, opts: &RenderOptions) -> Image {
-    let (img, _) = Renderer::new(scene.geometry())
+/// Renders `scene` with `renderer` (made from its geometry: one per scene,
+/// so the GPU device and its tables are opened once).
+fn render(renderer: &mut Renderer, scene: &Scene, opts: &RenderOptions) -> Image {
+    let (img, _) = renderer
         .render(&scene.shading(), opts, |_, _| {})
         .unwrap_or_else(|e| panic!("{:?}: {e}", opts.mode));
     assert_eq!(img.count_non_finite(), 0);
@@ -92,7 +96,7 @@ fn registry_is_complete() {
                 },
                 ..options(mode, false)
             };
-            let img = render(&s, &opts);
+            let img = render(&mut Renderer::new(s.geometry()), &s, &opts);
             assert!(
                 img.pixels.iter().any(|p| p[3] > 0.0),
                 "{}: empty",
@@ -104,64 +108,81 @@ fn registry_is_complete() {
     }
     // The reference exists.
     assert!(Mode::ALL.iter().any(|m| m.info().bounds.is_none()));
+    // Every shader function has its CPU twin of the same name.
+    assert_eq!(missing_twins(), Vec::<String>::new());
 }
 
 #[test]
-fn every_mode_matches_the_reference() {
+fn every_mode_matches_the_reference_on_zoo() {
+    every_mode_matches_the_reference("zoo_3x3x3.vtu");
+}
+
+#[test]
+fn every_mode_matches_the_reference_on_curvilinear() {
+    every_mode_matches_the_reference("curvilinear_4x4x4.vtu");
+}
+
+#[test]
+fn every_mode_matches_the_reference_on_ring() {
+    every_mode_matches_the_reference("ring_hole.vtu");
+}
+
+/// Every mode of `Mode::ALL` against the reference on the project mesh
+/// `name`, through its CPU twin and, where an adapter exists, on the GPU.
+fn every_mode_matches_the_reference(name: &str) {
     let gpu = gpu_available();
-    for name in ["zoo_3x3x3.vtu", "curvilinear_4x4x4.vtu", "ring_hole.vtu"] {
-        let s = scene(name);
-        for ortho in [false, true] {
-            for split in [false, true] {
-                let reference = RenderOptions {
-                    reference: ReferenceOptions {
-                        model: if split {
-                            FieldModel::Tets
-                        } else {
-                            FieldModel::Faces
-                        },
-                        ..options(Mode::Raycast, ortho).reference
+    let s = scene(name);
+    let mut renderer = Renderer::new(s.geometry());
+    for ortho in [false, true] {
+        for split in [false, true] {
+            let reference = RenderOptions {
+                reference: ReferenceOptions {
+                    model: if split {
+                        FieldModel::Tets
+                    } else {
+                        FieldModel::Faces
                     },
-                    ..options(Mode::Raycast, ortho)
+                    ..options(Mode::Raycast, ortho).reference
+                },
+                ..options(Mode::Raycast, ortho)
+            };
+            let expected = render(&mut renderer, &s, &reference);
+            for &mode in Mode::ALL {
+                let Some(bounds) = mode.info().bounds else {
+                    continue;
                 };
-                let expected = render(&s, &reference);
-                for &mode in Mode::ALL {
-                    let Some(bounds) = mode.info().bounds else {
-                        continue;
+                assert_eq!(bounds.reference, FieldModel::Faces);
+                let mut compositors = vec![Compositor::Cpu];
+                if gpu {
+                    compositors.push(Compositor::Gpu);
+                }
+                for compositor in compositors {
+                    let opts = RenderOptions {
+                        projected: ProjectedOptions {
+                            split_all: split,
+                            compositor,
+                            ..options(mode, ortho).projected
+                        },
+                        ..options(mode, ortho)
                     };
-                    assert_eq!(bounds.reference, FieldModel::Faces);
-                    let mut compositors = vec![Compositor::Cpu];
-                    if gpu {
-                        compositors.push(Compositor::Gpu);
-                    }
-                    for compositor in compositors {
-                        let opts = RenderOptions {
-                            projected: ProjectedOptions {
-                                split_all: split,
-                                compositor,
-                                ..options(mode, ortho).projected
-                            },
-                            ..options(mode, ortho)
-                        };
-                        let got = render(&s, &opts);
-                        let (d, _) = compare_display(&got, &expected, [0.0; 3]).unwrap();
-                        eprintln!(
-                            "{mode} {name} ortho={ortho} split={split} {compositor:?}: max {:.2e} at {:?}",
-                            d.max_abs, d.worst
-                        );
-                        let bound = if split {
-                            bounds.split_max
-                        } else {
-                            bounds.whole_max
-                        };
-                        assert!(
-                            d.max_abs <= bound,
-                            "{mode} {name} ortho={ortho} split={split} {compositor:?}: max {:.3e} at {:?} > {:.3e}",
-                            d.max_abs,
-                            d.worst,
-                            bound
-                        );
-                    }
+                    let got = render(&mut renderer, &s, &opts);
+                    let (d, _) = compare_display(&got, &expected, [0.0; 3]).unwrap();
+                    eprintln!(
+                        "{mode} {name} ortho={ortho} split={split} {compositor:?}: max {:.2e} at {:?}",
+                        d.max_abs, d.worst
+                    );
+                    let bound = if split {
+                        bounds.split_max
+                    } else {
+                        bounds.whole_max
+                    };
+                    assert!(
+                        d.max_abs <= bound,
+                        "{mode} {name} ortho={ortho} split={split} {compositor:?}: max {:.3e} at {:?} > {:.3e}",
+                        d.max_abs,
+                        d.worst,
+                        bound
+                    );
                 }
             }
         }

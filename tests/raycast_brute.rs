@@ -26,7 +26,8 @@ use zoovr::io;
 use zoovr::mesh::{CellKind, Mesh};
 use zoovr::raycast::brute::Brute;
 use zoovr::raycast::{
-    render, FieldModel, RaycastError, RaycastOptions, Raycaster, Scalars, Scene, Traversal,
+    render, FieldModel, RayTracer, RaycastError, RaycastOptions, Raycaster, Scalars, Scene,
+    Traversal,
 };
 use zoovr::render::{ScalarsRef, SceneSpec};
 use zoovr::testdata::{mesh_file, shared_file, Rng};

@@ -14,7 +14,9 @@
 mod render_util;
 use render_util::{gpu_available, options};
 
+use std::collections::HashMap;
 use std::path::Path;
+use std::sync::{Arc, Mutex, OnceLock};
 
 use zoovr::camera::CameraParams;
 use zoovr::image::{check_images_with, Bounds, Image};
@@ -69,7 +71,16 @@ fn kinked_tf(range: (f64, f64), unit: f64) -> TransferFunction {
     TransferFunction::from_channels(&tau, &col, None, EmissionModel::Glow).unwrap()
 }
 
-fn render(scene: &Scene, mode: Mode, model: FieldModel, split_all: bool, ortho: bool) -> Image {
+/// Renders `scene` with `renderer` (made from its geometry, so a GPU
+/// device is opened once per scene).
+fn render(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    mode: Mode,
+    model: FieldModel,
+    split_all: bool,
+    ortho: bool,
+) -> Image {
     let opts = RenderOptions {
         camera: CameraParams {
             width: 256,
@@ -82,11 +93,37 @@ fn render(scene: &Scene, mode: Mode, model: FieldModel, split_all: bool, ortho: 
         },
         ..options(mode, split_all, model)
     };
-    let (img, _) = Renderer::new(scene.geometry())
-        .render(&scene.shading(), &opts, |_, _| {})
-        .unwrap();
+    let (img, _) = renderer.render(&scene.shading(), &opts, |_, _| {}).unwrap();
     assert_eq!(img.count_non_finite(), 0, "non-finite pixels");
     img
+}
+
+/// The reference ray caster's image of `scene` (`key` names its file and
+/// transfer function) with `model`: rendered once per test binary, as the
+/// exact and the exact-frag checks compare with the same images.
+fn reference(key: &str, scene: &Scene, model: FieldModel, ortho: bool) -> Arc<Image> {
+    type Slot = Arc<OnceLock<Arc<Image>>>;
+    static IMAGES: OnceLock<Mutex<HashMap<String, Slot>>> = OnceLock::new();
+    let key = format!("{key} {model:?} ortho={ortho}");
+    let slot = IMAGES
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .entry(key)
+        .or_default()
+        .clone();
+    slot.get_or_init(|| {
+        let mut renderer = Renderer::new(scene.geometry());
+        Arc::new(render(
+            &mut renderer,
+            scene,
+            Mode::Raycast,
+            model,
+            false,
+            ortho,
+        ))
+    })
+    .clone()
 }
 
 /// Compares exact (whole cells) vs faces and exact --split all vs tets, both
@@ -114,13 +151,15 @@ fn check_mode(
         if kinked {
             scene.tf = kinked_tf(scene.range, scene.unit_distance);
         }
+        let mut renderer = Renderer::new(scene.geometry());
+        let key = format!("{} kinked={kinked}", path.display());
         for ortho in [false, true] {
             let tag = format!(
                 "{name}_{mode}_{}_{}",
                 if kinked { "kinked" } else { "default" },
                 if ortho { "ortho" } else { "persp" }
             );
-            let exact = render(&scene, mode, FieldModel::Faces, false, ortho);
+            let exact = render(&mut renderer, &scene, mode, FieldModel::Faces, false, ortho);
             // A single cell holding breakpoints is drawn entirely as its
             // consistent tets, so its reference is the `tets` model; with
             // several cells, only those holding a breakpoint are split and the
@@ -132,7 +171,7 @@ fn check_mode(
             } else {
                 FieldModel::Faces
             };
-            let faces = render(&scene, Mode::Raycast, reference_model, false, ortho);
+            let faces = reference(&key, &scene, reference_model, ortho);
             let (m, r) = if slices && kinked && !single_cell {
                 (
                     MODEL_DIFF.0.max(whole_bounds.0),
@@ -146,7 +185,7 @@ fn check_mode(
                 p999: m,
                 rms: r,
             };
-            let d = check_images_with(&format!("{tag}_whole"), &exact, &faces, &b)
+            let d = check_images_with(&format!("{tag}_whole"), &exact, faces.as_ref(), &b)
                 .unwrap_or_else(|e| panic!("{e}"));
             eprintln!(
                 "{tag} whole vs {}: max {:.2e} p99.9 {:.2e} rms {:.2e}",
@@ -155,14 +194,14 @@ fn check_mode(
                 d.p999,
                 d.rms
             );
-            let split = render(&scene, mode, FieldModel::Faces, true, ortho);
-            let tets = render(&scene, Mode::Raycast, FieldModel::Tets, false, ortho);
+            let split = render(&mut renderer, &scene, mode, FieldModel::Faces, true, ortho);
+            let tets = reference(&key, &scene, FieldModel::Tets, ortho);
             let b = Bounds {
                 max_abs: split_bounds.0,
                 p999: split_bounds.0,
                 rms: split_bounds.1,
             };
-            let d = check_images_with(&format!("{tag}_split"), &split, &tets, &b)
+            let d = check_images_with(&format!("{tag}_split"), &split, tets.as_ref(), &b)
                 .unwrap_or_else(|e| panic!("{e}"));
             eprintln!(
                 "{tag} split vs tets: max {:.2e} p99.9 {:.2e} rms {:.2e}",
@@ -258,6 +297,7 @@ fn coverage_culling_changes_no_pixel() {
     for path in files {
         let mesh = io::read(&path, &ReadOptions::default()).unwrap();
         let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        let mut renderer = Renderer::new(scene.geometry());
         for kinked in [false, true] {
             if kinked {
                 scene.tf = kinked_tf(scene.range, scene.unit_distance);
@@ -283,9 +323,7 @@ fn coverage_culling_changes_no_pixel() {
                         },
                         ..Default::default()
                     };
-                    let (img, stats) = Renderer::new(scene.geometry())
-                        .render(&scene.shading(), &opts, |_, _| {})
-                        .unwrap();
+                    let (img, stats) = renderer.render(&scene.shading(), &opts, |_, _| {}).unwrap();
                     triangles[k] = stats.projected().unwrap().gpu.triangles;
                     images.push(img);
                 }

@@ -19,10 +19,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use wgpu::util::DeviceExt;
-
 use super::device::Context;
-use super::stage::stage_source;
 use super::table::Table;
 use super::GpuError;
 
@@ -212,16 +209,7 @@ impl Context {
                     ))
                 }
             };
-            let mut v = bytes.to_vec();
-            v.resize(v.len().max(16).next_multiple_of(4), 0);
-            owned.push(
-                self.device
-                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some(desc.name),
-                        contents: &v,
-                        usage,
-                    }),
-            );
+            owned.push(self.buffer_with(desc.name, bytes, usage));
         }
         let mut next = owned.iter();
         let mut entries = Vec::new();
@@ -284,25 +272,7 @@ impl Kernel {
                 count: None,
             })
             .collect();
-        let layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(desc.name),
-                entries: &entries,
-            });
-        let pipeline_layout = ctx
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(desc.name),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
-        let module = ctx
-            .device
-            .create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(desc.name),
-                source: wgpu::ShaderSource::Wgsl(stage_source(desc.wgsl).into()),
-            });
+        let (layout, pipeline_layout, module) = ctx.program(desc.name, &entries, desc.wgsl);
         let pipeline = ctx
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

@@ -43,8 +43,9 @@
 
 use half::f16;
 
+use super::common::{count_of, piece_depth};
 use super::frame::{validate, DrawKind};
-use super::raster::{piece_depth, raster_side, ClipMapper, GpuVertex, BLOCKER_Z};
+use super::raster::{raster_side, ClipMapper, GpuVertex};
 use super::{AccumFormat, GpuError};
 use crate::image::Image;
 
@@ -259,12 +260,8 @@ impl CpuFrame {
                 }
             },
             DrawKind::CountPieces | DrawKind::CountTriangles => {
-                // `count_of`: blocker quads count nothing.
-                if tri[0].clip()[2] == BLOCKER_Z * tri[0].clip()[3] {
-                    [0.0; 4]
-                } else {
-                    [1.0, 0.0, 0.0, 0.0]
-                }
+                let clip = tri[0].clip();
+                count_of(clip[2] / clip[3])
             }
         };
         let key = piece_depth(piece);

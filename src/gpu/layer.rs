@@ -104,12 +104,18 @@ pub static LAYER_STAGE: StageDesc = StageDesc {
     bindings: &[],
 };
 
-/// The CPU twin of `fs_main` in `shaders/layer.wgsl`.
+/// Twin of `fs_main` in `shaders/layer.wgsl`: the quad's flat colour.
+pub fn fs_main(tri: [&LayerVertex; 3], _bary: [f64; 3]) -> Option<[f32; 4]> {
+    Some(tri[0].rgba)
+}
+
+/// The layer stage on the CPU (it binds nothing), drawing through its twin
+/// [`fs_main`].
 pub struct LayerTwin;
 
 impl CpuStage<LayerVertex> for LayerTwin {
-    fn shade(&self, tri: [&LayerVertex; 3], _bary: [f64; 3]) -> Option<[f32; 4]> {
-        Some(tri[0].rgba)
+    fn shade(&self, tri: [&LayerVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
+        fs_main(tri, bary)
     }
     fn describe(&self, tri: [&LayerVertex; 3], _bary: [f64; 3]) -> Vec<(&'static str, f32)> {
         let c = tri[0].rgba;

@@ -46,6 +46,7 @@
 //! Errors never panic: wgpu's uncaptured-error and device-lost callbacks are
 //! captured and turned into [`GpuError`] at the next check.
 
+pub mod common;
 pub mod compute;
 pub mod cpu;
 mod device;
@@ -57,9 +58,10 @@ pub mod stage;
 pub mod table;
 mod target;
 
+pub use common::{piece_depth, MAX_PIECES};
 pub use device::{Context, ContextInfo, PendingContext};
 pub use frame::{DrawKind, Frame, FrameOptions, FrameStats};
-pub use raster::{piece_depth, ClipMapper, GpuVertex, MAX_PIECES, SUBPIXEL};
+pub use raster::{ClipMapper, GpuVertex, SUBPIXEL};
 pub use stage::{Binding, Resource, Stage, StageDesc};
 pub use table::{Table, TableDim};
 

@@ -1,6 +1,7 @@
 //! The rasteriser's geometry, common to every stage: the pixel ->
-//! clip-space mapping, the sub-pixel grid, the piece keys, and the
-//! [`GpuVertex`] trait every stage's vertex implements.
+//! clip-space mapping, the sub-pixel grid, and the [`GpuVertex`] trait
+//! every stage's vertex implements (the piece keys are in
+//! [`super::common`]).
 //!
 //! [`ClipMapper`] builds clip-space positions from continuous pixel
 //! coordinates `(px, py)` (row 0 at the top, pixel centres at `i + 0.5`, as in
@@ -28,7 +29,7 @@ pub trait GpuVertex: Pod + Send + Sync {
     /// Clip-space position (x, y, z, w); see [`ClipMapper`].
     fn clip(&self) -> [f32; 4];
     /// The piece this vertex's triangles belong to, numbered in drawing
-    /// order ([`piece_depth`]).
+    /// order ([`super::common::piece_depth`]).
     fn piece(&self) -> u32;
     /// This vertex in piece `piece`.
     fn with_piece(self, piece: u32) -> Self;
@@ -44,26 +45,6 @@ pub trait GpuVertex: Pod + Send + Sync {
     /// (premultiplied colour and opacity 0) but still pass the depth test.
     fn transparent(self) -> Self;
 }
-
-/// The depth key of piece number `piece` in drawing order (CPU twin of
-/// `piece_depth` in `shaders/common.wgsl`): the `f32` just below 1 for piece
-/// 0 and one representable value lower for each later piece, so that a
-/// strict less-than depth test passes later pieces and stops a second
-/// fragment of the same piece at a pixel. Keys stay in `(0, 1)` for pieces
-/// below [`MAX_PIECES`].
-pub fn piece_depth(piece: u32) -> f32 {
-    f32::from_bits(0x3F7F_FFFF - piece.min(MAX_PIECES - 1))
-}
-
-/// Pieces one frame can number ([`piece_depth`] stays positive); the frame
-/// refuses more.
-pub const MAX_PIECES: u32 = 0x3F7F_FFFF;
-
-/// Clip z of the corners of a blocker quad ([`crate::render::ties`]): a
-/// pixel quad that takes a pixel for its piece without colouring or
-/// counting it (`count_of` in `shaders/common.wgsl`). Everything else is
-/// drawn at z = 0.5.
-pub const BLOCKER_Z: f32 = 0.25;
 
 /// Sub-pixel grid of the rasteriser: positions are snapped to 1/`SUBPIXEL`
 /// pixel (8 bits, what lavapipe, llvmpipe and the desktop drivers use).

@@ -158,26 +158,7 @@ impl Context {
                 Resource::Uniform(b) | Resource::Storage(b) => *b,
                 Resource::Table(_) => &[],
             };
-            // wgpu refuses empty buffers; a storage array may be empty.
-            let padded;
-            let bytes = if bytes.len() < 16 {
-                padded = {
-                    let mut v = bytes.to_vec();
-                    v.resize(16, 0);
-                    v
-                };
-                &padded[..]
-            } else {
-                bytes
-            };
-            let buf = self
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(desc.name),
-                    contents: bytes,
-                    usage,
-                });
-            buffers.push((k, buf));
+            buffers.push((k, self.buffer_with(desc.name, bytes, usage)));
         }
         let entries: Vec<wgpu::BindGroupEntry> = resources
             .iter()
@@ -253,25 +234,7 @@ impl Context {
                 count: None,
             })
             .collect();
-        let bind_layout = self
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(desc.name),
-                entries: &entries,
-            });
-        let pipeline_layout = self
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(desc.name),
-                bind_group_layouts: &[Some(&bind_layout)],
-                immediate_size: 0,
-            });
-        let module = self
-            .device
-            .create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(desc.name),
-                source: wgpu::ShaderSource::Wgsl(stage_source(desc.wgsl).into()),
-            });
+        let (bind_layout, pipeline_layout, module) = self.program(desc.name, &entries, desc.wgsl);
         let cache = Arc::new(StageCache {
             desc,
             module,
@@ -283,6 +246,62 @@ impl Context {
             m.insert(desc.name, cache.clone());
         }
         cache
+    }
+}
+
+impl Context {
+    /// A buffer of `usage` initialised with `bytes`, padded with zeros to
+    /// at least 16 bytes and a multiple of 4 (wgpu refuses empty buffers;
+    /// a storage array may be empty).
+    pub(super) fn buffer_with(
+        &self,
+        label: &str,
+        bytes: &[u8],
+        usage: wgpu::BufferUsages,
+    ) -> wgpu::Buffer {
+        let mut v = bytes.to_vec();
+        v.resize(v.len().max(16).next_multiple_of(4), 0);
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &v,
+                usage,
+            })
+    }
+
+    /// What a stage or a kernel compiles once: the layout of its one bind
+    /// group of `entries`, the pipeline layout of that group, and its shader
+    /// module (`wgsl` behind `shaders/common.wgsl`).
+    pub(super) fn program(
+        &self,
+        label: &str,
+        entries: &[wgpu::BindGroupLayoutEntry],
+        wgsl: &str,
+    ) -> (
+        wgpu::BindGroupLayout,
+        wgpu::PipelineLayout,
+        wgpu::ShaderModule,
+    ) {
+        let layout = self
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            });
+        let pipeline_layout = self
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+        let module = self
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(label),
+                source: wgpu::ShaderSource::Wgsl(stage_source(wgsl).into()),
+            });
+        (layout, pipeline_layout, module)
     }
 }
 

@@ -21,7 +21,7 @@ pub const DEGENERATE_VOLUME_REL: f64 = 1e-12;
 pub const MERGE_POINTS_REL: f64 = 1e-12;
 
 /// Measured maximum absolute error of the exact mode's exponential table
-/// (`render::modes::exptable`, 1024^2 texels, log-warped axes, f32 bilinear filtering)
+/// (`render::modes::exact::exptable`, 1024^2 texels, log-warped axes, f32 bilinear filtering)
 /// against the exact `1 - exp(-l tau)` over `l, tau` in `{0} + [1e-8, 1e6]`:
 /// 9.5e-5 on 2000^2 log-spaced samples (5.7e-5 for l, tau in [1e-3, 1e3]),
 /// rounded up for points between samples (test `exptable_error_is_bounded`). Used as the tolerance of

@@ -81,10 +81,9 @@ use glam::DVec3;
 
 use super::bvh::{ray_hits_box, Bvh, NodeQueue};
 use super::geometry::{Proj, RayFrame};
-use super::{render_tiles, validate, FieldModel, RaycastError, RaycastOptions, Scalars, Scene};
 use super::{stop_depth, Segment};
-use crate::camera::{Camera, Ray};
-use crate::image::Image;
+use super::{validate, FieldModel, RayTracer, RaycastError, RaycastOptions, Scalars, Scene};
+use crate::camera::Ray;
 use crate::integrate::{RayAccumulator, RayMaterial};
 use crate::mesh::tetra::{tetrahedralize, tetrahedralize_cell};
 use crate::mesh::CellKind;
@@ -588,34 +587,21 @@ impl<'a> Brute<'a> {
         }
         pending.drain(..i);
     }
+}
 
-    /// Renders an image through `camera` (parallel tiles, as the walk).
-    pub fn render<M: RayMaterial>(
+/// Rendering an image: parallel tiles, as the walk.
+impl RayTracer for Brute<'_> {
+    type Scratch = BruteScratch;
+
+    fn integrate<M: RayMaterial>(
         &self,
         material: &M,
-        camera: &Camera,
+        ray: &Ray,
+        t_near: f64,
         opts: &RaycastOptions,
-    ) -> Image {
-        self.render_with_progress(material, camera, opts, |_, _| {})
-    }
-
-    /// [`Brute::render`] with progress reports, as
-    /// [`super::Raycaster::render_with_progress`].
-    pub fn render_with_progress<M: RayMaterial>(
-        &self,
-        material: &M,
-        camera: &Camera,
-        opts: &RaycastOptions,
-        progress: impl FnMut(usize, usize),
-    ) -> Image {
-        render_tiles(
-            camera,
-            opts,
-            progress,
-            |ray, t_near, scratch: &mut BruteScratch| {
-                self.trace(material, ray, t_near, opts, scratch).rgba()
-            },
-        )
+        scratch: &mut BruteScratch,
+    ) -> RayAccumulator {
+        self.trace(material, ray, t_near, opts, scratch)
     }
 }
 

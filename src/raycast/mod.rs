@@ -10,6 +10,8 @@
 //! cells, each crossed whole or as its tets with the same crossing
 //! predicate, no adjacency), the reference
 //! for meshes whose adjacency cannot be trusted (`faces` and `tets` only).
+//! Both traversals are [`RayTracer`]s: each integrates one ray, and the
+//! trait renders an image from them in parallel tiles.
 //! Field models:
 //! - [`FieldModel::Faces`] (default): entry and exit on the cell's face
 //!   triangles, the scalar linear on each triangle (barycentric) and along the
@@ -644,9 +646,27 @@ impl<'a> Raycaster<'a> {
         });
         acc
     }
+}
+
+/// A traversal of the mesh by pixel rays: the walk ([`Raycaster`]) or the
+/// brute force ([`brute::Brute`]). Each integrates one ray; rendering an
+/// image (parallel tiles) is the same for both.
+pub trait RayTracer: Sync {
+    /// Per-thread scratch of one traversal.
+    type Scratch: Default + Send;
+
+    /// Integrates one ray from `t_near` on (the traversal's `trace`).
+    fn integrate<M: RayMaterial>(
+        &self,
+        material: &M,
+        ray: &Ray,
+        t_near: f64,
+        opts: &RaycastOptions,
+        scratch: &mut Self::Scratch,
+    ) -> RayAccumulator;
 
     /// Renders an image through `camera`.
-    pub fn render<M: RayMaterial>(
+    fn render<M: RayMaterial>(
         &self,
         material: &M,
         camera: &Camera,
@@ -655,24 +675,34 @@ impl<'a> Raycaster<'a> {
         self.render_with_progress(material, camera, opts, |_, _| {})
     }
 
-    /// [`Raycaster::render`], calling `progress(done, total)` (in tiles)
+    /// [`RayTracer::render`], calling `progress(done, total)` (in tiles)
     /// from the calling thread about ten times a second while the tiles are
     /// traced on the rayon pool, and once at the end.
-    pub fn render_with_progress<M: RayMaterial>(
+    fn render_with_progress<M: RayMaterial>(
         &self,
         material: &M,
         camera: &Camera,
         opts: &RaycastOptions,
         progress: impl FnMut(usize, usize),
     ) -> Image {
-        render_tiles(
-            camera,
-            opts,
-            progress,
-            |ray, t_near, scratch: &mut Scratch| {
-                self.trace(material, ray, t_near, opts, scratch).rgba()
-            },
-        )
+        render_tiles(camera, opts, progress, |ray, t_near, scratch| {
+            self.integrate(material, ray, t_near, opts, scratch).rgba()
+        })
+    }
+}
+
+impl RayTracer for Raycaster<'_> {
+    type Scratch = Scratch;
+
+    fn integrate<M: RayMaterial>(
+        &self,
+        material: &M,
+        ray: &Ray,
+        t_near: f64,
+        opts: &RaycastOptions,
+        scratch: &mut Scratch,
+    ) -> RayAccumulator {
+        self.trace(material, ray, t_near, opts, scratch)
     }
 }
 
@@ -759,7 +789,7 @@ fn render_tiles<S: Default + Send>(
 }
 
 /// Renders `scene` through `camera` (validates and prepares the scene, then
-/// [`Raycaster::render`]).
+/// [`RayTracer::render`]).
 pub fn render<M: RayMaterial>(
     scene: &Scene,
     material: &M,

@@ -50,9 +50,9 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use crate::camera::Camera;
+use crate::gpu::common::BLOCKER_Z;
 use crate::gpu::cpu::{CpuFrame, CpuStage};
 use crate::gpu::layer::{LayerTwin, LayerVertex, LAYER_STAGE};
-use crate::gpu::raster::BLOCKER_Z;
 use crate::gpu::{
     ClipMapper, Context, Frame, FrameOptions, FrameStats, GpuError, GpuVertex, PendingContext,
     Stage, MAX_PIECES,

@@ -35,7 +35,7 @@
 //! the mode's payload of the exact segment the ray cuts from the part
 //! (entry and exit depth and scalar from the crossings, the ray caster's
 //! numbers) where the exact part holds the centre, or transparent where it
-//! does not (a blocker, drawn at [`BLOCKER_Z`], which counting draws do
+//! does not (a blocker, drawn at [`crate::gpu::common::BLOCKER_Z`], which counting draws do
 //! not count). Each piece colours a pixel once (its depth key), so the
 //! quad decides the pixel and the triangles drawn after it leave it alone.
 

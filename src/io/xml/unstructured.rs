@@ -329,6 +329,21 @@ fn general_path(
     Ok((mesh.source.ignored_cells > 0).then_some(keep))
 }
 
+/// The array `name` of `<Cells>`, which polyhedra need.
+fn polyhedron_array<'e>(
+    src: &Source,
+    cells_el: &'e Element,
+    name: &str,
+) -> Result<&'e Element, IoError> {
+    cells_array(cells_el, name).ok_or_else(|| {
+        IoError::parse(
+            src.path,
+            cells_el.location(),
+            format!("polyhedra need a '{name}' array"),
+        )
+    })
+}
+
 /// Reads `faces`/`faceoffsets` into per-cell face lists (`None` for cells
 /// that are not polyhedra).
 fn read_faces(
@@ -337,15 +352,7 @@ fn read_faces(
     nc: usize,
     np: usize,
 ) -> Result<Vec<Option<Vec<Vec<u32>>>>, IoError> {
-    let need = |name: &str| {
-        cells_array(cells_el, name).ok_or_else(|| {
-            IoError::parse(
-                src.path,
-                cells_el.location(),
-                format!("polyhedra need a '{name}' array"),
-            )
-        })
-    };
+    let need = |name: &str| polyhedron_array(src, cells_el, name);
     let (faces_el, fo_el) = (need("faces")?, need("faceoffsets")?);
     let fo: Vec<i64> = src.decode(fo_el, scalar_type(src, fo_el)?, Some(nc))?;
     let faces: Vec<i64> = src.decode(faces_el, scalar_type(src, faces_el)?, None)?;
@@ -413,15 +420,7 @@ fn read_faces_vtk94(
     nc: usize,
     np: usize,
 ) -> Result<Vec<Option<Vec<Vec<u32>>>>, IoError> {
-    let need = |name: &str| {
-        cells_array(cells_el, name).ok_or_else(|| {
-            IoError::parse(
-                src.path,
-                cells_el.location(),
-                format!("polyhedra need a '{name}' array"),
-            )
-        })
-    };
+    let need = |name: &str| polyhedron_array(src, cells_el, name);
     let dec =
         |el: &Element| -> Result<Vec<i64>, IoError> { src.decode(el, scalar_type(src, el)?, None) };
     let (fc_el, fo_el, p2f_el, po_el) = (

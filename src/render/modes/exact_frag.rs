@@ -14,8 +14,8 @@
 //!   regions need no perspective refinement);
 //! - **stage** (`shaders/exact_frag.wgsl` behind `shaders/segment.wgsl` and
 //!   `shaders/integral.wgsl`, [`EXACT_FRAG_STAGE`]): per fragment
-//!   `integrate_segment(l, s_f, s_b)` in `f32`; [`ExactFragTwin`] is its CPU
-//!   twin ([`super::integral`]).
+//!   `integrate_segment(l, s_f, s_b)` in `f32`; [`fs_main`] is its CPU twin
+//!   (on [`super::segment::segment_at`] and [`super::integral`]).
 //!
 //! Glow and independent emission are both exact (the fragment integrates
 //! the source the transfer function defines). Within a whole cell the
@@ -25,14 +25,12 @@
 
 use crate::gpu::cpu::CpuStage;
 use crate::gpu::{Binding, ClipMapper, Context, GpuError, Resource, Stage, StageDesc};
-use crate::projection::{Polyhedron, Projected};
 use crate::raycast::FieldModel;
-use crate::render::driver::ProjectedMode;
 use crate::render::pieces::PieceSource;
 use crate::tf::{EmissionModel, TransferFunction};
 
 use super::integral::{closed_form_constants, TfBuffer};
-use super::segment::{segment_at, ScalarMap, SegmentPayload, SegmentVertex, SegmentView};
+use super::segment::{segment_at, ScalarMap, SegmentMode, SegmentVertex, SegmentView};
 use super::{Bounds, ModeInfo};
 
 /// The registry entry of the exact-frag mode.
@@ -88,7 +86,8 @@ pub fn bind_exact_frag_stage(
     )
 }
 
-/// The CPU twin of `fs_main` in `shaders/exact_frag.wgsl`.
+/// The exact-frag stage's bindings on the CPU (view, transfer function,
+/// the closed form's constants), for its twin [`fs_main`].
 pub struct ExactFragTwin {
     view: SegmentView,
     mapper: ClipMapper,
@@ -118,16 +117,28 @@ impl ExactFragTwin {
     }
 }
 
+/// Twin of `fs_main` in `shaders/exact_frag.wgsl`, the fragment at
+/// weights `bary` of `tri` drawn with `stage`'s bindings: its segment
+/// (`segment_at`), integrated (`integrate_segment`).
+pub fn fs_main(
+    stage: &ExactFragTwin,
+    tri: [&SegmentVertex; 3],
+    bary: [f64; 3],
+) -> Option<[f32; 4]> {
+    let seg = segment_at(&stage.view, &stage.mapper, tri, bary);
+    if !seg.ok {
+        return None;
+    }
+    Some(
+        stage
+            .tf
+            .integrate_segment(&stage.consts, seg.l, seg.s_f, seg.s_b),
+    )
+}
+
 impl CpuStage<SegmentVertex> for ExactFragTwin {
     fn shade(&self, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
-        let seg = segment_at(&self.view, &self.mapper, tri, bary);
-        if !seg.ok {
-            return None;
-        }
-        Some(
-            self.tf
-                .integrate_segment(&self.consts, seg.l, seg.s_f, seg.s_b),
-        )
+        fs_main(self, tri, bary)
     }
 
     fn describe(&self, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {
@@ -139,18 +150,7 @@ impl CpuStage<SegmentVertex> for ExactFragTwin {
 /// The exact-frag mode on the projected-cell driver.
 pub struct ExactFragMode;
 
-impl ProjectedMode for ExactFragMode {
-    type Vertex = SegmentVertex;
-    type Payload = SegmentPayload;
-
-    fn split_points(&self, _tf: &TransferFunction) -> Vec<f64> {
-        Vec::new()
-    }
-
-    fn perspective_refine(&self) -> bool {
-        SegmentVertex::needs_perspective_refinement()
-    }
-
+impl SegmentMode for ExactFragMode {
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         let tf = TfBuffer::new(src.tf, &ScalarMap::of(src.tf));
         bind_exact_frag_stage(gpu, &SegmentView::of(src.camera), &tf)
@@ -158,27 +158,5 @@ impl ProjectedMode for ExactFragMode {
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {
         Box::new(ExactFragTwin::new(src.tf, src.camera))
-    }
-
-    fn payload(
-        &self,
-        src: &PieceSource,
-        _part: &Polyhedron,
-        _proj: &mut Projected,
-        _used: &mut Vec<bool>,
-        payload: &mut SegmentPayload,
-        _refined: &mut usize,
-    ) {
-        payload.set(src);
-    }
-
-    fn vertex(
-        &self,
-        payload: &SegmentPayload,
-        proj: &Projected,
-        i: usize,
-        ndc: [f32; 2],
-    ) -> SegmentVertex {
-        SegmentVertex::of(proj, i, ndc, &payload.map, payload.ortho)
     }
 }

@@ -135,11 +135,11 @@ impl TfBuffer {
         (self.nodes.len() / 2) as u32
     }
 
-    fn node_s(&self, i: u32) -> f32 {
+    pub(crate) fn node_s(&self, i: u32) -> f32 {
         self.nodes[2 * i as usize][0]
     }
 
-    fn node(&self, i: u32) -> Material {
+    pub(crate) fn node(&self, i: u32) -> Material {
         let (a, b) = (self.nodes[2 * i as usize], self.nodes[2 * i as usize + 1]);
         Material {
             tau: a[1],
@@ -187,7 +187,7 @@ impl TfBuffer {
     }
 
     /// Adds one linear piece behind `acc` (`add_piece`).
-    fn add_piece(
+    pub(crate) fn add_piece(
         &self,
         consts: &[[f32; 4]],
         acc: &mut Composite,
@@ -217,7 +217,7 @@ impl TfBuffer {
 
     /// The piece between fractions `x0 < x1` (`add_sub`).
     #[allow(clippy::too_many_arguments)]
-    fn add_sub(
+    pub(crate) fn add_sub(
         &self,
         consts: &[[f32; 4]],
         acc: &mut Composite,
@@ -291,7 +291,7 @@ impl TfBuffer {
 
 /// The running composite of one segment's pieces (`Composite`).
 #[derive(Clone, Copy, Debug, Default)]
-struct Composite {
+pub(crate) struct Composite {
     color: [f32; 3],
     depth: f32,
     alpha: f32,
@@ -363,7 +363,7 @@ pub fn asym(t: f32, sign: f32) -> [f32; 2] {
     [s, q]
 }
 
-fn ends_increasing(consts: &[[f32; 4]], c: f32, r: f32, d: f32) -> [f32; 2] {
+pub(crate) fn ends_increasing(consts: &[[f32; 4]], c: f32, r: f32, d: f32) -> [f32; 2] {
     let u = c / r;
     if u <= ASYM_X {
         let pq = taylor_pq(consts, u);
@@ -374,7 +374,7 @@ fn ends_increasing(consts: &[[f32; 4]], c: f32, r: f32, d: f32) -> [f32; 2] {
     [sq[0] / c, sq[1] / cc]
 }
 
-fn ends_decreasing(consts: &[[f32; 4]], c: f32, r: f32, e: f32) -> [f32; 2] {
+pub(crate) fn ends_decreasing(consts: &[[f32; 4]], c: f32, r: f32, e: f32) -> [f32; 2] {
     let v = c / r;
     if v <= ASYM_X {
         let bg = taylor_bg(consts, v);
@@ -385,7 +385,7 @@ fn ends_decreasing(consts: &[[f32; 4]], c: f32, r: f32, e: f32) -> [f32; 2] {
     [sq[0] / c, sq[1] / cc]
 }
 
-fn sanitize_thickness(x: f32) -> f32 {
+pub(crate) fn sanitize_thickness(x: f32) -> f32 {
     if x > 0.0 {
         x.min(MAX_THICKNESS)
     } else {
@@ -395,7 +395,7 @@ fn sanitize_thickness(x: f32) -> f32 {
 
 /// `[w_f, w_b, phi_f, phi_b]` by the Gauss-Legendre rule of `pairs`
 /// entries from `base` (`gauss`).
-fn gauss(consts: &[[f32; 4]], a: f32, b: f32, base: usize, pairs: usize) -> [f32; 4] {
+pub(crate) fn gauss(consts: &[[f32; 4]], a: f32, b: f32, base: usize, pairs: usize) -> [f32; 4] {
     let mut acc = [0.0f32; 4];
     for e2 in &consts[base..base + pairs] {
         for h in 0..2 {

@@ -12,17 +12,20 @@
 //!    functions of `shaders/common.wgsl` are in scope);
 //! 2. `src/render/modes/NAME.rs`: the vertex type (a
 //!    [`crate::gpu::GpuVertex`] mirroring `VertexIn`), its `StageDesc`,
-//!    the CPU twin of `fs_main` ([`crate::gpu::cpu::CpuStage`]) and an
-//!    implementation of [`super::driver::ProjectedMode`] (split points,
-//!    payload, vertex, binding the stage);
+//!    the CPU twin `fn fs_main` with the stage's bindings on the CPU (a
+//!    [`crate::gpu::cpu::CpuStage`]) and an implementation of
+//!    [`super::driver::ProjectedMode`] (split points, payload, vertex,
+//!    binding the stage), or of [`segment::SegmentMode`] for a mode on the
+//!    segment payload;
 //! 3. a variant of [`Mode`], its [`ModeInfo`] in [`Mode::info`], and its arm
 //!    in `Renderer::render_with_camera` (src/render/mod.rs);
-//! 4. its file in [`SHADERS`]. `tests/modes.rs` then compares it with the
-//!    reference at its bounds, on the CPU twin and on the GPU.
+//! 4. its file in [`SHADERS`] and its twins in [`twins::stage_twins`].
+//!    `tests/modes.rs` then compares it with the reference at its bounds,
+//!    on the CPU twin and on the GPU, and checks that every function of its
+//!    shader has a twin of the same name ([`twins`] gives the scheme).
 
 pub mod exact;
 pub mod exact_frag;
-pub mod exptable;
 pub mod integral;
 pub mod preint;
 pub mod preint2d;
@@ -31,6 +34,10 @@ pub mod preint3d;
 pub mod preint_tables;
 pub mod raycast;
 pub mod segment;
+pub mod table_build;
+pub mod twins;
+
+pub use exact::exptable;
 
 use clap::ValueEnum;
 use serde::Serialize;

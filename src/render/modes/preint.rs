@@ -17,7 +17,7 @@
 //!    (`textureLoad`, so the CPU twin filters identically and GL, which
 //!    cannot filter `f32` textures, works too).
 //!
-//! [`PreintMode`] is the [`ProjectedMode`] of all three; a mode file gives
+//! [`PreintMode`] is the [`SegmentMode`] of all three; a mode file gives
 //! its registry entry, its stage and its lookup's twin.
 
 use std::sync::{Arc, Mutex};
@@ -27,16 +27,14 @@ use bytemuck::{Pod, Zeroable};
 use crate::camera::Camera;
 use crate::gpu::cpu::CpuStage;
 use crate::gpu::{ClipMapper, Context, GpuError, Resource, Stage, StageDesc, Table};
-use crate::projection::{Polyhedron, Projected};
-use crate::render::driver::ProjectedMode;
 use crate::render::pieces::PieceSource;
 use crate::render::{Compositor, RenderOptions, TableBuild, TableOptions};
 use crate::tf::{EmissionModel, TransferFunction};
 
 use super::preint_tables::{
-    fill_cpu, SceneLengths, TableCache, TableKind, TableSizeError, TableSpec, TableStats,
+    cpu_texels, SceneLengths, TableCache, TableKind, TableSizeError, TableSpec, TableStats,
 };
-use super::segment::{segment_at, SegmentPayload, SegmentVertex, SegmentView};
+use super::segment::{segment_at, SegmentMode, SegmentVertex, SegmentView};
 
 /// Most steps a segment is cut into (`MAX_STEPS` in the shader).
 const MAX_STEPS: u32 = 16;
@@ -122,7 +120,7 @@ pub fn one_minus_exp_over(x: f32) -> f32 {
 }
 
 /// A segment of length `l` in constant material `m` (`homogeneous`).
-fn homogeneous(p: &PreintParams, m: [f32; 4], l: f32) -> [f32; 4] {
+pub(crate) fn homogeneous(p: &PreintParams, m: [f32; 4], l: f32) -> [f32; 4] {
     let x = (m[3] * l).min(1e30);
     let f = l * one_minus_exp_over(x);
     let alpha = x * one_minus_exp_over(x);
@@ -139,7 +137,7 @@ fn homogeneous(p: &PreintParams, m: [f32; 4], l: f32) -> [f32; 4] {
 
 /// `back` behind `front` (`over`).
 #[inline]
-fn over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
+pub(crate) fn over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
     let t = 1.0 - front[3];
     [
         front[0] + t * back[0],
@@ -167,7 +165,7 @@ pub fn lerp4(a: [f32; 4], b: [f32; 4], w: f32) -> [f32; 4] {
     std::array::from_fn(|k| a[k] + (b[k] - a[k]) * w)
 }
 
-fn table_steps(
+pub(crate) fn table_steps(
     p: &PreintParams,
     t: &CpuTable,
     lookup: LookupFn,
@@ -192,7 +190,7 @@ fn table_steps(
     acc
 }
 
-fn extension(p: &PreintParams, s: f32) -> [f32; 4] {
+pub(crate) fn extension(p: &PreintParams, s: f32) -> [f32; 4] {
     if s < 0.5 {
         p.below
     } else {
@@ -236,7 +234,8 @@ pub fn preint_segment(
     acc
 }
 
-/// The CPU twin of a table stage's `fs_main`.
+/// A table stage's bindings on the CPU (view, table, parameters and the
+/// mode's lookup), for its twin [`fs_main`].
 pub struct PreintTwin {
     view: SegmentView,
     mapper: ClipMapper,
@@ -245,20 +244,27 @@ pub struct PreintTwin {
     lookup: LookupFn,
 }
 
+/// Twin of `fs_main` in `shaders/preint.wgsl`, the fragment at weights
+/// `bary` of `tri` drawn with `stage`'s bindings: its segment
+/// (`segment_at`) through [`preint_segment`].
+pub fn fs_main(stage: &PreintTwin, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
+    let seg = segment_at(&stage.view, &stage.mapper, tri, bary);
+    if !seg.ok {
+        return None;
+    }
+    Some(preint_segment(
+        &stage.params,
+        &stage.table,
+        stage.lookup,
+        seg.s_f,
+        seg.s_b,
+        seg.l,
+    ))
+}
+
 impl CpuStage<SegmentVertex> for PreintTwin {
     fn shade(&self, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
-        let seg = segment_at(&self.view, &self.mapper, tri, bary);
-        if !seg.ok {
-            return None;
-        }
-        Some(preint_segment(
-            &self.params,
-            &self.table,
-            self.lookup,
-            seg.s_f,
-            seg.s_b,
-            seg.l,
-        ))
+        fs_main(self, tri, bary)
     }
 
     fn describe(&self, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {
@@ -305,13 +311,21 @@ impl PreintMode {
     pub fn for_mode(mode: super::Mode, opts: &RenderOptions) -> Result<PreintMode, TableSizeError> {
         use super::{preint2d, preint2d_cyl, preint3d, Mode};
         let (kind, stage, lookup): (TableKind, &'static StageDesc, LookupFn) = match mode {
-            Mode::Preint2d => (TableKind::Flat, &preint2d::PREINT2D_STAGE, preint2d::lookup),
+            Mode::Preint2d => (
+                TableKind::Flat,
+                &preint2d::PREINT2D_STAGE,
+                preint2d::table_rgba,
+            ),
             Mode::Preint2dCyl => (
                 TableKind::Cylinder,
                 &preint2d_cyl::PREINT2D_CYL_STAGE,
-                preint2d_cyl::lookup,
+                preint2d_cyl::table_rgba,
             ),
-            _ => (TableKind::Cube, &preint3d::PREINT3D_STAGE, preint3d::lookup),
+            _ => (
+                TableKind::Cube,
+                &preint3d::PREINT3D_STAGE,
+                preint3d::table_rgba,
+            ),
         };
         PreintMode::new(kind, stage, lookup, opts)
     }
@@ -372,7 +386,8 @@ impl PreintMode {
         )
     }
 
-    /// The CPU twin for one frame (its table built on the CPU, not cached).
+    /// The CPU twin for one frame (its table built on the CPU, or the
+    /// process's copy of the same table, [`cpu_texels`]).
     pub fn twin_for(
         &self,
         mesh: &crate::mesh::Mesh,
@@ -384,14 +399,8 @@ impl PreintMode {
             .spec(SceneLengths::of(mesh))
             .unwrap_or_else(|e| unreachable!("checked by PreintMode::new: {e}"));
         let build = self.resolved_build(None);
-        let mut data = vec![0.0; 4 * spec.texels()];
-        let built = fill_cpu(
-            &spec,
-            tf,
-            build,
-            (f64::NEG_INFINITY, f64::INFINITY),
-            &mut data,
-        );
+        let (data, fresh) = cpu_texels(&spec, tf, build);
+        let built = if fresh { spec.texels() } else { 0 };
         if let Ok(mut s) = self.stats.lock() {
             *s = Some(TableStats {
                 kind: spec.kind,
@@ -408,52 +417,19 @@ impl PreintMode {
             params: PreintParams::new(tf, &spec),
             table: Arc::new(CpuTable {
                 size: spec.size,
-                data,
+                data: data.to_vec(),
             }),
             lookup: self.lookup,
         }
     }
 }
 
-impl ProjectedMode for PreintMode {
-    type Vertex = SegmentVertex;
-    type Payload = SegmentPayload;
-
-    fn split_points(&self, _tf: &TransferFunction) -> Vec<f64> {
-        Vec::new()
-    }
-
-    fn perspective_refine(&self) -> bool {
-        SegmentVertex::needs_perspective_refinement()
-    }
-
+impl SegmentMode for PreintMode {
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         self.bind_stage(gpu, src.mesh, src.tf, src.camera)
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {
         Box::new(self.twin_for(src.mesh, src.tf, src.camera))
-    }
-
-    fn payload(
-        &self,
-        src: &PieceSource,
-        _part: &Polyhedron,
-        _proj: &mut Projected,
-        _used: &mut Vec<bool>,
-        payload: &mut SegmentPayload,
-        _refined: &mut usize,
-    ) {
-        payload.set(src);
-    }
-
-    fn vertex(
-        &self,
-        payload: &SegmentPayload,
-        proj: &Projected,
-        i: usize,
-        ndc: [f32; 2],
-    ) -> SegmentVertex {
-        SegmentVertex::of(proj, i, ndc, &payload.map, payload.ortho)
     }
 }

@@ -19,7 +19,7 @@
 //! is left is the colour's dependence on `l` inside a segment whose colour
 //! and extinction vary (the front weighting changes with depth): largest
 //! for optically thick cells much longer or shorter than `l_ref`. The
-//! lookup is bilinear, by hand in `f32` ([`lookup`], the twin of
+//! lookup is bilinear, by hand in `f32` ([`table_rgba`], the twin of
 //! `table_rgba` in `shaders/preint2d.wgsl`). `--table N` sets the samples
 //! per scalar axis (default 512: the table is small).
 
@@ -67,7 +67,7 @@ pub static PREINT2D_STAGE: StageDesc = StageDesc {
 };
 
 /// Twin of `table_rgba` in `shaders/preint2d.wgsl`.
-pub fn lookup(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [f32; 4] {
+pub fn table_rgba(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [f32; 4] {
     let (i, wa) = axis(sf, p.ns);
     let (j, wb) = axis(sb, p.ns);
     let r0 = lerp4(t.load(i, j, 0), t.load(i + 1, j, 0), wa);

@@ -11,7 +11,7 @@
 //! `(S_f, S_b, L)` from the exact integrals ([`TableKind::Cylinder`]), as
 //! the layers of one 2D-array texture (the paper's tiles). A lookup is
 //! bilinear in each of the two nearest planes and linear between them, by
-//! hand in `f32` ([`lookup`], the twin of `table_rgba` in
+//! hand in `f32` ([`table_rgba`], the twin of `table_rgba` in
 //! `shaders/preint2d_cyl.wgsl`). `--table N` gives `N` samples per axis and
 //! `P = 2 N` planes (the paper: `4 N` reconstructs the 3D table exactly,
 //! `N` to `2 N` usually suffice). `l_table` is the largest cell diameter,
@@ -85,7 +85,7 @@ pub fn table_to_cyl(sf: f32, sb: f32, big_l: f32) -> (f32, f32) {
 }
 
 /// Twin of `table_rgba` in `shaders/preint2d_cyl.wgsl`.
-pub fn lookup(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [f32; 4] {
+pub fn table_rgba(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [f32; 4] {
     let big_l = (l / p.l_table).clamp(0.0, 1.0);
     let (a, u) = table_to_cyl(sf, sb, big_l);
     let (k, wp) = axis(a, p.nz);

@@ -9,7 +9,7 @@
 //! cell diameter of the mesh (a bound of every piece's thickness, computed
 //! once per mesh), so no segment needs more than one lookup; longer ones
 //! would be composited in steps ([`super::preint`]). The lookup is
-//! trilinear, by hand in `f32` ([`lookup`], the twin of `table_rgba` in
+//! trilinear, by hand in `f32` ([`table_rgba`], the twin of `table_rgba` in
 //! `shaders/preint3d.wgsl`).
 //!
 //! Where the error comes from: the trilinear interpolation of the
@@ -63,7 +63,7 @@ pub static PREINT3D_STAGE: StageDesc = StageDesc {
 };
 
 /// Twin of `table_rgba` in `shaders/preint3d.wgsl`.
-pub fn lookup(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [f32; 4] {
+pub fn table_rgba(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [f32; 4] {
     let (i, wa) = axis(sf, p.ns);
     let (j, wb) = axis(sb, p.ns);
     let (k, wc) = axis(l / p.l_table, p.nz);

@@ -20,7 +20,8 @@
 //! [`crate::integrate::fast`] (EKE 3.5: exact opacity, mean-glow colour);
 //! `Gpu` runs `shaders/table_build.wgsl`, one invocation per texel calling
 //! `integrate_segment` (shaders/integral.wgsl) through the generic compute
-//! facility ([`crate::gpu::compute`]); its CPU twin is [`gpu_texel`].
+//! facility ([`crate::gpu::compute`], [`super::table_build`]); its CPU
+//! twin is [`super::table_build::build_main`].
 //!
 //! **Edits.** A segment's integral depends only on the transfer function
 //! between its two scalars, so after an edit confined to the scalar
@@ -37,12 +38,10 @@
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::gpu::compute::{ComputeBinding, ComputeDesc, ComputeResource, GpuBuffer, ROW_ALIGN};
 use crate::gpu::{Context, GpuError, Table, TableDim};
 use crate::integrate::cylinder::cyl_to_table;
 use crate::integrate::fast::{approx_rgba, point_source, FastColour, IntegralFunctions};
@@ -55,6 +54,8 @@ use crate::tf::TransferFunction;
 
 use super::integral::{closed_form_constants, TfBuffer};
 use super::segment::ScalarMap;
+use super::table_build::build_main;
+pub use super::table_build::{row_texels, GpuBuilt, TABLE_BUILD};
 
 /// Largest number of texels a table may have (256 Mi: 4 GiB of RGBA f32).
 pub const MAX_TEXELS: u64 = 1 << 28;
@@ -102,7 +103,7 @@ impl TableKind {
         }
     }
 
-    fn code(self) -> u32 {
+    pub(super) fn code(self) -> u32 {
         match self {
             TableKind::Cube => 0,
             TableKind::Flat => 1,
@@ -271,42 +272,6 @@ fn touched(sf: f64, sb: f64, lo: f64, hi: f64) -> bool {
     sf.max(sb) >= lo && sf.min(sb) <= hi
 }
 
-/// The CPU twin of `build_main` in `shaders/table_build.wgsl` for one
-/// texel: the `f32` closed form at the texel's point.
-pub fn gpu_texel(tf: &TfBuffer, consts: &[[f32; 4]], kind: TableKind, p: [f32; 3]) -> [f32; 4] {
-    let mut v = tf.integrate_segment(consts, p[2], p[0], p[1]);
-    if kind == TableKind::Flat {
-        v[3] = optical_depth(tf, p[2], p[0], p[1]);
-    }
-    v
-}
-
-/// Twin of `optical_depth` in `shaders/table_build.wgsl`.
-pub fn optical_depth(tf: &TfBuffer, l: f32, sf: f32, sb: f32) -> f32 {
-    let (lo, hi) = (sf.min(sb), sf.max(sb));
-    let count = (tf.nodes.len() / 2) as u32;
-    let node_s = |i: u32| tf.nodes[2 * i as usize][0];
-    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
-        return l * tf.eval_piece(tf.piece_index(lo), lo).tau;
-    }
-    let (mut sum, mut s0, mut i) = (0.0f32, lo, tf.piece_index(lo));
-    loop {
-        let next = if i < count { node_s(i).min(hi) } else { hi };
-        if next > s0 {
-            let idx = tf.piece_index(0.5 * (s0 + next));
-            let t0 = tf.eval_piece(idx, s0).tau;
-            let t1 = tf.eval_piece(idx, next).tau;
-            sum += 0.5 * (t0 + t1) * (next - s0);
-        }
-        if next >= hi || i >= count {
-            break;
-        }
-        s0 = next;
-        i += 1;
-    }
-    l * (sum / (hi - lo))
-}
-
 /// Fills (or, over `range`, updates) `data` (RGBA, x fastest) on the CPU
 /// with `method` (`Gpu` means the CPU twin of the GPU build).
 pub fn fill_cpu(
@@ -370,117 +335,9 @@ pub fn fill_cpu(
             let consts = closed_form_constants();
             run(&|p| {
                 let q = p.map(|x| x as f32);
-                gpu_texel(&buf, &consts, spec.kind, q).map(|x| x as f64)
+                build_main(&buf, &consts, spec.kind, q).map(|x| x as f64)
             })
         }
-    }
-}
-
-/// Keep in sync with `BuildParams` in `shaders/table_build.wgsl`.
-#[repr(C)]
-#[derive(Pod, Zeroable, Clone, Copy, Debug)]
-struct BuildParams {
-    kind: u32,
-    ns: u32,
-    nz: u32,
-    row_texels: u32,
-    l_table: f32,
-    lo: f32,
-    hi: f32,
-    _pad: f32,
-}
-
-/// The GPU build kernel.
-pub static TABLE_BUILD: ComputeDesc = ComputeDesc {
-    name: "table_build.wgsl",
-    wgsl: concat!(
-        include_str!("../../../shaders/integral.wgsl"),
-        include_str!("../../../shaders/table_build.wgsl"),
-    ),
-    entry: "build_main",
-    bindings: &[
-        ComputeBinding::Uniform,
-        ComputeBinding::Storage,
-        ComputeBinding::Storage,
-        ComputeBinding::StorageRw,
-    ],
-};
-
-/// Texels per padded row of a GPU-built table of `ns` texels per row.
-pub fn row_texels(ns: u32) -> u32 {
-    let per_align = ROW_ALIGN / 16;
-    ns.div_ceil(per_align) * per_align
-}
-
-/// A table built on the GPU: its storage buffer (rows padded) and texture.
-pub struct GpuBuilt {
-    pub buffer: GpuBuffer,
-    pub row_texels: u32,
-}
-
-impl GpuBuilt {
-    /// A zeroed buffer for `spec`.
-    pub fn new(ctx: &Context, spec: &TableSpec) -> Result<GpuBuilt, GpuError> {
-        let rt = row_texels(spec.size[0]);
-        let len = rt as u64 * spec.size[1] as u64 * spec.size[2] as u64 * 16;
-        Ok(GpuBuilt {
-            buffer: GpuBuffer::new(ctx, "pre-integration table", len)?,
-            row_texels: rt,
-        })
-    }
-
-    /// Integrates the texels of `spec` that meet `range` into the buffer
-    /// and copies the buffer into `table`.
-    pub fn build(
-        &self,
-        ctx: &Context,
-        spec: &TableSpec,
-        tf: &TransferFunction,
-        range: (f64, f64),
-        table: &Table,
-    ) -> Result<(), GpuError> {
-        let clamp = |x: f64| x.clamp(-1e30, 1e30) as f32;
-        let params = BuildParams {
-            kind: spec.kind.code(),
-            ns: spec.size[0],
-            nz: spec.size[2],
-            row_texels: self.row_texels,
-            l_table: spec.l_table as f32,
-            lo: clamp(range.0),
-            hi: clamp(range.1),
-            _pad: 0.0,
-        };
-        let buf = TfBuffer::new(tf, &ScalarMap::of(tf));
-        let consts = closed_form_constants();
-        ctx.dispatch(
-            &TABLE_BUILD,
-            &[
-                ComputeResource::Uniform(bytemuck::bytes_of(&params)),
-                ComputeResource::Storage(&buf.bytes()),
-                ComputeResource::Storage(bytemuck::cast_slice(&consts)),
-                ComputeResource::Buffer(&self.buffer),
-            ],
-            [
-                spec.size[0].div_ceil(8),
-                spec.size[1].div_ceil(8),
-                spec.size[2],
-            ],
-        )?;
-        self.buffer.copy_to_table(ctx, table, self.row_texels * 16);
-        ctx.check()
-    }
-
-    /// The texels (unpadded, RGBA, x fastest), read back.
-    pub fn read(&self, ctx: &Context, spec: &TableSpec) -> Result<Vec<f32>, GpuError> {
-        let bytes = self.buffer.read(ctx)?;
-        let all: &[f32] = bytemuck::cast_slice(&bytes);
-        let (ns, rt) = (spec.size[0] as usize, self.row_texels as usize);
-        let rows = spec.size[1] as usize * spec.size[2] as usize;
-        let mut out = Vec::with_capacity(4 * ns * rows);
-        for r in 0..rows {
-            out.extend_from_slice(&all[4 * r * rt..4 * (r * rt + ns)]);
-        }
-        Ok(out)
     }
 }
 
@@ -537,6 +394,65 @@ impl SceneLengths {
             },
         }
     }
+}
+
+/// Whole tables built on the CPU, kept for the process: by spec, build and
+/// transfer function (the least recently used of [`CPU_TABLES_KEPT`] goes
+/// first). A CPU twin and a device's first CPU build of the same table
+/// share them instead of integrating every texel again.
+static CPU_TABLES: Mutex<Vec<CpuTexels>> = Mutex::new(Vec::new());
+
+/// Whole CPU-built tables the process keeps.
+const CPU_TABLES_KEPT: usize = 6;
+
+/// One table of [`CPU_TABLES`].
+struct CpuTexels {
+    spec: TableSpec,
+    build: TableBuild,
+    tf: TransferFunction,
+    data: Arc<Vec<f32>>,
+}
+
+/// Every texel of `spec` for `tf`, built on the CPU with `build`
+/// ([`fill_cpu`]) or found in the process's cache of whole tables; with
+/// whether it was built now.
+pub fn cpu_texels(
+    spec: &TableSpec,
+    tf: &TransferFunction,
+    build: TableBuild,
+) -> (Arc<Vec<f32>>, bool) {
+    let same = |e: &CpuTexels| e.spec == *spec && e.build == build && e.tf == *tf;
+    {
+        let mut kept = CPU_TABLES.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(i) = kept.iter().position(same) {
+            let e = kept.remove(i);
+            let data = e.data.clone();
+            kept.push(e);
+            return (data, false);
+        }
+    }
+    let mut data = vec![0.0; 4 * spec.texels()];
+    fill_cpu(
+        spec,
+        tf,
+        build,
+        (f64::NEG_INFINITY, f64::INFINITY),
+        &mut data,
+    );
+    let data = Arc::new(data);
+    let mut kept = CPU_TABLES.lock().unwrap_or_else(|e| e.into_inner());
+    if !kept.iter().any(same) {
+        kept.push(CpuTexels {
+            spec: *spec,
+            build,
+            tf: tf.clone(),
+            data: data.clone(),
+        });
+        if kept.len() > CPU_TABLES_KEPT {
+            kept.remove(0);
+        }
+    }
+    (data, true)
 }
 
 /// One cached table.
@@ -638,6 +554,13 @@ impl TableCache {
                     g.build(ctx, spec, tf, range, &entry.table)?;
                 }
                 built = count_touched(spec, range);
+            } else if change == TfChange::All {
+                // A whole table: every texel written, from the process's
+                // cache where another render built it.
+                let data = cpu_texels(spec, tf, build).0.to_vec();
+                built = spec.texels();
+                entry.table.write_rgba(ctx, &data)?;
+                entry.cpu = Some(data);
             } else {
                 let data = entry
                     .cpu

@@ -9,7 +9,7 @@ use std::time::Instant;
 use crate::camera::Camera;
 use crate::image::Image;
 use crate::raycast::brute::Brute;
-use crate::raycast::{self, RaycastOptions, Raycaster, Traversal};
+use crate::raycast::{self, RayTracer, RaycastOptions, Raycaster, Traversal};
 use crate::render::scene::{ScalarsRef, Scene};
 use crate::render::stats::RaycastStats;
 use crate::render::{RenderError, RenderOptions};

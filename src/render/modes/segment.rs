@@ -20,14 +20,20 @@
 //! Scalars are normalised to the transfer function's node range
 //! ([`ScalarMap`]) before they are rounded to `f32`, so data with a large
 //! offset keeps its resolution where the transfer function changes.
+//!
+//! A mode on this payload implements [`SegmentMode`] (its stage and its
+//! twin's bindings); the rest of its [`ProjectedMode`] (no slicing, no
+//! perspective refinement, [`SegmentPayload`] and [`SegmentVertex::of`])
+//! is held here once.
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec2;
 
 use crate::camera::Camera;
-use crate::gpu::cpu::lerp;
-use crate::gpu::{ClipMapper, GpuVertex};
-use crate::projection::{Projected, ViewMap};
+use crate::gpu::cpu::{lerp, CpuStage};
+use crate::gpu::{ClipMapper, Context, GpuError, GpuVertex, Stage};
+use crate::projection::{Polyhedron, Projected, ViewMap};
+use crate::render::driver::ProjectedMode;
 use crate::render::pieces::PieceSource;
 use crate::tf::TransferFunction;
 
@@ -283,6 +289,61 @@ impl SegmentPayload {
     pub fn set(&mut self, src: &PieceSource) {
         self.map = ScalarMap::of(src.tf);
         self.ortho = src.camera.ortho;
+    }
+}
+
+/// A projected-cell mode on the segment payload (exact-frag, the table
+/// modes): it supplies its stage and its twin; every such mode is a
+/// [`ProjectedMode`] that slices nowhere, needs no perspective refinement
+/// and sends [`SegmentVertex::of`] its [`SegmentPayload`].
+pub trait SegmentMode: Sync {
+    /// Binds the mode's stage for one frame of `src`.
+    fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError>;
+    /// The stage's bindings on the CPU, drawing through its twin, for one
+    /// frame of `src`.
+    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>>;
+}
+
+impl<M: SegmentMode> ProjectedMode for M {
+    type Vertex = SegmentVertex;
+    type Payload = SegmentPayload;
+
+    fn split_points(&self, _tf: &TransferFunction) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn perspective_refine(&self) -> bool {
+        SegmentVertex::needs_perspective_refinement()
+    }
+
+    fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
+        SegmentMode::bind(self, gpu, src)
+    }
+
+    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {
+        SegmentMode::twin(self, src)
+    }
+
+    fn payload(
+        &self,
+        src: &PieceSource,
+        _part: &Polyhedron,
+        _proj: &mut Projected,
+        _used: &mut Vec<bool>,
+        payload: &mut SegmentPayload,
+        _refined: &mut usize,
+    ) {
+        payload.set(src);
+    }
+
+    fn vertex(
+        &self,
+        payload: &SegmentPayload,
+        proj: &Projected,
+        i: usize,
+        ndc: [f32; 2],
+    ) -> SegmentVertex {
+        SegmentVertex::of(proj, i, ndc, &payload.map, payload.ortho)
     }
 }
 

@@ -19,8 +19,8 @@
 //!   balanced for the table's axes ([`depth_balance`]);
 //! - **stage** (`shaders/exact.wgsl`, [`EXACT_STAGE`]): per fragment,
 //!   `alpha = 1 - exp(-l tau)` from the 2D exponential table
-//!   ([`super::exptable`], manual bilinear filtering in `f32`) and colour
-//!   `glow * alpha`, premultiplied; [`ExactTwin`] is its CPU twin.
+//!   ([`exptable`], manual bilinear filtering in `f32`) and colour
+//!   `glow * alpha`, premultiplied; [`fs_main`] is its CPU twin.
 //!
 //! The glow colour per unit opacity is all a vertex carries, so the mode
 //! cannot represent independent emission (the registry says so).
@@ -28,6 +28,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 
+use crate::gpu::common::finite;
 use crate::gpu::cpu::{lerp, CpuStage};
 use crate::gpu::{Binding, Context, GpuError, GpuVertex, Resource, Stage, StageDesc, Table};
 use crate::integrate::{vertex_values, VertexValues};
@@ -38,7 +39,9 @@ use crate::render::driver::ProjectedMode;
 use crate::render::pieces::{value_range, PieceSource};
 use crate::tf::TransferFunction;
 
-use super::exptable::{shader_params, ExpTable, TABLE_N};
+pub mod exptable;
+
+use self::exptable::{shader_params, ExpTable, TABLE_N};
 use super::{Bounds, ModeInfo};
 use crate::raycast::FieldModel;
 use crate::tf::EmissionModel;
@@ -158,7 +161,7 @@ pub struct ExactParams {
 /// The exact stage.
 pub static EXACT_STAGE: StageDesc = StageDesc {
     name: "exact.wgsl",
-    wgsl: include_str!("../../../shaders/exact.wgsl"),
+    wgsl: include_str!("../../../../shaders/exact.wgsl"),
     vertex: wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<ExactVertex>() as wgpu::BufferAddress,
         step_mode: wgpu::VertexStepMode::Vertex,
@@ -207,10 +210,8 @@ pub fn bind_exact_stage(gpu: &Context, length_unit: f32) -> Result<Stage, GpuErr
     )
 }
 
-/// The CPU twin of `fs_main` in `shaders/exact.wgsl`: a fragment with a
-/// non-finite attribute is discarded; otherwise `alpha` comes from the
-/// exponential table ([`ExpTable::sample`], the twin of `alpha_of`) and
-/// the colour is `glow * alpha`.
+/// The exact stage's bindings on the CPU (the length unit of `Params` and
+/// the exponential table), for its twin [`fs_main`].
 pub struct ExactTwin {
     length_unit: f32,
     table: ExpTable,
@@ -235,14 +236,23 @@ impl ExactTwin {
     }
 }
 
+/// Twin of `fs_main` in `shaders/exact.wgsl`, the fragment at weights
+/// `bary` of `tri` drawn with `stage`'s bindings: a fragment with a
+/// non-finite attribute is discarded; otherwise `alpha` comes from the
+/// exponential table ([`ExpTable::alpha_of`]) and the colour is
+/// `glow * alpha`.
+pub fn fs_main(stage: &ExactTwin, tri: [&ExactVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
+    let (l, tau, glow) = stage.values(tri, bary);
+    if !(finite(l) && finite(tau) && glow.iter().all(|&g| finite(g))) {
+        return None;
+    }
+    let alpha = stage.table.alpha_of(l, tau);
+    Some([glow[0] * alpha, glow[1] * alpha, glow[2] * alpha, alpha])
+}
+
 impl CpuStage<ExactVertex> for ExactTwin {
     fn shade(&self, tri: [&ExactVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
-        let (l, tau, glow) = self.values(tri, bary);
-        if !(l.is_finite() && tau.is_finite() && glow.iter().all(|g| g.is_finite())) {
-            return None;
-        }
-        let alpha = self.table.sample(l, tau);
-        Some([glow[0] * alpha, glow[1] * alpha, glow[2] * alpha, alpha])
+        fs_main(self, tri, bary)
     }
 
     fn describe(&self, tri: [&ExactVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {

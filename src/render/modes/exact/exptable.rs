@@ -10,12 +10,12 @@
 //! ```
 //!
 //! (`x` is `l / unit` or `tau * unit` for the frame's length unit, see
-//! [`super::exact::ExactParams`]). Texel `i` of `N` sits at
+//! [`super::ExactParams`]). Texel `i` of `N` sits at
 //! `s = i / (N - 1)`, i.e. at `x_i = expm1(s_i ln(1 + X^2)) / X`, and stores
 //! `1 - exp(-x_i x_j)` (computed in f64, stored as f32; the table is symmetric).
 //! The shader reads the four neighbours with `textureLoad` and filters them
 //! bilinearly in f32 itself, so the result does not depend on a GPU's
-//! fixed-point filter weights and [`ExpTable::sample`] reproduces it.
+//! fixed-point filter weights and [`ExpTable::alpha_of`] reproduces it.
 //!
 //! * Range: each of `l'`, `tau'` in `[0, 1e6]`; optical depths from below
 //!   1e-12 (the linear region, where `alpha ~ l tau` keeps its relative
@@ -98,7 +98,7 @@ impl ExpTable {
 
     /// The CPU twin of `alpha_of` in `shaders/exact.wgsl`: the same f32
     /// operations (warp, clamp, four loads, bilinear `mix`).
-    pub fn sample(&self, l: f32, tau: f32) -> f32 {
+    pub fn alpha_of(&self, l: f32, tau: f32) -> f32 {
         let (scale, inv_range) = shader_params();
         let u = coord(l, scale, inv_range, self.n);
         let v = coord(tau, scale, inv_range, self.n);
@@ -112,7 +112,7 @@ impl ExpTable {
         mix(r0, r1, fv)
     }
 
-    /// Maximum absolute error of [`Self::sample`] against the exact
+    /// Maximum absolute error of [`Self::alpha_of`] against the exact
     /// `1 - exp(-l tau)` over the whole range: [`Self::max_error_in`] over
     /// `[1e-8, 1e6]` for both axes.
     pub fn max_error(&self, k: u32) -> (f64, f32, f32) {
@@ -134,7 +134,7 @@ impl ExpTable {
         for &l in &vals {
             for &tau in &vals {
                 let exact = exact_alpha(l as f64, tau as f64);
-                let e = (self.sample(l, tau) as f64 - exact).abs();
+                let e = (self.alpha_of(l, tau) as f64 - exact).abs();
                 if e > worst.0 {
                     worst = (e, l, tau);
                 }
@@ -150,8 +150,9 @@ pub fn axis_value(i: u32, n: u32) -> f64 {
     (s * log_range()).exp_m1() / AXIS_MAX
 }
 
-/// `ln(1 + z)` as the shader computes it (f32).
-pub fn log1p_f32(z: f32) -> f32 {
+/// Twin of `log1p_` in `shaders/exact.wgsl`: `ln(1 + z)` as the shader
+/// computes it (f32).
+pub fn log1p_(z: f32) -> f32 {
     if z < LOG1P_SERIES_BELOW {
         z * (1.0 - z * (0.5 - z * (1.0 / 3.0)))
     } else {
@@ -159,11 +160,12 @@ pub fn log1p_f32(z: f32) -> f32 {
     }
 }
 
-/// Continuous texel coordinate in `[0, n - 1]` of a normalised value
+/// Twin of `coord` in `shaders/exact.wgsl`: the continuous texel
+/// coordinate in `[0, n - 1]` of a normalised value
 /// (negative and NaN map to 0, beyond `AXIS_MAX` clamps to `n - 1`).
 pub fn coord(x: f32, scale: f32, inv_range: f32, n: u32) -> f32 {
     let xs = if x > 0.0 { x } else { 0.0 };
-    let s = log1p_f32(xs * scale) * inv_range;
+    let s = log1p_(xs * scale) * inv_range;
     s.min(1.0) * (n - 1) as f32
 }
 
@@ -206,21 +208,21 @@ mod tests {
             let x = axis_value(i, 64) as f32;
             let y = axis_value(j, 64) as f32;
             let want = exact_alpha(x as f64, y as f64);
-            assert!((t.sample(x, y) as f64 - want).abs() < 2e-6 * want.max(1e-3));
+            assert!((t.alpha_of(x, y) as f64 - want).abs() < 2e-6 * want.max(1e-3));
         }
     }
 
     #[test]
     fn clamps_and_sanitises() {
         let t = ExpTable::new(TABLE_N);
-        assert_eq!(t.sample(0.0, 5.0), 0.0);
-        assert_eq!(t.sample(f32::NAN, 5.0), 0.0);
-        assert_eq!(t.sample(-1.0, 5.0), 0.0);
-        assert!((t.sample(1e9, 1.0) - 1.0).abs() < 1e-6);
-        assert!((t.sample(f32::INFINITY, f32::INFINITY) - 1.0).abs() < 1e-6);
+        assert_eq!(t.alpha_of(0.0, 5.0), 0.0);
+        assert_eq!(t.alpha_of(f32::NAN, 5.0), 0.0);
+        assert_eq!(t.alpha_of(-1.0, 5.0), 0.0);
+        assert!((t.alpha_of(1e9, 1.0) - 1.0).abs() < 1e-6);
+        assert!((t.alpha_of(f32::INFINITY, f32::INFINITY) - 1.0).abs() < 1e-6);
         // Beyond AXIS_MAX the coordinate clamps: 1 - exp(-1e6 * 1e-7).
         let want = exact_alpha(1e6, 1e-7);
-        assert!((t.sample(1e8, 1e-7) as f64 - want).abs() < 1e-4);
+        assert!((t.alpha_of(1e8, 1e-7) as f64 - want).abs() < 1e-4);
     }
 
     #[test]
@@ -232,7 +234,7 @@ mod tests {
                 if tau < 1e-6 {
                     continue;
                 }
-                let got = t.sample(l as f32, tau as f32) as f64;
+                let got = t.alpha_of(l as f32, tau as f32) as f64;
                 let rel = (got - exact_alpha(l, tau)).abs() / exact_alpha(l, tau);
                 assert!(rel < 1e-3, "depth {d} l {l}: rel {rel:.2e}");
             }
