@@ -22,4 +22,5 @@ pub mod render;
 #[doc(hidden)]
 pub mod testdata;
 pub mod tf;
+pub mod video;
 pub mod visibility;
