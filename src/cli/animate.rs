@@ -108,6 +108,9 @@ struct FrameReport {
     /// What changed since the frame before: none, values, points, cells, or
     /// camera (an orbit on the same step).
     change: &'static str,
+    /// The scalar range the transfer function maps (the same in every
+    /// frame).
+    range: (f64, f64),
     /// Waiting for the step's file (read by the loader thread), preparing
     /// its geometry and shading.
     load_s: f64,
@@ -395,6 +398,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
                 time: step.time,
                 file: step.path.display().to_string(),
                 change,
+                range: shading.range,
                 load_s,
                 sort_s,
                 draw_s: (stats.total_s - sort_s).max(0.0),
@@ -534,13 +538,6 @@ fn ranges(v: &[usize]) -> String {
         i = j + 1;
     }
     out.join(", ")
-}
-
-/// Whether a path names the output folder's frames.
-pub fn is_frame(p: &Path) -> bool {
-    p.file_name()
-        .and_then(|n| n.to_str())
-        .is_some_and(|n| n.starts_with("frame_") && n.ends_with(".png"))
 }
 
 #[cfg(test)]
