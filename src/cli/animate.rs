@@ -86,6 +86,11 @@ pub struct AnimateArgs {
     /// first pass over the series) or first (step 0's).
     #[arg(long, value_enum, conflicts_with = "range")]
     pub range_from: Option<RangeFrom>,
+    /// Reuse nothing across frames: a new geometry, topology, sorter and
+    /// GPU context per step, as separate `render` runs would (to measure
+    /// what reuse saves).
+    #[arg(long)]
+    pub no_reuse: bool,
     #[command(flatten)]
     pub view: ViewArgs,
 }
@@ -336,7 +341,15 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
                     debug_assert_eq!(k, f.step);
                     let mesh = mesh?;
                     let at = || format!("{}", step.path.display());
+                    if args.no_reuse {
+                        renderer = None;
+                    }
                     let change = match renderer.as_mut() {
+                        None if args.no_reuse && current.is_some() => {
+                            let g = Geometry::build(mesh, spec.show_hidden).with_context(at)?;
+                            renderer = Some(Renderer::new(g));
+                            StepChange::Cells
+                        }
                         None => {
                             let g = Geometry::build(mesh, spec.show_hidden).with_context(at)?;
                             let mut r = Renderer::new(g);
