@@ -80,7 +80,11 @@ fn main() -> Result<()> {
             entries.push((*t, name));
         }
         write_pvd(&out, &entries)?;
-        eprintln!("{k} steps of {} hexes: {}", side * side * side, out.display());
+        eprintln!(
+            "{k} steps of {} hexes: {}",
+            side * side * side,
+            out.display()
+        );
         return Ok(());
     }
     let t0 = std::time::Instant::now();

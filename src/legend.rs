@@ -55,9 +55,9 @@ impl Canvas<'_> {
         }
         let a = a.min(1.0);
         let i = (y as usize * self.width as usize + x as usize) * self.channels;
-        for k in 0..3 {
-            let old = self.pixels[i + k] as f32;
-            self.pixels[i + k] = (old + (rgb[k] as f32 - old) * a).round() as u8;
+        for (dst, &src) in self.pixels[i..i + 3].iter_mut().zip(&rgb) {
+            let old = *dst as f32;
+            *dst = (old + (src as f32 - old) * a).round() as u8;
         }
         if self.channels == 4 {
             let old = self.pixels[i + 3] as f32;
@@ -149,7 +149,11 @@ pub fn draw(canvas: &mut Canvas, legend: &Legend, background: [f32; 3]) -> Resul
     let px = (h / 28.0).clamp(9.0, 48.0);
     let font = font.into_scaled(PxScale::from(px));
     let luminance = 0.2126 * background[0] + 0.7152 * background[1] + 0.0722 * background[2];
-    let ink = if luminance > 0.5 { [0, 0, 0] } else { [255, 255, 255] };
+    let ink = if luminance > 0.5 {
+        [0, 0, 0]
+    } else {
+        [255, 255, 255]
+    };
     let margin = (h / 40.0).max(3.0);
     let bar_h = (h / 36.0).max(4.0).round();
     let bar_w = (w * 0.6).round().max(8.0);
@@ -184,7 +188,14 @@ pub fn draw(canvas: &mut Canvas, legend: &Legend, background: [f32; 3]) -> Resul
     draw_text(canvas, &font, &hi_s, x0 + bar_w - hw, y_labels, ink);
     let tw = text_width(&font, legend.title);
     let y_title = y0 - margin * 0.5 + font.descent();
-    draw_text(canvas, &font, legend.title, (w - tw) / 2.0, y_title.max(line), ink);
+    draw_text(
+        canvas,
+        &font,
+        legend.title,
+        (w - tw) / 2.0,
+        y_title.max(line),
+        ink,
+    );
     if let Some(t) = legend.time {
         let s = format!("t = {}", format_value(t));
         draw_text(canvas, &font, &s, margin, margin + font.ascent(), ink);

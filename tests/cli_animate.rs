@@ -81,7 +81,10 @@ fn frames_equal_renders_of_each_step_with_the_global_range() {
     assert!(o.status.success(), "{}", stderr(&o));
     let lines = json_lines(&o);
     assert_eq!(lines.len(), 3);
-    let changes: Vec<&str> = lines.iter().map(|l| l["change"].as_str().unwrap()).collect();
+    let changes: Vec<&str> = lines
+        .iter()
+        .map(|l| l["change"].as_str().unwrap())
+        .collect();
     assert_eq!(changes, ["none", "values", "values"]);
     let range = &lines[0]["range"];
     let (lo, hi) = (range[0].as_f64().unwrap(), range[1].as_f64().unwrap());
@@ -105,7 +108,10 @@ fn frames_equal_renders_of_each_step_with_the_global_range() {
     assert!(first.status.success(), "{}", stderr(&first));
     let r0 = &json_lines(&first)[0]["range"];
     let (lo0, hi0) = (r0[0].as_f64().unwrap(), r0[1].as_f64().unwrap());
-    assert!(lo <= lo0 && hi >= hi0 && (lo < lo0 || hi > hi0), "{lo} {hi} vs {lo0} {hi0}");
+    assert!(
+        lo <= lo0 && hi >= hi0 && (lo < lo0 || hi > hi0),
+        "{lo} {hi} vs {lo0} {hi0}"
+    );
     for l in &lines {
         assert_eq!(&l["range"], range, "one range in every frame");
     }
@@ -130,8 +136,7 @@ fn frames_equal_renders_of_each_step_with_the_global_range() {
 #[test]
 fn exact_mode_frames_equal_renders_and_reuse_is_reported() {
     let dir = tempfile::tempdir().unwrap();
-    let series = write_steps(dir.path(), &time_series(4, 3))
-        .with_file_name("series.vtu.series");
+    let series = write_steps(dir.path(), &time_series(4, 3)).with_file_name("series.vtu.series");
     let out = dir.path().join("frames");
     let mut args = vec!["animate", s(&series), "-o", s(&out), "--range", "-1,2"];
     args.extend(VIEW);
@@ -167,9 +172,8 @@ fn each_step_change_is_detected() {
     }
     let mut other = warped_hex_grid(4, &Warp::default());
     other.point_data = series[0].1.point_data.clone();
-    other.point_data[0].data = zoovr::field::ArrayData::F64(
-        other.points.iter().map(|p| p.x + p.y).collect(),
-    );
+    other.point_data[0].data =
+        zoovr::field::ArrayData::F64(other.points.iter().map(|p| p.x + p.y).collect());
     let pvd = write_steps(
         dir.path(),
         &[
@@ -193,7 +197,10 @@ fn each_step_change_is_detected() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let lines = json_lines(&o);
-    let changes: Vec<&str> = lines.iter().map(|l| l["change"].as_str().unwrap()).collect();
+    let changes: Vec<&str> = lines
+        .iter()
+        .map(|l| l["change"].as_str().unwrap())
+        .collect();
     assert_eq!(changes, ["none", "values", "points", "cells"]);
     let times: Vec<f64> = lines.iter().map(|l| l["time"].as_f64().unwrap()).collect();
     assert_eq!(times, [0.0, 0.5, 1.0, 1.5]);
@@ -206,8 +213,22 @@ fn orbit_frames_equal_renders_at_their_azimuth() {
     write_vtu(&file, &time_series(3, 1)[0].1, Compression::None).unwrap();
     let out = dir.path().join("turn");
     let o = zoovr(&[
-        "animate", s(&file), "-o", s(&out), "--mode", "raycast", "--size", "24x20",
-        "--azimuth", "10", "--orbit", "30", "--count", "3", "--stats", "--json",
+        "animate",
+        s(&file),
+        "-o",
+        s(&out),
+        "--mode",
+        "raycast",
+        "--size",
+        "24x20",
+        "--azimuth",
+        "10",
+        "--orbit",
+        "30",
+        "--count",
+        "3",
+        "--stats",
+        "--json",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let changes: Vec<String> = json_lines(&o)
@@ -218,8 +239,16 @@ fn orbit_frames_equal_renders_at_their_azimuth() {
     for (k, az) in ["10", "40", "70"].iter().enumerate() {
         let want = dir.path().join(format!("az_{k}.png"));
         let o = zoovr(&[
-            "render", s(&file), "-o", s(&want), "--mode", "raycast", "--size", "24x20",
-            "--azimuth", az,
+            "render",
+            s(&file),
+            "-o",
+            s(&want),
+            "--mode",
+            "raycast",
+            "--size",
+            "24x20",
+            "--azimuth",
+            az,
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
         assert!(
@@ -256,7 +285,15 @@ fn frame_ranges_add_up_to_one_run_and_assemble_into_a_gif() {
         );
     }
     let assembled = dir.path().join("parts.gif");
-    let o = zoovr(&["animate", "--assemble", s(&parts), "--gif", s(&assembled), "--fps", "4"]);
+    let o = zoovr(&[
+        "animate",
+        "--assemble",
+        s(&parts),
+        "--gif",
+        s(&assembled),
+        "--fps",
+        "4",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
         std::fs::read(&gif_path).unwrap(),
@@ -288,7 +325,16 @@ fn legend_is_drawn_into_the_frames() {
     let plain = dir.path().join("plain");
     let legend = dir.path().join("legend");
     for (out, extra) in [(&plain, None), (&legend, Some("--legend"))] {
-        let mut a = vec!["animate", s(&pvd), "-o", s(out), "--mode", "raycast", "--size", "96x80"];
+        let mut a = vec![
+            "animate",
+            s(&pvd),
+            "-o",
+            s(out),
+            "--mode",
+            "raycast",
+            "--size",
+            "96x80",
+        ];
         a.extend(extra);
         let o = zoovr(&a);
         assert!(o.status.success(), "{}", stderr(&o));
@@ -300,7 +346,17 @@ fn legend_is_drawn_into_the_frames() {
     // `render --legend` too.
     let png = dir.path().join("r.png");
     let step = dir.path().join("step_0.vtu");
-    let o = zoovr(&["render", s(&step), "-o", s(&png), "--mode", "raycast", "--size", "96x80", "--legend"]);
+    let o = zoovr(&[
+        "render",
+        s(&step),
+        "-o",
+        s(&png),
+        "--mode",
+        "raycast",
+        "--size",
+        "96x80",
+        "--legend",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
@@ -311,20 +367,36 @@ fn a_folder_and_a_glob_list_the_steps_in_numeric_order() {
     std::fs::create_dir(&steps).unwrap();
     // Written as step_8, step_9, step_10: numeric order, not byte order.
     for (k, (_, m)) in time_series(3, 3).iter().enumerate() {
-        write_vtu(&steps.join(format!("step_{}.vtu", k + 8)), m, Compression::None).unwrap();
+        write_vtu(
+            &steps.join(format!("step_{}.vtu", k + 8)),
+            m,
+            Compression::None,
+        )
+        .unwrap();
     }
     let pattern = steps.join("step_*.vtu");
     for series in [steps.as_path(), pattern.as_path()] {
         let o = zoovr(&[
-            "animate", s(series), "-o", s(&dir.path().join("o")), "--mode", "raycast",
-            "--size", "8x8", "--stats", "--json",
+            "animate",
+            s(series),
+            "-o",
+            s(&dir.path().join("o")),
+            "--mode",
+            "raycast",
+            "--size",
+            "8x8",
+            "--stats",
+            "--json",
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
         let files: Vec<String> = json_lines(&o)
             .iter()
             .map(|l| l["file"].as_str().unwrap().to_string())
             .collect();
-        assert!(files[0].ends_with("step_8.vtu") && files[2].ends_with("step_10.vtu"), "{files:?}");
+        assert!(
+            files[0].ends_with("step_8.vtu") && files[2].ends_with("step_10.vtu"),
+            "{files:?}"
+        );
     }
 }
 
@@ -355,11 +427,18 @@ fn bad_input_names_the_file_and_exits_with_the_documented_code() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("step_0.vtu"), "{}", stderr(&o));
     // A corrupt step: named, and the frames before it are said complete.
-    std::fs::write(d.join("step_2.vtu"), "<VTKFile type=\"UnstructuredGrid\"> garbage").unwrap();
+    std::fs::write(
+        d.join("step_2.vtu"),
+        "<VTKFile type=\"UnstructuredGrid\"> garbage",
+    )
+    .unwrap();
     let o = go(&[s(&pvd), "--range", "0,1"]);
     assert_eq!(o.status.code(), Some(1));
     let e = stderr(&o);
-    assert!(e.contains("step_2.vtu") && e.contains("frames 0..1 are complete"), "{e}");
+    assert!(
+        e.contains("step_2.vtu") && e.contains("frames 0..1 are complete"),
+        "{e}"
+    );
     assert!(!o.status.success() && !e.contains("panicked"), "{e}");
     // A missing step.
     std::fs::remove_file(d.join("step_1.vtu")).unwrap();
@@ -369,11 +448,25 @@ fn bad_input_names_the_file_and_exits_with_the_documented_code() {
     // An output folder that cannot be made.
     let file = d.join("a_file");
     std::fs::write(&file, "x").unwrap();
-    let o = zoovr(&["animate", s(&d.join("step_0.vtu")), "-o", s(&file.join("sub")), "--mode", "raycast"]);
+    let o = zoovr(&[
+        "animate",
+        s(&d.join("step_0.vtu")),
+        "-o",
+        s(&file.join("sub")),
+        "--mode",
+        "raycast",
+    ]);
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("a_file"), "{}", stderr(&o));
     // --mp4 without ffmpeg says what to install.
-    let o = zoovr(&["animate", s(&d.join("step_0.vtu")), "-o", s(&out), "--mp4", s(&d.join("a.mp4"))]);
+    let o = zoovr(&[
+        "animate",
+        s(&d.join("step_0.vtu")),
+        "-o",
+        s(&out),
+        "--mp4",
+        s(&d.join("a.mp4")),
+    ]);
     if !o.status.success() {
         assert_eq!(o.status.code(), Some(1));
         assert!(stderr(&o).contains("ffmpeg"), "{}", stderr(&o));
@@ -388,8 +481,14 @@ fn can_crush_series_deforms_with_the_topology_kept() {
     };
     let dir = tempfile::tempdir().unwrap();
     let o = zoovr(&[
-        "animate", s(&pvd), "-o", s(&dir.path().join("can")), "--size", "64x64",
-        "--stats", "--json",
+        "animate",
+        s(&pvd),
+        "-o",
+        s(&dir.path().join("can")),
+        "--size",
+        "64x64",
+        "--stats",
+        "--json",
     ]);
     if no_adapter(&o) {
         eprintln!("skipping: {}", stderr(&o));

@@ -163,7 +163,10 @@ fn later_steps_keep_what_did_not_change_and_match_fresh_renderers() {
     renderer.set_geometry(g2.clone(), change);
     let s2 = Shading::build(&g2, &fixed).unwrap();
     let (img, _) = renderer.render(&s2, &opts, |_, _| {}).unwrap();
-    assert!(img.pixels == fresh(&g2, &s2, &opts).pixels, "points restored");
+    assert!(
+        img.pixels == fresh(&g2, &s2, &opts).pixels,
+        "points restored"
+    );
 
     // Other cells: a new topology.
     let other = io::read(&mesh_file("hexahedron.vtu"), &ReadOptions::default()).unwrap();

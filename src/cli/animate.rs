@@ -203,7 +203,11 @@ fn check_field(
 
 /// The colour range (module docs, step 2), or `None` where there is no
 /// field.
-fn colour_range(args: &AnimateArgs, steps: &[TimeStep], ropts: &ReadOptions) -> Result<Option<(f64, f64)>> {
+fn colour_range(
+    args: &AnimateArgs,
+    steps: &[TimeStep],
+    ropts: &ReadOptions,
+) -> Result<Option<(f64, f64)>> {
     if let Some(r) = args.view.range {
         return Ok(Some(r));
     }
@@ -275,9 +279,8 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     if args.mp4.is_some() {
         assemble::check_mp4_encoder()?;
     }
-    std::fs::create_dir_all(out).with_context(|| {
-        format!("{}: cannot make the output folder", out.display())
-    })?;
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("{}: cannot make the output folder", out.display()))?;
     let ropts = ReadOptions {
         q_file: args.view.q.clone(),
     };

@@ -83,7 +83,9 @@ pub fn parse_frames(s: &str) -> Result<(usize, usize), String> {
     let a: usize = a.trim().parse().map_err(|_| bad())?;
     let b: usize = b.trim().parse().map_err(|_| bad())?;
     if a > b {
-        return Err(format!("empty frame range '{s}': A must not be greater than B"));
+        return Err(format!(
+            "empty frame range '{s}': A must not be greater than B"
+        ));
     }
     Ok((a, b))
 }

@@ -27,8 +27,8 @@ pub fn check_mp4_encoder() -> Result<()> {
 /// The frame files of `dir` in index order.
 fn frames(dir: &Path) -> Result<Vec<PathBuf>> {
     let mut found: Vec<(usize, PathBuf)> = Vec::new();
-    let entries =
-        std::fs::read_dir(dir).with_context(|| format!("{}: cannot read the folder", dir.display()))?;
+    let entries = std::fs::read_dir(dir)
+        .with_context(|| format!("{}: cannot read the folder", dir.display()))?;
     for e in entries {
         let e = e.with_context(|| format!("{}", dir.display()))?;
         let name = e.file_name().to_string_lossy().into_owned();
@@ -49,7 +49,7 @@ fn frames(dir: &Path) -> Result<Vec<PathBuf>> {
     let missing: Vec<String> = (0..found.last().map_or(0, |f| f.0))
         .filter(|i| found.binary_search_by_key(i, |f| f.0).is_err())
         .take(10)
-        .map(|i| super::animate::frame_name(i))
+        .map(super::animate::frame_name)
         .collect();
     if !missing.is_empty() {
         bail!(
@@ -65,7 +65,9 @@ fn frames(dir: &Path) -> Result<Vec<PathBuf>> {
 /// Reads one frame as RGB bytes of the expected size.
 fn read_rgb(path: &Path, size: Option<(u32, u32)>) -> Result<(u32, u32, Vec<u8>), VideoError> {
     let img = image::open(path)
-        .map_err(|e| VideoError::Invalid(format!("{}: cannot read the frame: {e}", path.display())))?
+        .map_err(|e| {
+            VideoError::Invalid(format!("{}: cannot read the frame: {e}", path.display()))
+        })?
         .to_rgb8();
     let (w, h) = img.dimensions();
     if let Some((ew, eh)) = size {

@@ -42,20 +42,22 @@ pub fn list_steps(path: &Path) -> Result<Vec<TimeStep>, IoError> {
                 .extension()
                 .map(|e| e.to_string_lossy().to_lowercase())
                 .unwrap_or_default();
-            if !name.starts_with('.') && p.is_file() && DATASET_EXTENSIONS.contains(&ext.as_str())
-            {
+            if !name.starts_with('.') && p.is_file() && DATASET_EXTENSIONS.contains(&ext.as_str()) {
                 files.push(p);
             }
         }
-        return numbered(path, files, "the folder holds no dataset files (.vtk, .vtu, .vts, .vtr, .vti, .pvtu)");
+        return numbered(
+            path,
+            files,
+            "the folder holds no dataset files (.vtk, .vtu, .vts, .vtr, .vti, .pvtu)",
+        );
     }
     if path.exists() || !is_pattern(path) {
         return read_series(path);
     }
     let pattern = path.to_string_lossy();
-    let paths = glob::glob(&pattern).map_err(|e| {
-        IoError::parse(path, Location::None, format!("bad glob pattern: {e}"))
-    })?;
+    let paths = glob::glob(&pattern)
+        .map_err(|e| IoError::parse(path, Location::None, format!("bad glob pattern: {e}")))?;
     let mut files = Vec::new();
     for p in paths {
         let p = p.map_err(|e| {
@@ -154,7 +156,10 @@ mod tests {
         assert_eq!(list_steps(&pat).unwrap().len(), 2);
         let none = dir.path().join("g_*.vtu");
         let err = list_steps(&none).unwrap_err().to_string();
-        assert!(err.contains("g_*.vtu") && err.contains("matches no files"), "{err}");
+        assert!(
+            err.contains("g_*.vtu") && err.contains("matches no files"),
+            "{err}"
+        );
         let empty = tempfile::tempdir().unwrap();
         assert!(list_steps(empty.path()).is_err());
     }

@@ -110,10 +110,7 @@ impl Geometry {
     /// The mesh as a geometry holds it: hidden and duplicate cells left out
     /// (unless `show_hidden`) and coincident points merged. Returns it with
     /// the number of cells left out and of points merged.
-    pub fn prepare(
-        mut mesh: Mesh,
-        show_hidden: bool,
-    ) -> Result<(Mesh, usize, usize), RenderError> {
+    pub fn prepare(mut mesh: Mesh, show_hidden: bool) -> Result<(Mesh, usize, usize), RenderError> {
         if mesh.cells.is_empty() {
             return Err(RenderError::NoCells);
         }

@@ -66,7 +66,12 @@ pub fn write_mp4(
         .args(["-f", "rawvideo", "-pix_fmt", "rgb24"])
         .args(["-s", &format!("{width}x{height}"), "-r", &format!("{fps}")])
         .args(["-i", "-", "-an", "-c:v", encoder])
-        .args(["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p"])
+        .args([
+            "-vf",
+            "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+            "-pix_fmt",
+            "yuv420p",
+        ])
         .args(["-movflags", "+faststart", "-f", "mp4"])
         .arg(&tmp)
         .stdin(Stdio::piped())
