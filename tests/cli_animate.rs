@@ -275,8 +275,13 @@ fn frame_ranges_add_up_to_one_run_and_assemble_into_a_gif() {
     };
     let gif_path = dir.path().join("whole.gif");
     run(&whole, &["--gif", s(&gif_path), "--fps", "4"]);
-    run(&parts, &["--frames", "2..3"]);
-    run(&parts, &["--frames", "0..1"]);
+    // Separate processes share the whole run's range through a range file.
+    let range_file = dir.path().join("range.json");
+    let o = zoovr(&["animate", s(&pvd), "--range-only", s(&range_file)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let rf = s(&range_file);
+    run(&parts, &["--frames", "2..3", "--range-file", rf]);
+    run(&parts, &["--frames", "0..1", "--range-file", rf]);
     for k in 0..4 {
         let name = format!("frame_{k:05}.png");
         assert!(
@@ -500,4 +505,61 @@ fn can_crush_series_deforms_with_the_topology_kept() {
         .map(|l| l["change"].as_str().unwrap().to_string())
         .collect();
     assert_eq!(changes, ["none", "points", "points"]);
+}
+
+#[test]
+fn mp4_through_ffmpeg_when_it_is_installed() {
+    let have = |tool: &str| {
+        Command::new(tool)
+            .arg("-version")
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !have("ffmpeg") {
+        eprintln!("skipping: no ffmpeg on PATH");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let pvd = write_steps(dir.path(), &time_series(3, 3));
+    let mp4 = dir.path().join("a.mp4");
+    // An odd size: the encoder pads it to even.
+    let o = zoovr(&[
+        "animate",
+        s(&pvd),
+        "-o",
+        s(&dir.path().join("f")),
+        "--mode",
+        "raycast",
+        "--size",
+        "21x17",
+        "--mp4",
+        s(&mp4),
+        "--fps",
+        "5",
+    ]);
+    if !o.status.success() && stderr(&o).contains("encoder") {
+        eprintln!("skipping: {}", stderr(&o));
+        return;
+    }
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&mp4).unwrap();
+    assert_eq!(&bytes[4..8], b"ftyp", "not an MP4");
+    if have("ffprobe") {
+        let p = Command::new("ffprobe")
+            .args(["-v", "error", "-count_frames", "-select_streams", "v:0"])
+            .args([
+                "-show_entries",
+                "stream=nb_read_frames,codec_name",
+                "-of",
+                "csv=p=0",
+            ])
+            .arg(&mp4)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&p.stdout);
+        assert!(
+            text.trim().ends_with(",3") || text.trim().ends_with("3"),
+            "{text}"
+        );
+    }
 }

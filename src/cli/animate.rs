@@ -57,7 +57,7 @@ pub struct AnimateArgs {
     #[arg(required_unless_present = "assemble")]
     pub series: Option<PathBuf>,
     /// Output folder for the frames DIR/frame_NNNNN.png (made if missing).
-    #[arg(short, long, value_name = "DIR", required_unless_present = "assemble")]
+    #[arg(short, long, value_name = "DIR", required_unless_present_any = ["assemble", "range_only"])]
     pub output: Option<PathBuf>,
     /// Render nothing: assemble the frames already in DIR (e.g. written by
     /// several `--frames` runs) into --gif and/or --mp4.
@@ -86,6 +86,14 @@ pub struct AnimateArgs {
     /// first pass over the series) or first (step 0's).
     #[arg(long, value_enum, conflicts_with = "range")]
     pub range_from: Option<RangeFrom>,
+    /// Render nothing: write the colour range the run would use (JSON
+    /// `{"range": [LO, HI]}`) to FILE, for --range-file in separate
+    /// processes of one run.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["output", "frames", "gif", "mp4"])]
+    pub range_only: Option<PathBuf>,
+    /// Read the colour range from a file written by --range-only.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["range", "range_from", "range_only"])]
+    pub range_file: Option<PathBuf>,
     /// Reuse nothing across frames: a new geometry, topology, sorter and
     /// GPU context per step, as separate `render` runs would (to measure
     /// what reuse saves).
@@ -211,6 +219,9 @@ fn colour_range(
     if let Some(r) = args.view.range {
         return Ok(Some(r));
     }
+    if let Some(file) = &args.range_file {
+        return read_range_file(file);
+    }
     let spec = args.view.scene_spec();
     let upto = match args.range_from.unwrap_or(RangeFrom::All) {
         RangeFrom::All => steps.len(),
@@ -242,6 +253,28 @@ fn colour_range(
     Ok(range)
 }
 
+/// The range of a `--range-only` file.
+fn read_range_file(file: &Path) -> Result<Option<(f64, f64)>> {
+    #[derive(serde::Deserialize)]
+    struct RangeFile {
+        range: Option<(f64, f64)>,
+    }
+    let text = std::fs::read_to_string(file)
+        .with_context(|| format!("{}: cannot read the range file", file.display()))?;
+    let r: RangeFile = serde_json::from_str(&text).with_context(|| {
+        format!(
+            "{}: not a range file (expected {{\"range\": [LO, HI]}})",
+            file.display()
+        )
+    })?;
+    if let Some((lo, hi)) = r.range {
+        if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+            bail!("{}: bad range [{lo}, {hi}]", file.display());
+        }
+    }
+    Ok(r.range)
+}
+
 /// A progress bar of frames on a terminal (hidden otherwise).
 fn frame_bar(n: usize) -> indicatif::ProgressBar {
     let bar = indicatif::ProgressBar::new(n as u64);
@@ -268,7 +301,19 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             gif: args.gif.clone(),
             mp4: args.mp4.clone(),
             fps: args.fps,
+            only: None,
         });
+    }
+    if let (Some(series), Some(file)) = (&args.series, &args.range_only) {
+        let steps = io::sequence::list_steps(series)?;
+        let ropts = ReadOptions {
+            q_file: args.view.q.clone(),
+        };
+        let range = colour_range(args, &steps, &ropts)?;
+        let text = serde_json::to_string(&serde_json::json!({ "range": range }))?;
+        std::fs::write(file, text + "\n")
+            .with_context(|| format!("{}: cannot write the range", file.display()))?;
+        return Ok(());
     }
     let (Some(series), Some(out)) = (&args.series, &args.output) else {
         return Err(UsageError("give SERIES and -o DIR (or --assemble DIR)".into()).into());
@@ -466,6 +511,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             gif: args.gif.clone(),
             mp4: args.mp4.clone(),
             fps: args.fps,
+            only: Some(done),
         })?;
     }
     Ok(())

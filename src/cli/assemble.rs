@@ -1,6 +1,7 @@
 //! `--gif` / `--mp4` of `zoovr animate`, and `zoovr animate --assemble DIR`:
-//! the frames `DIR/frame_NNNNN.png` (all of them, from one run or from
-//! several `--frames` runs) into a GIF and/or an MP4. The frames are read
+//! the frames `DIR/frame_NNNNN.png` into a GIF and/or an MP4: with
+//! `--assemble`, all of them (from one run or from several `--frames`
+//! runs); after a run, the frames that run wrote. The frames are read
 //! back from the folder one at a time, so memory does not grow with the
 //! number of frames; a gap in the numbering is an error naming the missing
 //! frames.
@@ -16,6 +17,9 @@ pub struct AssembleArgs {
     pub gif: Option<PathBuf>,
     pub mp4: Option<PathBuf>,
     pub fps: f64,
+    /// The frame indices to use (those a run just wrote); `None`: every
+    /// frame in the folder, which must be numbered without gaps.
+    pub only: Option<Vec<usize>>,
 }
 
 /// Fails early, before rendering, when `--mp4` cannot be written.
@@ -82,7 +86,13 @@ fn read_rgb(path: &Path, size: Option<(u32, u32)>) -> Result<(u32, u32, Vec<u8>)
 }
 
 pub fn run(args: &AssembleArgs) -> Result<()> {
-    let files = frames(&args.dir)?;
+    let files = match &args.only {
+        Some(list) if !list.is_empty() => list
+            .iter()
+            .map(|&i| args.dir.join(super::animate::frame_name(i)))
+            .collect(),
+        _ => frames(&args.dir)?,
+    };
     let (w, h, _) = read_rgb(&files[0], None)?;
     let fetch = |i: usize| read_rgb(&files[i], Some((w, h))).map(|f| f.2);
     if let Some(gif) = &args.gif {
