@@ -202,6 +202,12 @@ fn each_step_change_is_detected() {
         .map(|l| l["change"].as_str().unwrap())
         .collect();
     assert_eq!(changes, ["none", "values", "points", "cells"]);
+    // The step whose cells changed is named.
+    assert!(
+        stderr(&o).contains("step_3.vtu: its cells differ"),
+        "{}",
+        stderr(&o)
+    );
     let times: Vec<f64> = lines.iter().map(|l| l["time"].as_f64().unwrap()).collect();
     assert_eq!(times, [0.0, 0.5, 1.0, 1.5]);
 }

@@ -413,6 +413,13 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
                                 .next_step(mesh, spec.show_hidden)
                                 .with_context(at)?;
                             r.set_geometry(g, change);
+                            if change == StepChange::Cells && !args.no_reuse {
+                                eprintln!(
+                                    "zoovr: note: {}: its cells differ from the step before; \
+                                     rendered with a new topology (nothing reused)",
+                                    step.path.display()
+                                );
+                            }
                             change
                         }
                     };
@@ -491,7 +498,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         }
         return Err(e);
     }
-    if super::interrupt::requested() {
+    if super::interrupt::requested() && done.len() < frames.len() {
         bail!(
             "interrupted: frames {} are complete in {} (no partial frame is left)",
             if done.is_empty() {
