@@ -19,7 +19,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use glam::DVec3;
-use zoovr::generate::{ring_grid, single_cell, time_series, warped_hex_grid, zoo_grid, Warp};
+use zoovr::generate::{
+    flow_series, ring_grid, single_cell, time_series, warped_hex_grid, zoo_grid, Warp,
+};
 use zoovr::io::writer::{write_legacy_ascii, write_pvd, write_series, write_vtu, Compression};
 use zoovr::mesh::{CellKind, Mesh};
 
@@ -196,6 +198,15 @@ fn write_meshes(dir: &Path) -> Result<()> {
     }
     write_pvd(&sdir.join("series.pvd"), &steps)?;
     write_series(&sdir.join("series.vtu.series"), &steps)?;
+    let fdir = dir.join("flow");
+    std::fs::create_dir_all(&fdir)?;
+    let mut fsteps = Vec::new();
+    for (k, (t, m)) in flow_series(12, 36, 6, 16).into_iter().enumerate() {
+        let name = format!("flow_{k:02}.vtu");
+        write_vtu(&fdir.join(&name), &m, Compression::Zlib)?;
+        fsteps.push((t, name));
+    }
+    write_pvd(&fdir.join("flow.pvd"), &fsteps)?;
     both(dir, "degenerate", &degenerate())?;
     Ok(())
 }

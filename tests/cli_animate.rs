@@ -569,3 +569,33 @@ fn mp4_through_ffmpeg_when_it_is_installed() {
         );
     }
 }
+
+/// The README's first animation: the example series the repository holds.
+#[test]
+fn the_example_flow_series_animates_with_values_reused() {
+    let pvd = zoovr::testdata::mesh_file("flow/flow.pvd");
+    let dir = tempfile::tempdir().unwrap();
+    let o = zoovr(&[
+        "animate",
+        s(&pvd),
+        "-o",
+        s(&dir.path().join("f")),
+        "--mode",
+        "raycast",
+        "--size",
+        "24x24",
+        "--frames",
+        "0..3",
+        "--legend",
+        "--stats",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines = json_lines(&o);
+    let changes: Vec<&str> = lines
+        .iter()
+        .map(|l| l["change"].as_str().unwrap())
+        .collect();
+    assert_eq!(changes, ["none", "values", "values", "values"]);
+    assert_eq!(lines[3]["time"].as_f64(), Some(0.75));
+}
