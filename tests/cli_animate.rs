@@ -385,6 +385,15 @@ fn a_folder_and_a_glob_list_the_steps_in_numeric_order() {
         )
         .unwrap();
     }
+    // step_9 records its own time, as ParaView writes it.
+    let p9 = steps.join("step_9.vtu");
+    let bytes = std::fs::read(&p9).unwrap();
+    let tag = b"<UnstructuredGrid>";
+    let at = bytes.windows(tag.len()).position(|w| w == tag).unwrap() + tag.len();
+    let field = b"<FieldData><DataArray type=\"Float64\" Name=\"TimeValue\" \
+                  NumberOfTuples=\"1\" format=\"ascii\">2.5</DataArray></FieldData>";
+    let edited = [&bytes[..at], &field[..], &bytes[at..]].concat();
+    std::fs::write(&p9, edited).unwrap();
     let pattern = steps.join("step_*.vtu");
     for series in [steps.as_path(), pattern.as_path()] {
         let o = zoovr(&[
@@ -408,6 +417,11 @@ fn a_folder_and_a_glob_list_the_steps_in_numeric_order() {
             files[0].ends_with("step_8.vtu") && files[2].ends_with("step_10.vtu"),
             "{files:?}"
         );
+        let times: Vec<f64> = json_lines(&o)
+            .iter()
+            .map(|l| l["time"].as_f64().unwrap())
+            .collect();
+        assert_eq!(times, [0.0, 2.5, 2.0], "index, TimeValue, index");
     }
 }
 

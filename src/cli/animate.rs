@@ -320,6 +320,13 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     };
     super::interrupt::install();
     let steps = io::sequence::list_steps(series)?;
+    // A collection's times win; steps found by a folder or a pattern take
+    // the file's own TimeValue where it has one, else their index.
+    let collection = series.is_file()
+        && matches!(
+            io::detect_format(series),
+            Ok(io::Format::Pvd | io::Format::Series)
+        );
     let frames = plan(args, series, &steps)?;
     if args.mp4.is_some() {
         assemble::check_mp4_encoder()?;
@@ -365,7 +372,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         });
         let mut renderer: Option<Renderer> = None;
         let mut pending = pending;
-        let mut current: Option<(usize, Shading)> = None;
+        let mut current: Option<(usize, Shading, f64)> = None;
         let mut first_field = None;
         let mut camera_bounds: Option<[f64; 6]> = None;
         for f in &frames {
@@ -375,7 +382,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             let t0 = Instant::now();
             let step = &steps[f.step];
             let change = match &current {
-                Some((k, _)) if *k == f.step => {
+                Some((k, _, _)) if *k == f.step => {
                     if opts.camera.azimuth == f.azimuth {
                         "none"
                     } else {
@@ -388,6 +395,10 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
                         .map_err(|_| anyhow!("the loader thread stopped"))?;
                     debug_assert_eq!(k, f.step);
                     let mesh = mesh?;
+                    let time = match mesh.source.time_value {
+                        Some(t) if !collection => t,
+                        _ => step.time,
+                    };
                     let at = || format!("{}", step.path.display());
                     if args.no_reuse {
                         renderer = None;
@@ -430,12 +441,12 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
                     } else {
                         check_field(&first_field, &shading, step)?;
                     }
-                    current = Some((f.step, shading));
+                    current = Some((f.step, shading, time));
                     change.name()
                 }
             };
             let renderer = renderer.as_mut().ok_or_else(|| anyhow!("no renderer"))?;
-            let Some((_, shading)) = &current else {
+            let Some((_, shading, time)) = &current else {
                 bail!("no shading");
             };
             let bounds = match camera_bounds {
@@ -454,7 +465,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
                 .with_context(|| format!("{}", step.path.display()))?;
             let t_write = Instant::now();
             let path = out.join(frame_name(f.index));
-            super::legend::write_frame(&image, &path, &args.view, shading, Some(step.time))?;
+            super::legend::write_frame(&image, &path, &args.view, shading, Some(*time))?;
             let write_s = t_write.elapsed().as_secs_f64();
             let sort_s = match &stats.detail {
                 ModeStats::Projected(p) => p.sort_s,
@@ -463,7 +474,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             let report = FrameReport {
                 frame: f.index,
                 step: f.step,
-                time: step.time,
+                time: *time,
                 file: step.path.display().to_string(),
                 change,
                 range: shading.range,
