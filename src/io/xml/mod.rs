@@ -92,32 +92,22 @@ fn read_nested(path: &Path, bytes: &[u8], format: Format, depth: usize) -> Resul
         return Err(IoError::parse(path, grid.location(), "no <Piece> element"));
     }
     let mut mesh = merge_checked(path, grid, pieces)?;
-    mesh.source.time_value = time_value(&src, grid)?;
+    mesh.source.time_value = time_value(&src, grid);
     Ok(mesh)
 }
 
 /// The first value of the `TimeValue` array in the dataset's
-/// `<FieldData>` (as ParaView writes the time of a step), if there is one;
-/// a non-finite value is an error naming it.
-fn time_value(src: &Source, grid: &dom::Element) -> Result<Option<f64>, IoError> {
-    let Some(arr) = grid.child("FieldData").and_then(|fd| {
+/// `<FieldData>` (as ParaView writes the time of a step), if there is one
+/// and it decodes to a finite number. A bad time never stops the dataset
+/// from being read: it is only a label.
+fn time_value(src: &Source, grid: &dom::Element) -> Option<f64> {
+    let arr = grid.child("FieldData").and_then(|fd| {
         fd.children_named("DataArray")
             .find(|a| a.attr("Name") == Some("TimeValue"))
-    }) else {
-        return Ok(None);
-    };
-    let Some(ty) = scalar::Scalar::parse(arr.attr("type").unwrap_or("")) else {
-        return Ok(None);
-    };
-    let values: Vec<f64> = src.decode(arr, ty, None)?;
-    match values.first() {
-        Some(t) if !t.is_finite() => Err(IoError::parse(
-            src.path,
-            arr.location(),
-            format!("TimeValue {t} is not finite"),
-        )),
-        t => Ok(t.copied()),
-    }
+    })?;
+    let ty = scalar::Scalar::parse(arr.attr("type").unwrap_or(""))?;
+    let values: Vec<f64> = src.decode(arr, ty, None).ok()?;
+    values.first().copied().filter(|t| t.is_finite())
 }
 
 /// Merges pieces after checking the total point count fits `u32` ids.
