@@ -5,6 +5,9 @@
 //! cargo run --example gen_mesh -- --meshes meshes      # the committed small meshes
 //! ```
 //! cargo run --release --example gen_mesh -- --hexes 1000000 --connect [-i FILE.vtu]
+//! cargo run --release --example gen_mesh -- --hexes 1000000 --steps 3 -o /tmp/s/series.pvd
+//! `--steps K` writes K time steps of the grid (same cells and points, the
+//! field `f` at t = 0, 0.5, ...) as `step_K.vtu` beside the `.pvd` given.
 //! `--connect` builds the topology and the `info` report of the generated
 //! grid (or of `-i FILE` read with `zoovr::io::read`) and prints the times;
 //! run it under `/usr/bin/time -v` for the peak resident memory.
@@ -16,7 +19,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use glam::DVec3;
-use zoovr::generate::{ring_grid, single_cell, time_series, warped_hex_grid, zoo_grid, Warp};
+use zoovr::generate::{
+    flow_series, ring_grid, single_cell, time_series, warped_hex_grid, zoo_grid, Warp,
+};
 use zoovr::io::writer::{write_legacy_ascii, write_pvd, write_series, write_vtu, Compression};
 use zoovr::mesh::{CellKind, Mesh};
 
@@ -27,6 +32,7 @@ fn main() -> Result<()> {
     let mut meshes = None;
     let mut compression = Compression::Zlib;
     let mut connect = false;
+    let mut steps: Option<usize> = None;
     let mut input: Option<PathBuf> = None;
     let mut i = 0;
     while i < args.len() {
@@ -41,6 +47,10 @@ fn main() -> Result<()> {
             }
             "--meshes" => {
                 meshes = Some(PathBuf::from(args.get(i + 1).context("--meshes DIR")?));
+                i += 1;
+            }
+            "--steps" => {
+                steps = Some(args.get(i + 1).context("--steps K")?.parse::<usize>()?);
                 i += 1;
             }
             "--raw" => compression = Compression::None,
@@ -63,6 +73,22 @@ fn main() -> Result<()> {
         bail!("usage: gen_mesh --hexes N -o FILE.vtu [--raw] | --meshes DIR");
     };
     let side = (n as f64).cbrt().round().max(1.0) as usize;
+    if let Some(k) = steps {
+        let dir = out.parent().unwrap_or(Path::new("."));
+        let mut entries = Vec::new();
+        for (i, (t, m)) in time_series(side, k).iter().enumerate() {
+            let name = format!("step_{i}.vtu");
+            write_vtu(&dir.join(&name), m, compression)?;
+            entries.push((*t, name));
+        }
+        write_pvd(&out, &entries)?;
+        eprintln!(
+            "{k} steps of {} hexes: {}",
+            side * side * side,
+            out.display()
+        );
+        return Ok(());
+    }
     let t0 = std::time::Instant::now();
     let mesh = warped_hex_grid(side, &Warp::default());
     let t1 = std::time::Instant::now();
@@ -172,6 +198,15 @@ fn write_meshes(dir: &Path) -> Result<()> {
     }
     write_pvd(&sdir.join("series.pvd"), &steps)?;
     write_series(&sdir.join("series.vtu.series"), &steps)?;
+    let fdir = dir.join("flow");
+    std::fs::create_dir_all(&fdir)?;
+    let mut fsteps = Vec::new();
+    for (k, (t, m)) in flow_series(12, 36, 6, 16).into_iter().enumerate() {
+        let name = format!("flow_{k:02}.vtu");
+        write_vtu(&fdir.join(&name), &m, Compression::Zlib)?;
+        fsteps.push((t, name));
+    }
+    write_pvd(&fdir.join("flow.pvd"), &fsteps)?;
     both(dir, "degenerate", &degenerate())?;
     Ok(())
 }

@@ -18,6 +18,12 @@
 //! - [`ring_grid`]: a square ring of hexahedra (a square hole through the
 //!   middle): non-convex, one component.
 //! - [`time_series`]: the warped grid with `f` advancing in time.
+//! - [`flow_series`]: a curved channel (three quarters of an annulus, so
+//!   non-convex, its faces bent out of plane by a wavy floor and roof) with
+//!   the speed of an analytic flow in it: a free vortex `1 / r` around the
+//!   channel's axis carrying a Gaussian puff that travels along it. Same
+//!   points and cells in every step, only the values move: the example
+//!   series in `meshes/flow/`.
 //! - [`ghost_grid`]: the warped grid as VTK exports a reservoir grid with
 //!   inactive cells: a `vtkGhostType` cell array marking some cells hidden
 //!   and some duplicate, VTK's id arrays, an integer and a float cell array.
@@ -439,6 +445,65 @@ pub fn time_series(n: usize, steps: usize) -> Vec<(f64, Mesh)> {
             let t = s as f64 * 0.5;
             let mut m = base.clone();
             m.point_data = vec![f_array(&m.points, t)];
+            (t, m)
+        })
+        .collect()
+}
+
+/// Steps `(time, mesh)` of a curved channel (module docs): `nr x nt x nz`
+/// hexahedra over radius 0.4..1, angle 0..270 degrees, height 0..0.5 (the
+/// floor and roof waved by `0.04 r sin(3 theta)`), with the point scalar
+/// `speed` (Float32) at `t = 0, 0.25, 0.5, ...`.
+pub fn flow_series(nr: usize, nt: usize, nz: usize, steps: usize) -> Vec<(f64, Mesh)> {
+    use std::f64::consts::PI;
+    let (r0, r1, sweep, height) = (0.4, 1.0, 1.5 * PI, 0.5);
+    let mut base = Mesh::default();
+    let mut polar = Vec::new();
+    for k in 0..=nz {
+        for j in 0..=nt {
+            for i in 0..=nr {
+                let r = r0 + (r1 - r0) * i as f64 / nr as f64;
+                let th = sweep * j as f64 / nt as f64;
+                let z = height * k as f64 / nz as f64 + 0.04 * r * (3.0 * th).sin();
+                base.points.push(DVec3::new(r * th.cos(), r * th.sin(), z));
+                polar.push((r, th, z));
+            }
+        }
+    }
+    for k in 0..nz {
+        for j in 0..nt {
+            for i in 0..nr {
+                base.cells.push(
+                    CellKind::Hexahedron,
+                    &lattice_hex(nr + 1, nt + 1, [i, j, k]),
+                );
+            }
+        }
+    }
+    let base = finish(base, 0.0);
+    (0..steps)
+        .map(|s| {
+            let t = s as f64 * 0.25;
+            // The puff's centre moves along the channel, a quarter turn a
+            // second, and wraps.
+            let centre = (0.3 + t * 0.5 * PI) % sweep;
+            let speed: Vec<f32> = polar
+                .iter()
+                .map(|&(r, th, z)| {
+                    let d2 = (th - centre).powi(2) / 0.08
+                        + (r - 0.7).powi(2) / 0.02
+                        + (z - 0.25).powi(2) / 0.03;
+                    (0.4 / r + (-d2).exp() * (1.0 + 0.3 * (6.0 * th - 2.0 * t).sin())) as f32
+                })
+                .collect();
+            let mut m = base.clone();
+            m.point_data = vec![DataArray {
+                name: "speed".into(),
+                components: 1,
+                data: ArrayData::F32(speed),
+                vtk_type: "Float32".into(),
+            }];
+            m.active_point_scalars = Some("speed".into());
             (t, m)
         })
         .collect()

@@ -109,22 +109,7 @@ impl Image {
         alpha: bool,
     ) -> Result<(), ImageError> {
         let bytes = self.to_png_bytes(background, alpha);
-        let ct = if alpha {
-            image::ExtendedColorType::Rgba8
-        } else {
-            image::ExtendedColorType::Rgb8
-        };
-        write_atomic(path, |tmp| {
-            image::save_buffer_with_format(
-                tmp,
-                &bytes,
-                self.width,
-                self.height,
-                ct,
-                image::ImageFormat::Png,
-            )
-            .map_err(|e| e.to_string())
-        })
+        write_png_bytes(path, &bytes, self.width, self.height, alpha)
     }
 
     /// Writes linear premultiplied RGBA f32 as OpenEXR (atomically).
@@ -170,6 +155,26 @@ impl Image {
             pixels,
         })
     }
+}
+
+/// Writes 8-bit RGB (or RGBA with `alpha`) bytes as a PNG, atomically
+/// (temp file + rename).
+pub fn write_png_bytes(
+    path: &Path,
+    bytes: &[u8],
+    width: u32,
+    height: u32,
+    alpha: bool,
+) -> Result<(), ImageError> {
+    let ct = if alpha {
+        image::ExtendedColorType::Rgba8
+    } else {
+        image::ExtendedColorType::Rgb8
+    };
+    write_atomic(path, |tmp| {
+        image::save_buffer_with_format(tmp, bytes, width, height, ct, image::ImageFormat::Png)
+            .map_err(|e| e.to_string())
+    })
 }
 
 fn write_atomic(

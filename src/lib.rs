@@ -14,6 +14,7 @@ pub mod gpu;
 pub mod image;
 pub mod integrate;
 pub mod io;
+pub mod legend;
 pub mod mesh;
 pub mod numeric;
 pub mod projection;
@@ -22,4 +23,5 @@ pub mod render;
 #[doc(hidden)]
 pub mod testdata;
 pub mod tf;
+pub mod video;
 pub mod visibility;

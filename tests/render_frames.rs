@@ -13,7 +13,7 @@ use zoovr::image::Image;
 use zoovr::io::{self, ReadOptions};
 use zoovr::render::{
     Compositor, Geometry, Mode, ProjectedOptions, RenderError, RenderOptions, Renderer, SceneSpec,
-    Shading,
+    Shading, StepChange,
 };
 use zoovr::testdata::mesh_file;
 
@@ -117,4 +117,64 @@ fn a_field_of_another_mesh_is_a_typed_error() {
             "{mode:?}: {err}"
         );
     }
+}
+
+/// The steps of a series mapped onto the geometry of step 0
+/// (`Geometry::next_step`): the change is detected exactly, the topology is
+/// shared while the cells are the same, and a renderer that moves on with
+/// `set_geometry` draws each step as a fresh renderer does, bit for bit.
+#[test]
+fn later_steps_keep_what_did_not_change_and_match_fresh_renderers() {
+    let read = || io::read(&mesh_file("zoo_3x3x3.vtu"), &ReadOptions::default()).unwrap();
+    let geometry = geometry();
+    let spec = SceneSpec::default();
+    let first = Shading::build(&geometry, &spec).unwrap();
+    let fixed = SceneSpec {
+        range: Some(first.range),
+        ..spec
+    };
+    let opts = options(Mode::Exact);
+    let mut renderer = Renderer::new(geometry.clone());
+    renderer.render(&first, &opts, |_, _| {}).unwrap();
+
+    // Same file again: values only.
+    let (same, change) = geometry.next_step(read(), false).unwrap();
+    assert_eq!(change, StepChange::Values);
+    assert!(Arc::ptr_eq(&same.topology, &geometry.topology));
+
+    // Points moved, cells kept: the topology is shared.
+    let mut moved = read();
+    for p in &mut moved.points {
+        p.x += 0.05 * p.y * p.y;
+        p.z -= 0.03 * p.x;
+    }
+    let (g1, change) = geometry.next_step(moved, false).unwrap();
+    assert_eq!(change, StepChange::Points);
+    assert!(Arc::ptr_eq(&g1.topology, &geometry.topology));
+    let s1 = Shading::build(&g1, &fixed).unwrap();
+    renderer.set_geometry(g1.clone(), change);
+    let (img, _) = renderer.render(&s1, &opts, |_, _| {}).unwrap();
+    assert!(img.pixels == fresh(&g1, &s1, &opts).pixels, "moved points");
+
+    // Back to the first points: values only relative to step 0, but the
+    // renderer holds g1, so it is a points change again.
+    let (g2, change) = g1.next_step(read(), false).unwrap();
+    assert_eq!(change, StepChange::Points);
+    renderer.set_geometry(g2.clone(), change);
+    let s2 = Shading::build(&g2, &fixed).unwrap();
+    let (img, _) = renderer.render(&s2, &opts, |_, _| {}).unwrap();
+    assert!(
+        img.pixels == fresh(&g2, &s2, &opts).pixels,
+        "points restored"
+    );
+
+    // Other cells: a new topology.
+    let other = io::read(&mesh_file("hexahedron.vtu"), &ReadOptions::default()).unwrap();
+    let (g3, change) = g2.next_step(other, false).unwrap();
+    assert_eq!(change, StepChange::Cells);
+    assert!(!Arc::ptr_eq(&g3.topology, &geometry.topology));
+    renderer.set_geometry(g3.clone(), change);
+    let s3 = Shading::build(&g3, &SceneSpec::default()).unwrap();
+    let (img, _) = renderer.render(&s3, &opts, |_, _| {}).unwrap();
+    assert!(img.pixels == fresh(&g3, &s3, &opts).pixels, "other cells");
 }

@@ -1,4 +1,5 @@
-//! Parsers for CLI values (`--size WxH`, `--range LO,HI`, `--background R,G,B`)
+//! Parsers for CLI values (`--size WxH`, `--range LO,HI`, `--background R,G,B`,
+//! `--frames A..B`)
 //! that reject NaN and nonsense with a usage error.
 
 /// Parses `WxH` (e.g. `512x512`); both positive and at most 16384.
@@ -72,6 +73,23 @@ pub fn parse_floats(s: &str) -> Result<Vec<f64>, String> {
     s.split(',').map(parse_finite).collect()
 }
 
+/// Parses `A..B` (inclusive, A <= B) or a single frame `A`.
+pub fn parse_frames(s: &str) -> Result<(usize, usize), String> {
+    let bad = || format!("expected A..B (inclusive frame indices, e.g. 0..9), got '{s}'");
+    let (a, b) = match s.split_once("..") {
+        Some((a, b)) => (a, b.strip_prefix('=').unwrap_or(b)),
+        None => (s, s),
+    };
+    let a: usize = a.trim().parse().map_err(|_| bad())?;
+    let b: usize = b.trim().parse().map_err(|_| bad())?;
+    if a > b {
+        return Err(format!(
+            "empty frame range '{s}': A must not be greater than B"
+        ));
+    }
+    Ok((a, b))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -86,5 +104,9 @@ mod tests {
         assert!(parse_range("nan,1").is_err());
         assert_eq!(parse_rgb("1,0,0.5"), Ok([1.0, 0.0, 0.5]));
         assert!(parse_rgb("2,0,0").is_err());
+        assert_eq!(parse_frames("2..5"), Ok((2, 5)));
+        assert_eq!(parse_frames("3"), Ok((3, 3)));
+        assert!(parse_frames("5..2").is_err());
+        assert!(parse_frames("a..2").is_err());
     }
 }

@@ -1,9 +1,13 @@
 //! Command-line parsing and dispatch. Each command lives in its own file;
 //! `anyhow` is used only here, at the edge.
 
+mod animate;
 mod args;
+mod assemble;
 mod compare;
 mod info;
+mod interrupt;
+mod legend;
 mod render;
 
 use clap::error::ErrorKind;
@@ -25,6 +29,10 @@ enum Command {
     /// Render one image of a dataset (exact mode through wgpu, or the CPU
     /// reference ray caster).
     Render(Box<render::RenderArgs>),
+    /// Render the steps of a time series (or a turntable of one dataset) to
+    /// numbered PNG frames, and optionally a GIF or an MP4, reusing the
+    /// topology, sort and GPU state across frames where the steps allow.
+    Animate(Box<animate::AnimateArgs>),
     /// Compare two images: max absolute, RMS and PSNR over pixels and
     /// channels (float values for two EXR files, else PNG display values).
     Compare(compare::CompareArgs),
@@ -40,31 +48,49 @@ pub fn run() -> i32 {
             return code;
         }
     };
-    if let Command::Render(args) = &cli.command {
-        if let Some(msg) = args.view.usage_error() {
-            let mut cmd = Cli::command();
-            // Built, so that the subcommand's usage line reads `zoovr render`.
-            cmd.build();
-            let e = match cmd.find_subcommand_mut("render") {
-                Some(render) => render.error(ErrorKind::ArgumentConflict, msg),
-                None => cmd.error(ErrorKind::ArgumentConflict, msg),
-            };
-            let _ = e.print();
-            return 2;
-        }
+    let (name, view) = match &cli.command {
+        Command::Render(args) => ("render", Some(&args.view)),
+        Command::Animate(args) => ("animate", Some(&args.view)),
+        _ => ("", None),
+    };
+    if let Some(msg) = view.and_then(|v| v.usage_error()) {
+        return usage(name, msg);
     }
     let result = match cli.command {
         Command::Info(args) => info::run(&args),
         Command::Render(args) => render::run(&args),
+        Command::Animate(args) => animate::run(&args),
         Command::Compare(args) => compare::run(&args),
     };
     match result {
         Ok(()) => 0,
-        Err(e) => {
-            eprintln!("zoovr: error: {}", error_chain(&e));
-            1
-        }
+        Err(e) => match e.downcast_ref::<UsageError>() {
+            Some(UsageError(msg)) => usage(name, msg.clone()),
+            None => {
+                eprintln!("zoovr: error: {}", error_chain(&e));
+                1
+            }
+        },
     }
+}
+
+/// A usage error found after parsing (a flag combination, or one that
+/// depends on the input, e.g. `--frames` beyond the series): exit code 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
+/// Prints a usage error of subcommand `name` the way clap does; returns 2.
+fn usage(name: &str, msg: String) -> i32 {
+    let mut cmd = Cli::command();
+    // Built, so that the subcommand's usage line reads `zoovr NAME`.
+    cmd.build();
+    let e = match cmd.find_subcommand_mut(name) {
+        Some(sub) => sub.error(ErrorKind::ArgumentConflict, msg),
+        None => cmd.error(ErrorKind::ArgumentConflict, msg),
+    };
+    let _ = e.print();
+    2
 }
 
 /// The error and its causes joined by ": ", leaving out a cause whose text

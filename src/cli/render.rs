@@ -120,6 +120,11 @@ pub struct ViewArgs {
     /// Force the software (CPU) adapter even where a GPU exists.
     #[arg(long)]
     pub cpu_adapter: bool,
+    /// Draw a colour legend into the PNG: a bar of the transfer function's
+    /// colours over the range, the field name and the range's ends (and,
+    /// for `animate`, the time value of the step).
+    #[arg(long)]
+    pub legend: bool,
     /// Print timings and counts to stderr.
     #[arg(long)]
     pub stats: bool,
@@ -302,7 +307,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .render(&shading, &opts, progress_bar("rendering"))
         .with_context(|| format!("{}", args.file.display()))?;
     if let Some(out) = &args.output {
-        image.write_png(out, args.view.background, args.view.alpha)?;
+        super::legend::write_frame(&image, out, &args.view, &shading, None)?;
     }
     if let Some(out) = &args.float {
         image.write_exr(out)?;

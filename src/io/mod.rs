@@ -13,6 +13,7 @@ pub mod collection;
 pub mod error;
 pub mod legacy;
 pub mod plot3d;
+pub mod sequence;
 pub mod writer;
 pub mod xml;
 

@@ -172,6 +172,9 @@ pub struct SourceInfo {
     pub ignored_cells: usize,
     /// Human-readable notes about repairs the reader made.
     pub notes: Vec<String>,
+    /// The time value the file itself records (VTK XML: the first value of
+    /// the `TimeValue` array of the dataset's `<FieldData>`), if any.
+    pub time_value: Option<f64>,
 }
 
 /// One dataset: points, 3D cells and attached arrays.

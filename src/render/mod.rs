@@ -23,6 +23,7 @@ mod options;
 pub mod pieces;
 pub mod scene;
 pub mod stats;
+pub mod steps;
 pub mod ties;
 mod workers;
 
@@ -44,6 +45,7 @@ pub use options::{
 pub use pieces::PieceError;
 pub use scene::{Geometry, ScalarsRef, Scene, SceneSpec, Shading};
 pub use stats::{ModeStats, ProjectedStats, RaycastStats, RenderStats};
+pub use steps::StepChange;
 
 /// Errors of a render.
 #[derive(Debug, Error)]
@@ -112,6 +114,19 @@ impl Renderer {
     /// The geometry it renders.
     pub fn geometry(&self) -> &Geometry {
         &self.geometry
+    }
+
+    /// Moves on to the geometry of another step of the series
+    /// ([`Geometry::next_step`]), keeping what `change` allows: with
+    /// [`StepChange::Values`] (or `None`) the visibility sorter (its planes,
+    /// splits and scratch) stays, otherwise it is rebuilt on first use (on
+    /// the shared topology for [`StepChange::Points`]); the GPU context
+    /// always stays.
+    pub fn set_geometry(&mut self, geometry: Geometry, change: StepChange) {
+        if !matches!(change, StepChange::None | StepChange::Values) {
+            self.sorter = None;
+        }
+        self.geometry = geometry;
     }
 
     /// Hands over a GPU context that is still opening ([`Context::spawn`]);

@@ -96,7 +96,21 @@ impl Geometry {
     /// Leaves out hidden and duplicate cells (unless `show_hidden`), merges
     /// coincident points and builds the face adjacency of a freshly read
     /// mesh.
-    pub fn build(mut mesh: Mesh, show_hidden: bool) -> Result<Geometry, RenderError> {
+    pub fn build(mesh: Mesh, show_hidden: bool) -> Result<Geometry, RenderError> {
+        let (mesh, ghost_cells, merged_points) = Geometry::prepare(mesh, show_hidden)?;
+        let topology = Topology::build(&mesh.cells);
+        Ok(Geometry {
+            mesh: Arc::new(mesh),
+            topology: Arc::new(topology),
+            merged_points,
+            ghost_cells,
+        })
+    }
+
+    /// The mesh as a geometry holds it: hidden and duplicate cells left out
+    /// (unless `show_hidden`) and coincident points merged. Returns it with
+    /// the number of cells left out and of points merged.
+    pub fn prepare(mut mesh: Mesh, show_hidden: bool) -> Result<(Mesh, usize, usize), RenderError> {
         if mesh.cells.is_empty() {
             return Err(RenderError::NoCells);
         }
@@ -109,24 +123,23 @@ impl Geometry {
             return Err(RenderError::AllCellsHidden(ghost_cells));
         }
         let merged_points = merge_coincident_points(&mut mesh);
-        let topology = Topology::build(&mesh.cells);
-        Ok(Geometry {
-            mesh: Arc::new(mesh),
-            topology: Arc::new(topology),
-            merged_points,
-            ghost_cells,
-        })
+        Ok((mesh, ghost_cells, merged_points))
     }
 
     /// The default opacity unit distance: bounds diagonal / 10 (1 when the
     /// bounds are degenerate).
     pub fn default_unit(&self) -> f64 {
-        let diagonal = self.mesh.diagonal();
-        if diagonal.is_finite() && diagonal > 0.0 {
-            diagonal / 10.0
-        } else {
-            1.0
-        }
+        default_unit_of(&self.mesh)
+    }
+}
+
+/// Bounds diagonal / 10 of `mesh` (1 when the bounds are degenerate).
+fn default_unit_of(mesh: &Mesh) -> f64 {
+    let diagonal = mesh.diagonal();
+    if diagonal.is_finite() && diagonal > 0.0 {
+        diagonal / 10.0
+    } else {
+        1.0
     }
 }
 
@@ -149,8 +162,14 @@ impl Shading {
     /// Picks the field from the arrays of `geometry`'s mesh and the
     /// transfer function, as `spec` asks (module docs).
     pub fn build(geometry: &Geometry, spec: &SceneSpec) -> Result<Shading, RenderError> {
-        let mesh = &*geometry.mesh;
-        let default_unit = geometry.default_unit();
+        Shading::build_for_mesh(&geometry.mesh, spec)
+    }
+
+    /// [`Shading::build`] from a mesh prepared as a geometry holds it
+    /// ([`Geometry::prepare`]), without its topology: e.g. to find the
+    /// range of every step of a series first.
+    pub fn build_for_mesh(mesh: &Mesh, spec: &SceneSpec) -> Result<Shading, RenderError> {
+        let default_unit = default_unit_of(mesh);
         let file_tf = match &spec.tf_file {
             Some(p) => Some(
                 TransferFunction::from_json_file(p, default_unit).map_err(|e| RenderError::Tf {

@@ -91,7 +91,23 @@ fn read_nested(path: &Path, bytes: &[u8], format: Format, depth: usize) -> Resul
     if pieces.is_empty() {
         return Err(IoError::parse(path, grid.location(), "no <Piece> element"));
     }
-    merge_checked(path, grid, pieces)
+    let mut mesh = merge_checked(path, grid, pieces)?;
+    mesh.source.time_value = time_value(&src, grid);
+    Ok(mesh)
+}
+
+/// The first value of the `TimeValue` array in the dataset's
+/// `<FieldData>` (as ParaView writes the time of a step), if there is one
+/// and it decodes to a finite number. A bad time never stops the dataset
+/// from being read: it is only a label.
+fn time_value(src: &Source, grid: &dom::Element) -> Option<f64> {
+    let arr = grid.child("FieldData").and_then(|fd| {
+        fd.children_named("DataArray")
+            .find(|a| a.attr("Name") == Some("TimeValue"))
+    })?;
+    let ty = scalar::Scalar::parse(arr.attr("type").unwrap_or(""))?;
+    let values: Vec<f64> = src.decode(arr, ty, None).ok()?;
+    values.first().copied().filter(|t| t.is_finite())
 }
 
 /// Merges pieces after checking the total point count fits `u32` ids.

@@ -1,0 +1,632 @@
+//! `zoovr animate SERIES -o DIR [...]`: numbered frames of a time series
+//! (or a turntable of one dataset), then optionally a GIF or an MP4.
+//!
+//! How a run goes:
+//! 1. The steps are listed ([`zoovr::io::sequence::list_steps`]) and the
+//!    frames planned: frame `i` shows step `i` (a single dataset with
+//!    `--count N` gives N frames of it) from azimuth `--azimuth + i *
+//!    --orbit`; `--frames A..B` keeps frames A to B, named by their index
+//!    in the whole run, so separate ranges add up to one run.
+//! 2. The colour range: `--range`, else a first pass over every step's
+//!    values (`--range-from all`, the default) or step 0's
+//!    (`--range-from first`). Always over the whole series, whatever
+//!    `--frames` keeps, so every process of a farmed run agrees.
+//! 3. The camera is fitted once, to step 0's bounds, and stays fixed (or
+//!    turns with `--orbit`), so a deforming mesh moves in a still frame.
+//! 4. The frames are rendered by one [`Renderer`]: a loader thread reads
+//!    the next step while the current one is drawn; each step is compared
+//!    with the geometry drawn before ([`Geometry::next_step`]) and the
+//!    renderer keeps what did not change ([`StepChange`]). Every frame is
+//!    written atomically (temporary file, then rename), so an interrupted
+//!    run leaves only whole frames.
+//! 5. `--gif` / `--mp4` assemble the frames of DIR ([`super::assemble`]).
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::time::Instant;
+
+use anyhow::{anyhow, bail, Context as _, Result};
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+
+use zoovr::camera::Camera;
+use zoovr::io::{self, ReadOptions, TimeStep};
+use zoovr::mesh::Mesh;
+use zoovr::render::{Geometry, ModeStats, RenderStats, Renderer, Shading, StepChange};
+
+use super::args::{parse_finite, parse_frames, parse_positive};
+use super::assemble::{self, AssembleArgs};
+use super::render::ViewArgs;
+use super::UsageError;
+
+/// Where the colour range comes from when `--range` is absent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum RangeFrom {
+    /// Min..max of the field over every step (a first pass over the values).
+    All,
+    /// Min..max of the field in step 0.
+    First,
+}
+
+#[derive(Args, Debug)]
+pub struct AnimateArgs {
+    /// The time series: a .pvd or .series collection, a quoted glob
+    /// pattern ('out/step_*.vtu'), a folder of numbered dataset files, or
+    /// one dataset (a turntable with --orbit and --count).
+    #[arg(required_unless_present = "assemble")]
+    pub series: Option<PathBuf>,
+    /// Output folder for the frames DIR/frame_NNNNN.png (made if missing).
+    #[arg(short, long, value_name = "DIR", required_unless_present_any = ["assemble", "range_only"])]
+    pub output: Option<PathBuf>,
+    /// Render nothing: assemble the frames already in DIR (e.g. written by
+    /// several `--frames` runs) into --gif and/or --mp4.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["series", "output", "frames"])]
+    pub assemble: Option<PathBuf>,
+    /// Also write an animated GIF of the frames (one global palette,
+    /// looping forever).
+    #[arg(long, value_name = "FILE")]
+    pub gif: Option<PathBuf>,
+    /// Also write an MP4 (H.264) of the frames, encoded by ffmpeg from PATH.
+    #[arg(long, value_name = "FILE")]
+    pub mp4: Option<PathBuf>,
+    /// Frames per second of the GIF and MP4.
+    #[arg(long, value_parser = parse_positive, default_value_t = 10.0)]
+    pub fps: f64,
+    /// Degrees of azimuth added per frame (a turning camera).
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true, value_name = "DEG")]
+    pub orbit: Option<f64>,
+    /// Frames of a single dataset (a turntable with --orbit).
+    #[arg(long, value_name = "N")]
+    pub count: Option<usize>,
+    /// Render only frames A..B (inclusive, indices in the whole run).
+    #[arg(long, value_parser = parse_frames, value_name = "A..B")]
+    pub frames: Option<(usize, usize)>,
+    /// Colour range when --range is absent: all (every step's values, a
+    /// first pass over the series) or first (step 0's).
+    #[arg(long, value_enum, conflicts_with = "range")]
+    pub range_from: Option<RangeFrom>,
+    /// Render nothing: write the colour range the run would use (JSON
+    /// `{"range": [LO, HI]}`) to FILE, for --range-file in separate
+    /// processes of one run.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["output", "frames", "gif", "mp4"])]
+    pub range_only: Option<PathBuf>,
+    /// Read the colour range from a file written by --range-only.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["range", "range_from", "range_only"])]
+    pub range_file: Option<PathBuf>,
+    /// Reuse nothing across frames: a new geometry, topology, sorter and
+    /// GPU context per step, as separate `render` runs would (to measure
+    /// what reuse saves).
+    #[arg(long)]
+    pub no_reuse: bool,
+    #[command(flatten)]
+    pub view: ViewArgs,
+}
+
+/// One frame of the run.
+#[derive(Clone, Copy, Debug)]
+struct FramePlan {
+    index: usize,
+    step: usize,
+    azimuth: f64,
+}
+
+/// What `--stats` reports per frame.
+#[derive(Debug, Serialize)]
+struct FrameReport {
+    frame: usize,
+    step: usize,
+    time: f64,
+    file: String,
+    /// What changed since the frame before: none, values, points, cells, or
+    /// camera (an orbit on the same step).
+    change: &'static str,
+    /// The scalar range the transfer function maps (the same in every
+    /// frame).
+    range: (f64, f64),
+    /// Waiting for the step's file (read by the loader thread), preparing
+    /// its geometry and shading.
+    load_s: f64,
+    /// The visibility sort.
+    sort_s: f64,
+    /// Everything else in the render: projection, drawing, readback.
+    draw_s: f64,
+    /// Writing the PNG.
+    write_s: f64,
+    total_s: f64,
+    render: RenderStats,
+}
+
+/// The name of frame `i` in the output folder.
+pub fn frame_name(i: usize) -> String {
+    format!("frame_{i:05}.png")
+}
+
+fn plan(args: &AnimateArgs, series: &Path, steps: &[TimeStep]) -> Result<Vec<FramePlan>> {
+    let count = match args.count {
+        Some(0) => return Err(UsageError("--count must be at least 1".into()).into()),
+        Some(n) if steps.len() == 1 => n,
+        Some(_) => {
+            return Err(UsageError(format!(
+                "--count is for a single dataset; {} has {} steps (one frame each)",
+                series.display(),
+                steps.len()
+            ))
+            .into())
+        }
+        None => steps.len(),
+    };
+    let orbit = args.orbit.unwrap_or(0.0);
+    let all: Vec<FramePlan> = (0..count)
+        .map(|i| FramePlan {
+            index: i,
+            step: if steps.len() == 1 { 0 } else { i },
+            azimuth: args.view.azimuth + i as f64 * orbit,
+        })
+        .collect();
+    match args.frames {
+        None => Ok(all),
+        Some((a, b)) if b < all.len() => Ok(all[a..=b].to_vec()),
+        Some((a, b)) => Err(UsageError(format!(
+            "--frames {a}..{b}: the run has {} frames (0..{})",
+            all.len(),
+            all.len() - 1
+        ))
+        .into()),
+    }
+}
+
+/// Reads step `k` (its errors name the file).
+fn read_step(steps: &[TimeStep], k: usize, opts: &ReadOptions) -> Result<Mesh> {
+    let path = &steps[k].path;
+    io::read(path, opts).with_context(|| format!("step {k}"))
+}
+
+/// The field's name and association in a shading, to check every step
+/// renders the same field.
+fn field_key(s: &Shading) -> Option<(String, zoovr::field::Association)> {
+    s.field.as_ref().map(|f| (f.name.clone(), f.association))
+}
+
+fn check_field(
+    want: &Option<(String, zoovr::field::Association)>,
+    got: &Shading,
+    step: &TimeStep,
+) -> Result<()> {
+    let got = field_key(got);
+    if &got != want {
+        let show = |k: &Option<(String, zoovr::field::Association)>| match k {
+            Some((n, a)) => format!("{a:?} field '{n}'"),
+            None => "no field".to_string(),
+        };
+        bail!(
+            "{}: this step renders {}, but the first step renders {} (give --field)",
+            step.path.display(),
+            show(&got),
+            show(want)
+        );
+    }
+    Ok(())
+}
+
+/// The colour range (module docs, step 2), or `None` where there is no
+/// field.
+fn colour_range(
+    args: &AnimateArgs,
+    steps: &[TimeStep],
+    ropts: &ReadOptions,
+) -> Result<Option<(f64, f64)>> {
+    if let Some(r) = args.view.range {
+        return Ok(Some(r));
+    }
+    if let Some(file) = &args.range_file {
+        return read_range_file(file);
+    }
+    let spec = args.view.scene_spec();
+    let upto = match args.range_from.unwrap_or(RangeFrom::All) {
+        RangeFrom::All => steps.len(),
+        RangeFrom::First => 1,
+    };
+    let mut range: Option<(f64, f64)> = None;
+    let mut first_field = None;
+    for (k, step) in steps.iter().take(upto).enumerate() {
+        let mesh = read_step(steps, k, ropts)?;
+        let (mesh, _, _) = Geometry::prepare(mesh, spec.show_hidden)
+            .with_context(|| format!("{}", step.path.display()))?;
+        let shading = Shading::build_for_mesh(&mesh, &spec)
+            .with_context(|| format!("{}", step.path.display()))?;
+        if k == 0 {
+            first_field = field_key(&shading);
+        } else {
+            check_field(&first_field, &shading, step)?;
+        }
+        if let Some(f) = &shading.field {
+            let (lo, hi) = f.range;
+            if lo.is_finite() && hi.is_finite() {
+                range = Some(match range {
+                    Some((a, b)) => (a.min(lo), b.max(hi)),
+                    None => (lo, hi),
+                });
+            }
+        }
+    }
+    Ok(range)
+}
+
+/// The range of a `--range-only` file.
+fn read_range_file(file: &Path) -> Result<Option<(f64, f64)>> {
+    #[derive(serde::Deserialize)]
+    struct RangeFile {
+        range: Option<(f64, f64)>,
+    }
+    let text = std::fs::read_to_string(file)
+        .with_context(|| format!("{}: cannot read the range file", file.display()))?;
+    let r: RangeFile = serde_json::from_str(&text).with_context(|| {
+        format!(
+            "{}: not a range file (expected {{\"range\": [LO, HI]}})",
+            file.display()
+        )
+    })?;
+    if let Some((lo, hi)) = r.range {
+        if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+            bail!("{}: bad range [{lo}, {hi}]", file.display());
+        }
+    }
+    Ok(r.range)
+}
+
+/// A progress bar of frames on a terminal (hidden otherwise).
+fn frame_bar(n: usize) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(n as u64);
+    if std::io::stderr().is_terminal() {
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "frame {pos}/{len} [{bar:30}] {elapsed} (ETA {eta}) {msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+    } else {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    bar
+}
+
+pub fn run(args: &AnimateArgs) -> Result<()> {
+    if let Some(dir) = &args.assemble {
+        if args.gif.is_none() && args.mp4.is_none() {
+            return Err(UsageError("--assemble needs --gif FILE and/or --mp4 FILE".into()).into());
+        }
+        return assemble::run(&AssembleArgs {
+            dir: dir.clone(),
+            gif: args.gif.clone(),
+            mp4: args.mp4.clone(),
+            fps: args.fps,
+            only: None,
+        });
+    }
+    if let (Some(series), Some(file)) = (&args.series, &args.range_only) {
+        let steps = io::sequence::list_steps(series)?;
+        let ropts = ReadOptions {
+            q_file: args.view.q.clone(),
+        };
+        let range = colour_range(args, &steps, &ropts)?;
+        let text = serde_json::to_string(&serde_json::json!({ "range": range }))?;
+        std::fs::write(file, text + "\n")
+            .with_context(|| format!("{}: cannot write the range", file.display()))?;
+        return Ok(());
+    }
+    let (Some(series), Some(out)) = (&args.series, &args.output) else {
+        return Err(UsageError("give SERIES and -o DIR (or --assemble DIR)".into()).into());
+    };
+    super::interrupt::install();
+    let steps = io::sequence::list_steps(series)?;
+    // A collection's times win; steps found by a folder or a pattern take
+    // the file's own TimeValue where it has one, else their index.
+    let collection = series.is_file()
+        && matches!(
+            io::detect_format(series),
+            Ok(io::Format::Pvd | io::Format::Series)
+        );
+    let frames = plan(args, series, &steps)?;
+    if args.mp4.is_some() {
+        assemble::check_mp4_encoder()?;
+    }
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("{}: cannot make the output folder", out.display()))?;
+    let ropts = ReadOptions {
+        q_file: args.view.q.clone(),
+    };
+    let mut opts = args.view.render_options();
+    let pending = opts
+        .mode
+        .info()
+        .gpu
+        .then(|| zoovr::gpu::Context::spawn(&opts.gpu));
+    let range = colour_range(args, &steps, &ropts)?;
+    let mut spec = args.view.scene_spec();
+    if range.is_some() {
+        spec.range = range;
+    }
+
+    // The steps in the order the frames need them, read ahead by a loader
+    // thread (one step in flight) while the frame before is drawn.
+    let mut needed: Vec<usize> = Vec::new();
+    for f in &frames {
+        if needed.last() != Some(&f.step) {
+            needed.push(f.step);
+        }
+    }
+    let bar = frame_bar(frames.len());
+    let mut reports = Vec::new();
+    let result = std::thread::scope(|scope| -> Result<()> {
+        let (tx, rx) = mpsc::sync_channel::<(usize, Result<Mesh>)>(1);
+        let (steps_ref, ropts_ref, needed_ref) = (&steps, &ropts, &needed);
+        scope.spawn(move || {
+            for &k in needed_ref {
+                let mesh = read_step(steps_ref, k, ropts_ref);
+                let failed = mesh.is_err();
+                if tx.send((k, mesh)).is_err() || failed {
+                    break;
+                }
+            }
+        });
+        let mut renderer: Option<Renderer> = None;
+        let mut pending = pending;
+        let mut current: Option<(usize, Shading, f64)> = None;
+        let mut first_field = None;
+        let mut camera_bounds: Option<[f64; 6]> = None;
+        for f in &frames {
+            if super::interrupt::requested() {
+                break;
+            }
+            let t0 = Instant::now();
+            let step = &steps[f.step];
+            let change = match &current {
+                Some((k, _, _)) if *k == f.step => {
+                    if opts.camera.azimuth == f.azimuth {
+                        "none"
+                    } else {
+                        "camera"
+                    }
+                }
+                _ => {
+                    let (k, mesh) = rx
+                        .recv()
+                        .map_err(|_| anyhow!("the loader thread stopped"))?;
+                    debug_assert_eq!(k, f.step);
+                    let mesh = mesh?;
+                    let time = match mesh.source.time_value {
+                        Some(t) if !collection => t,
+                        _ => step.time,
+                    };
+                    let at = || format!("{}", step.path.display());
+                    if args.no_reuse {
+                        renderer = None;
+                    }
+                    let change = match renderer.as_mut() {
+                        None if args.no_reuse && current.is_some() => {
+                            let g = Geometry::build(mesh, spec.show_hidden).with_context(at)?;
+                            renderer = Some(Renderer::new(g));
+                            StepChange::Cells
+                        }
+                        None => {
+                            let g = Geometry::build(mesh, spec.show_hidden).with_context(at)?;
+                            let mut r = Renderer::new(g);
+                            if let Some(p) = pending.take() {
+                                r.set_pending_gpu(p);
+                            }
+                            renderer = Some(r);
+                            StepChange::None
+                        }
+                        Some(r) => {
+                            let (g, change) = r
+                                .geometry()
+                                .next_step(mesh, spec.show_hidden)
+                                .with_context(at)?;
+                            r.set_geometry(g, change);
+                            if change == StepChange::Cells && !args.no_reuse {
+                                eprintln!(
+                                    "zoovr: note: {}: its cells differ from the step before; \
+                                     rendered with a new topology (nothing reused)",
+                                    step.path.display()
+                                );
+                            }
+                            change
+                        }
+                    };
+                    let r = renderer.as_ref().ok_or_else(|| anyhow!("no renderer"))?;
+                    let shading = Shading::build(r.geometry(), &spec).with_context(at)?;
+                    if current.is_none() && f.step == frames[0].step {
+                        first_field = field_key(&shading);
+                    } else {
+                        check_field(&first_field, &shading, step)?;
+                    }
+                    current = Some((f.step, shading, time));
+                    change.name()
+                }
+            };
+            let renderer = renderer.as_mut().ok_or_else(|| anyhow!("no renderer"))?;
+            let Some((_, shading, time)) = &current else {
+                bail!("no shading");
+            };
+            let bounds = match camera_bounds {
+                Some(b) => b,
+                None => {
+                    let b = step0_bounds(&steps, f.step, renderer, &ropts, spec.show_hidden)?;
+                    camera_bounds = Some(b);
+                    b
+                }
+            };
+            let load_s = t0.elapsed().as_secs_f64();
+            opts.camera.azimuth = f.azimuth;
+            let camera = Camera::fit(bounds, &opts.camera);
+            let (image, stats) = renderer
+                .render_with_camera(shading, &opts, &camera, |_, _| {})
+                .with_context(|| format!("{}", step.path.display()))?;
+            let t_write = Instant::now();
+            let path = out.join(frame_name(f.index));
+            super::legend::write_frame(&image, &path, &args.view, shading, Some(*time))?;
+            let write_s = t_write.elapsed().as_secs_f64();
+            let sort_s = match &stats.detail {
+                ModeStats::Projected(p) => p.sort_s,
+                _ => 0.0,
+            };
+            let report = FrameReport {
+                frame: f.index,
+                step: f.step,
+                time: *time,
+                file: step.path.display().to_string(),
+                change,
+                range: shading.range,
+                load_s,
+                sort_s,
+                draw_s: (stats.total_s - sort_s).max(0.0),
+                write_s,
+                total_s: t0.elapsed().as_secs_f64(),
+                render: stats,
+            };
+            bar.set_message(format!(
+                "load {:.0} ms, sort {:.0} ms, draw {:.0} ms",
+                report.load_s * 1e3,
+                report.sort_s * 1e3,
+                report.draw_s * 1e3
+            ));
+            bar.inc(1);
+            emit(args, &report)?;
+            reports.push(report);
+        }
+        Ok(())
+    });
+    bar.finish_and_clear();
+    let done: Vec<usize> = reports.iter().map(|r| r.frame).collect();
+    if let Err(e) = result {
+        if !done.is_empty() {
+            eprintln!(
+                "zoovr: frames {} are complete in {}",
+                ranges(&done),
+                out.display()
+            );
+        }
+        return Err(e);
+    }
+    if super::interrupt::requested() && done.len() < frames.len() {
+        bail!(
+            "interrupted: frames {} are complete in {} (no partial frame is left)",
+            if done.is_empty() {
+                "none".to_string()
+            } else {
+                ranges(&done)
+            },
+            out.display()
+        );
+    }
+    if args.view.stats && !args.view.json {
+        summary(&reports);
+    }
+    if args.gif.is_some() || args.mp4.is_some() {
+        assemble::run(&AssembleArgs {
+            dir: out.clone(),
+            gif: args.gif.clone(),
+            mp4: args.mp4.clone(),
+            fps: args.fps,
+            only: Some(done),
+        })?;
+    }
+    Ok(())
+}
+
+/// The bounds the camera is fitted to: step 0's (already loaded when the
+/// run starts at step 0, else read once).
+fn step0_bounds(
+    steps: &[TimeStep],
+    current: usize,
+    renderer: &Renderer,
+    ropts: &ReadOptions,
+    show_hidden: bool,
+) -> Result<[f64; 6]> {
+    if current == 0 {
+        return Ok(renderer.geometry().mesh.bounds());
+    }
+    let mesh = read_step(steps, 0, ropts)?;
+    let (mesh, _, _) = Geometry::prepare(mesh, show_hidden)
+        .with_context(|| format!("{}", steps[0].path.display()))?;
+    Ok(mesh.bounds())
+}
+
+/// Prints one frame's report (`--stats`: a line on stderr; `--stats
+/// --json`: one JSON object on stdout).
+fn emit(args: &AnimateArgs, r: &FrameReport) -> Result<()> {
+    if args.view.json {
+        println!("{}", serde_json::to_string(r)?);
+    } else if args.view.stats {
+        eprintln!(
+            "frame {:5}  step {:4}  t={:<10} change {:<6}  load {:8.1} ms  sort {:8.1} ms  draw {:8.1} ms  write {:6.1} ms  total {:8.1} ms",
+            r.frame,
+            r.step,
+            r.time,
+            r.change,
+            r.load_s * 1e3,
+            r.sort_s * 1e3,
+            r.draw_s * 1e3,
+            r.write_s * 1e3,
+            r.total_s * 1e3
+        );
+    }
+    Ok(())
+}
+
+/// The human summary of `--stats`: frames by change, mean times.
+fn summary(reports: &[FrameReport]) {
+    if reports.is_empty() {
+        return;
+    }
+    let n = reports.len() as f64;
+    let mean = |f: &dyn Fn(&FrameReport) -> f64| reports.iter().map(f).sum::<f64>() / n * 1e3;
+    let count = |c: &str| reports.iter().filter(|r| r.change == c).count();
+    eprintln!(
+        "frames       {}  (changes: {} values only, {} points, {} cells, {} camera only)",
+        reports.len(),
+        count("values"),
+        count("points"),
+        count("cells"),
+        count("camera")
+    );
+    eprintln!(
+        "mean         load {:.1} ms, sort {:.1} ms, draw {:.1} ms, write {:.1} ms, total {:.1} ms per frame",
+        mean(&|r| r.load_s),
+        mean(&|r| r.sort_s),
+        mean(&|r| r.draw_s),
+        mean(&|r| r.write_s),
+        mean(&|r| r.total_s)
+    );
+}
+
+/// `0..3, 7` for `[0, 1, 2, 3, 7]`.
+fn ranges(v: &[usize]) -> String {
+    let mut out: Vec<String> = Vec::new();
+    let mut i = 0;
+    while i < v.len() {
+        let mut j = i;
+        while j + 1 < v.len() && v[j + 1] == v[j] + 1 {
+            j += 1;
+        }
+        out.push(if i == j {
+            v[i].to_string()
+        } else {
+            format!("{}..{}", v[i], v[j])
+        });
+        i = j + 1;
+    }
+    out.join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ranges;
+
+    #[test]
+    fn ranges_of_frames() {
+        assert_eq!(ranges(&[0, 1, 2, 3, 7]), "0..3, 7");
+        assert_eq!(ranges(&[5]), "5");
+    }
+}
