@@ -19,7 +19,9 @@
 // interpolated as itself, so a thin piece far away loses nothing to
 // cancellation. Scalars are normalised (segment.rs `ScalarMap`).
 //
-// Binding 0 is the view (`SegmentView`); a stage's own bindings follow.
+// Binding 0 is the view (`SegmentView`); a stage's own bindings follow. The
+// vertex stage (`VertexIn`, `VertexOut`, `vs_main`) is shaders/segment_vertex.wgsl
+// (or shaders/iso_vertex.wgsl), which a stage puts in front of this file.
 
 // Keep in sync with `SegmentView` in src/render/modes/segment.rs.
 struct View {
@@ -34,43 +36,12 @@ struct View {
 
 @group(0) @binding(0) var<uniform> view: View;
 
-// Keep in sync with `SegmentVertex` in src/render/modes/segment.rs.
-struct VertexIn {
-    @location(0) pos: vec4<f32>,
-    @location(1) front: vec2<f32>,
-    @location(2) back: vec2<f32>,
-    @location(3) thick: f32,
-    @location(4) piece: u32,
-}
-
-// Varyings use the default perspective-correct interpolation, which with
-// w = 1 is linear in screen space; never @interpolate(linear) (Mesa gives
-// NaN with it on triangles crossing the viewport edge).
-struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) front: vec2<f32>,
-    @location(1) back: vec2<f32>,
-    @location(2) thick: f32,
-    @location(3) @interpolate(flat) piece: u32,
-}
-
 // What a fragment writes: its colour, and as its depth the piece's key (see
 // `piece_depth`), so that the depth test lets each piece colour a pixel at
 // most once.
 struct FragOut {
     @location(0) color: vec4<f32>,
     @builtin(frag_depth) depth: f32,
-}
-
-@vertex
-fn vs_main(v: VertexIn) -> VertexOut {
-    var out: VertexOut;
-    out.clip = v.pos;
-    out.front = v.front;
-    out.back = v.back;
-    out.thick = v.thick;
-    out.piece = v.piece;
-    return out;
 }
 
 // A fragment's ray segment through its piece.

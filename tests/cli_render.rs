@@ -1,7 +1,11 @@
 //! `zoovr render` through the real binary: outputs, exit codes, messages.
 
+mod cli_util;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
+
+use cli_util::{no_adapter, render, stderr, zoovr};
 
 use zoovr::field::{ArrayData, DataArray};
 use zoovr::generate::{ghost_grid, Warp};
@@ -9,36 +13,6 @@ use zoovr::image::Image;
 use zoovr::io::writer::{write_vtu, Compression};
 use zoovr::mesh::{Cells, Mesh};
 use zoovr::testdata::mesh_file;
-
-fn zoovr(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_zoovr"))
-        .args(args)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .expect("run zoovr")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Runs `zoovr render FILE -o OUT ARGS...`.
-fn render(file: &Path, out: &Path, args: &[&str]) -> Output {
-    let mut all = vec![
-        "render",
-        file.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ];
-    all.extend(args);
-    zoovr(&all)
-}
-
-/// Whether a render failed only for want of a GPU adapter (the exact mode
-/// is then skipped).
-fn no_adapter(o: &Output) -> bool {
-    !o.status.success() && stderr(o).contains("adapter")
-}
 
 #[test]
 fn renders_png_and_exr_in_both_modes() {

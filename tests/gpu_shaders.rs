@@ -6,6 +6,7 @@ use naga::{Binding, Interpolation, ScalarKind, ShaderStage, TypeInner, VectorSiz
 use zoovr::gpu::layer::LAYER_STAGE;
 use zoovr::gpu::stage::stage_source;
 use zoovr::gpu::StageDesc;
+use zoovr::render::modes::iso;
 use zoovr::render::modes::preint_tables::TABLE_BUILD;
 use zoovr::render::modes::SHADERS;
 use zoovr::render::Mode;
@@ -14,6 +15,13 @@ use zoovr::render::Mode;
 fn stages() -> Vec<&'static StageDesc> {
     let mut v: Vec<&'static StageDesc> = Mode::ALL.iter().filter_map(|m| m.info().stage).collect();
     v.push(&LAYER_STAGE);
+    // The isosurface stages over each volume.
+    v.extend([
+        &iso::ISO_EXACT_FRAG_STAGE,
+        &iso::ISO_PREINT3D_STAGE,
+        &iso::ISO_PREINT2D_STAGE,
+        &iso::ISO_PREINT2D_CYL_STAGE,
+    ]);
     v
 }
 

@@ -17,6 +17,7 @@ use zoovr::camera::CameraParams;
 use zoovr::image::{compare_display, Image};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
+use zoovr::render::iso::IsoOptions;
 use zoovr::render::modes::twins::missing_twins;
 use zoovr::render::modes::SHADERS;
 use zoovr::render::{
@@ -32,7 +33,18 @@ fn scene(name: &str) -> Scene {
 }
 
 fn options(mode: Mode, ortho: bool) -> RenderOptions {
+    // `--mode iso` draws the isosurfaces it is given (tests/iso.rs
+    // compares it with the reference).
+    let iso = if mode == Mode::Iso {
+        IsoOptions {
+            surfaces: zoovr::render::iso::parse_list("0.5").unwrap(),
+            ..Default::default()
+        }
+    } else {
+        IsoOptions::default()
+    };
     RenderOptions {
+        iso,
         camera: CameraParams {
             width: 96,
             height: 80,
@@ -151,6 +163,10 @@ fn every_mode_matches_the_reference(name: &str) {
                 let Some(bounds) = mode.info().bounds else {
                     continue;
                 };
+                if mode == Mode::Iso {
+                    // Surfaces, not the volume: tests/iso.rs.
+                    continue;
+                }
                 assert_eq!(bounds.reference, FieldModel::Faces);
                 let mut compositors = vec![Compositor::Cpu];
                 if gpu {

@@ -176,6 +176,7 @@ fn hex_from_view(c: [DVec3; 8]) -> Polyhedron {
         points: c.to_vec(),
         scalars: (0..8).map(|i| i as f64 * 0.25).collect(),
         triangles: Vec::new(),
+        gradients: Vec::new(),
     };
     cells.for_each_face(0, |_, f| {
         zoovr::mesh::tetra::triangulate_face(f, |t| p.triangles.push(t));
@@ -291,6 +292,7 @@ fn vertex_on_edge_and_vertex_on_vertex() {
             points: vec![base[0], base[1], base[2], base[3], apex],
             scalars: vec![0.0, 1.0, 2.0, 3.0, 4.0],
             triangles: Vec::new(),
+            gradients: Vec::new(),
         };
         cells.for_each_face(0, |_, f| {
             zoovr::mesh::tetra::triangulate_face(f, |t| p.triangles.push(t));

@@ -15,7 +15,19 @@ use zoovr::render::{
     SceneSpec, Shading, TableBuild, TableOptions,
 };
 
+use zoovr::render::iso::{IsoOptions, IsoSpec, Lighting};
+
 use super::args::{parse_finite, parse_positive, parse_range, parse_rgb, parse_size};
+
+/// The parsed `--iso` list.
+#[derive(Clone, Debug)]
+pub struct IsoList(pub Vec<IsoSpec>);
+
+fn parse_iso(s: &str) -> Result<IsoList, String> {
+    zoovr::render::iso::parse_list(s)
+        .map(IsoList)
+        .map_err(|e| e.to_string())
+}
 
 /// Options shared by `render` and `animate`: field, transfer function,
 /// camera, mode and output encoding.
@@ -67,8 +79,8 @@ pub struct ViewArgs {
     pub ortho: bool,
     /// Rendering mode: exact (projection + exact vertex integrals, wgpu),
     /// exact-frag (the exact integral per fragment), preint3d, preint2d,
-    /// preint2d-cyl (pre-integrated tables, see --table), or raycast (CPU
-    /// reference).
+    /// preint2d-cyl (pre-integrated tables, see --table), iso (the --iso
+    /// surfaces alone), or raycast (CPU reference).
     #[arg(long, value_enum, default_value_t = Mode::Exact)]
     pub mode: Mode,
     /// Field model of the ray caster: faces (default), tets or native. The
@@ -105,6 +117,28 @@ pub struct ViewArgs {
     /// or gpu (exact integrals in a wgpu compute pass).
     #[arg(long, value_enum, default_value_t = TableBuild::Auto)]
     pub table_build: TableBuild,
+    /// Isosurfaces, comma-separated: V[:COLOUR[:OPACITY[:BACKCOLOUR[:BACKOPACITY]]]].
+    ///
+    /// Drawn alone by --mode iso, mixed with the volume in the exact order
+    /// by exact-frag, preint3d, preint2d, preint2d-cyl and raycast (not
+    /// exact, which slices per vertex). COLOUR is #rrggbb or `tf` (the
+    /// transfer function's colour at V, the default); OPACITY in [0, 1]
+    /// (default 1, opaque). The front side is the one a ray meets while
+    /// the field rises; the back side takes the front's style unless
+    /// BACKCOLOUR/BACKOPACITY are given. Example: --iso
+    /// 0.3:#ff8000:0.5,0.7:tf:1:#0040ff. At most 1024 surfaces; they need a
+    /// point field (see --cell-to-point).
+    #[arg(long, value_parser = parse_iso, allow_hyphen_values = true, value_name = "V[:STYLE],..")]
+    pub iso: Option<IsoList>,
+    /// Light of the isosurfaces: smooth (default; a headlight on the
+    /// points' gradients interpolated like the field), flat (one gradient
+    /// per cell or tet) or none (their colours as given).
+    #[arg(long, value_enum, default_value_t = Lighting::Smooth)]
+    pub shading: Lighting,
+    /// Draw the --iso surfaces without the volume, in any mode (what --mode
+    /// iso draws; with --mode raycast, its reference).
+    #[arg(long, requires = "iso")]
+    pub iso_only: bool,
     /// `--split all`: draw every cell as its consistent tetrahedra.
     #[arg(long, value_parser = ["all"])]
     pub split: Option<String>,
@@ -178,11 +212,56 @@ impl ViewArgs {
                 size: self.table,
                 build: self.table_build,
             },
+            iso: IsoOptions {
+                surfaces: self.iso.as_ref().map(|l| l.0.clone()).unwrap_or_default(),
+                lighting: self.shading,
+                alone: self.iso_only,
+            },
+        }
+    }
+
+    /// A warning for each isovalue outside the field's range `(lo, hi)`
+    /// (its surface is not drawn).
+    pub fn iso_range_warnings(&self, shading: &Shading) {
+        let (Some(list), Some(field)) = (&self.iso, &shading.field) else {
+            return;
+        };
+        let (lo, hi) = field.range;
+        for s in &list.0 {
+            if !(s.value >= lo && s.value <= hi) {
+                eprintln!(
+                    "zoovr: warning: isovalue {} is outside the range [{lo}, {hi}] of field '{}': \
+                     that surface is not drawn",
+                    s.value, field.name
+                );
+            }
         }
     }
 
     /// Flag combinations that are usage errors (beyond what clap checks).
     pub fn usage_error(&self) -> Option<String> {
+        if self.mode == Mode::Iso && self.iso.is_none() {
+            return Some("--mode iso draws isosurfaces only: give them with --iso V,V,...".into());
+        }
+        if self.mode == Mode::Exact && self.iso.is_some() && !self.iso_only {
+            return Some(
+                "--mode exact cannot draw isosurfaces (it slices pieces per vertex); use --mode \
+                 exact-frag, preint3d, preint2d, preint2d-cyl, iso or raycast with --iso"
+                    .into(),
+            );
+        }
+        if self.iso.is_some() && self.mode == Mode::Raycast {
+            if self.model == Some(FieldModel::Native) {
+                return Some(
+                    "--iso with --mode raycast needs --model faces or tets (isosurface \
+                     crossings of the native field are not implemented)"
+                        .into(),
+                );
+            }
+            if self.traversal == Some(Traversal::Brute) {
+                return Some("--iso with --mode raycast needs --traversal walk".into());
+            }
+        }
         if self.traversal == Some(Traversal::Brute) && self.model == Some(FieldModel::Native) {
             return Some(
                 "--traversal brute supports --model faces and --model tets, not --model native \
@@ -277,6 +356,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let t0 = std::time::Instant::now();
     let (geometry, shading) = args.view.load_scene(&args.file)?;
     let load_s = t0.elapsed().as_secs_f64();
+    args.view.iso_range_warnings(&shading);
     let ghost_cells = geometry.ghost_cells;
     let mut renderer = Renderer::new(geometry);
     if let Some(p) = pending {

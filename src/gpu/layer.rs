@@ -95,6 +95,7 @@ impl GpuVertex for LayerVertex {
 /// The layer stage.
 pub static LAYER_STAGE: StageDesc = StageDesc {
     name: "layer.wgsl",
+    fragment: "fs_main",
     wgsl: include_str!("../../shaders/layer.wgsl"),
     vertex: wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<LayerVertex>() as wgpu::BufferAddress,

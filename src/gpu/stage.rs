@@ -61,6 +61,10 @@ pub enum Binding {
 pub struct StageDesc {
     /// File name under `shaders/` (the cache key and the label).
     pub name: &'static str,
+    /// The fragment entry point that composites (`fs_main` unless the stage
+    /// gathers files that define one of their own, as the isosurface stages
+    /// do).
+    pub fragment: &'static str,
     /// The file's WGSL (without `shaders/common.wgsl`).
     pub wgsl: &'static str,
     /// Layout of the vertex buffer (`VertexIn`).
@@ -328,7 +332,7 @@ impl StageCache {
         // Premultiplied "over", back to front: dst = src + (1 - src.a) dst;
         // counting adds.
         let (blend, entry) = match kind {
-            DrawKind::Composite => (wgpu::BlendComponent::OVER, "fs_main"),
+            DrawKind::Composite => (wgpu::BlendComponent::OVER, self.desc.fragment),
             DrawKind::CountPieces | DrawKind::CountTriangles => (
                 wgpu::BlendComponent {
                     src_factor: wgpu::BlendFactor::One,

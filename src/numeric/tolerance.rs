@@ -380,3 +380,25 @@ pub const GAUSS_LEGENDRE_8_MAX_DEPTH: f64 = 0.5;
 /// rebuilt per fragment, still falls inside the table instead of being cut
 /// into two steps.
 pub const TABLE_LENGTH_MARGIN: f64 = 1e-3;
+
+/// A least-squares gradient fit ([`crate::render::gradients::fit_gradient`])
+/// whose normal-equation determinant is below this times the cube of the
+/// largest squared distance from the centroid comes from a flat (coplanar)
+/// set of points: the gradient across it is undefined and taken as zero
+/// (the determinant grows as the squared volume spanned: this flags pieces
+/// thinner than about 1e-6 of their size).
+pub const GRADIENT_FLAT_REL: f64 = 1e-12;
+
+/// Isosurface level, `f64` (the reference, cycle groups): a scalar reaches
+/// the isovalue `V` when it is at least `V - ISO_LEVEL_F64 * max(|V|, span)`
+/// (`span` the transfer function's node range). A surface through vertices
+/// with the value `V` (integer data, fields built from levels) is then one
+/// surface: barycentric interpolation of equal values rounds to a few ulps
+/// either side of `V`, and without the margin the segments on both sides
+/// of such a face would both or neither cross it.
+pub const ISO_LEVEL_F64: f64 = 1e-12;
+
+/// The same margin for the GPU stages and their twins, in normalised scalar
+/// units (`f32`, about 16 ulps of 1), relative to `max(1, |V|)`: the
+/// fragment's `s = (s q) / q` is interpolated in `f32`.
+pub const ISO_LEVEL_F32: f64 = 1e-6;

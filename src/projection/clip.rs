@@ -300,6 +300,7 @@ mod tests {
             points: pts,
             scalars,
             triangles: tris,
+            gradients: Vec::new(),
         };
         poly.orient_outward();
         poly

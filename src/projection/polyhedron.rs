@@ -31,6 +31,10 @@ pub struct Polyhedron {
     pub scalars: Vec<f64>,
     /// Boundary triangles, outward by the right-hand rule in world space.
     pub triangles: Vec<[u32; 3]>,
+    /// View-space gradient of the field per point, for smooth isosurface
+    /// shading ([`crate::render::gradients`]); empty unless the piece's
+    /// source fills it (builders and clippers leave it empty).
+    pub gradients: Vec<DVec3>,
 }
 
 impl Polyhedron {
@@ -39,6 +43,7 @@ impl Polyhedron {
         self.points.clear();
         self.scalars.clear();
         self.triangles.clear();
+        self.gradients.clear();
     }
 
     /// A tetrahedron from view-space corners (either orientation).

@@ -57,6 +57,7 @@
 pub mod brute;
 pub mod bvh;
 pub mod geometry;
+pub mod iso;
 pub mod native;
 pub mod walk;
 

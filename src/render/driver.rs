@@ -60,8 +60,9 @@ use crate::gpu::{
 use crate::image::Image;
 use crate::projection::coverage::PixelGrid;
 use crate::projection::{Polyhedron, Projected, Projector};
-use crate::tf::TransferFunction;
 use crate::visibility::{Piece, Sorter, SplitPolicy};
+
+pub use super::projected_mode::ProjectedMode;
 
 use super::group::composite_group;
 use super::pieces::{PartScratch, PieceError, PieceSource};
@@ -78,64 +79,6 @@ const CHUNK: usize = 2048;
 /// the memory in flight (about 0.4 MB per chunk on a fine mesh) while
 /// keeping every worker busy when chunk costs vary.
 const AHEAD_PER_WORKER: usize = 4;
-
-/// What a projected-cell mode adds to the shared driver: its split policy,
-/// its per-vertex payload, its stage (shader) and the stage's CPU twin.
-pub trait ProjectedMode: Sync {
-    /// The Rust mirror of the stage's `VertexIn`.
-    type Vertex: GpuVertex;
-    /// Per-worker scratch holding the payload of the piece being drawn.
-    type Payload: Default + Send;
-
-    /// TF values at which pieces are sliced (empty: never sliced).
-    fn split_points(&self, tf: &TransferFunction) -> Vec<f64>;
-
-    /// Whether regions are refined in perspective views until linear
-    /// interpolation in screen space is within
-    /// [`crate::numeric::tolerance::PERSPECTIVE_INTERP_REL`] (a mode whose
-    /// payload interpolates exactly in perspective says no).
-    fn perspective_refine(&self) -> bool {
-        true
-    }
-
-    /// Whether centres next to a part's outline are decided on the exact
-    /// geometry ([`super::ties`]): on for every mode (a mode whose stage
-    /// cannot draw a tie quad may say no).
-    fn decides_ties(&self) -> bool {
-        true
-    }
-
-    /// Binds the mode's stage for one frame (uniforms, tables) of `src`.
-    fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError>;
-
-    /// The CPU twin of the stage's fragment shader, for one frame of `src`.
-    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<Self::Vertex>>;
-
-    /// Computes the payload of `part`'s projection at every vertex
-    /// `used[i]` marks (a kept triangle uses it). It may refine
-    /// `proj.triangles` (adding vertices, then marking them used) and must
-    /// then cull them again when `src.cull`; `refined` counts the triangles
-    /// it added.
-    fn payload(
-        &self,
-        src: &PieceSource,
-        part: &Polyhedron,
-        proj: &mut Projected,
-        used: &mut Vec<bool>,
-        payload: &mut Self::Payload,
-        refined: &mut usize,
-    );
-
-    /// Vertex `i` of `proj` at normalised device coordinates `ndc` (on the
-    /// sub-pixel grid), in piece 0 (the driver numbers the pieces).
-    fn vertex(
-        &self,
-        payload: &Self::Payload,
-        proj: &Projected,
-        i: usize,
-        ndc: [f32; 2],
-    ) -> Self::Vertex;
-}
 
 /// Output of one chunk: vertices and triangles ready for the GPU.
 pub(super) struct ChunkOut<V> {
@@ -600,6 +543,9 @@ pub fn render_projected<M: ProjectedMode>(
         cull: opts.projected.cull_to_pixels,
         grid: PixelGrid::new(camera.width, camera.height),
         ties: TieRays::new(camera, scene.mesh.bounds()),
+        iso: mode.isosurfaces(),
+        volume: mode.draws_volume(),
+        gradients: mode.point_gradients(),
     };
     let t_open = Instant::now();
     let mut sink = match opts.projected.compositor {
@@ -705,6 +651,7 @@ mod tests {
     use crate::render::modes::exact::{ExactMode, ExactVertex};
     use crate::render::SceneSpec;
     use crate::tf::EmissionModel;
+    use crate::tf::TransferFunction;
     use crate::visibility::Order;
 
     /// The context of `order` for `scene` seen by `camera`.
@@ -727,6 +674,9 @@ mod tests {
             cull,
             grid: PixelGrid::new(camera.width, camera.height),
             ties: TieRays::new(camera, scene.mesh.bounds()),
+            iso: None,
+            volume: true,
+            gradients: None,
         }
     }
 

@@ -36,8 +36,8 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::gradients::{boundary_gradient, piece_gradient};
 use crate::camera::Camera;
-use crate::integrate::segment;
 use crate::projection::Polyhedron;
 use crate::visibility::Piece;
 
@@ -62,6 +62,8 @@ struct GroupPiece {
     /// each comes from.
     planes: Vec<(DVec3, f64, usize)>,
     poly: Polyhedron,
+    /// Its flat gradient (isosurface light), view space.
+    flat_gradient: DVec3,
     /// Pixel box `[x0, x1) x [y0, y1)`.
     bbox: [u32; 4],
 }
@@ -69,6 +71,8 @@ struct GroupPiece {
 /// A ray segment through one piece: parameters and scalars at both ends.
 #[derive(Clone, Copy, Debug)]
 struct Hit {
+    /// Index of the piece in the group's prepared pieces.
+    piece: usize,
     t_in: f64,
     t_out: f64,
     s_in: f64,
@@ -86,6 +90,7 @@ pub(super) fn composite_group(
     for piece in pieces {
         let mut poly = Polyhedron::default();
         src.polyhedron(piece, &mut poly)?;
+        src.piece_gradients(piece, &mut poly);
         let (lo, hi) = value_range(poly.scalars.iter().copied());
         if src.invisible(lo, hi) {
             layer.culled += 1;
@@ -114,12 +119,12 @@ pub(super) fn composite_group(
             for i in bbox[0]..bbox[2] {
                 hits.clear();
                 let (o, d) = view_ray(camera, i as f64 + 0.5, j as f64 + 0.5);
-                for p in &prepared {
+                for (k, p) in prepared.iter().enumerate() {
                     if i < p.bbox[0] || i >= p.bbox[2] || j < p.bbox[1] || j >= p.bbox[3] {
                         continue;
                     }
                     if let Some(h) = clip_ray(p, o, d, camera) {
-                        hits.push(h);
+                        hits.push(Hit { piece: k, ..h });
                     }
                 }
                 if hits.is_empty() {
@@ -128,7 +133,11 @@ pub(super) fn composite_group(
                 hits.sort_by(|a, b| (a.t_in + a.t_out).total_cmp(&(b.t_in + b.t_out)));
                 let (mut color, mut depth, mut trans) = ([0.0; 3], 0.0, 1.0);
                 for h in &hits {
-                    let seg = segment(src.tf, h.t_out - h.t_in, h.s_in, h.s_out);
+                    let seg = src.segment_value(h.t_out - h.t_in, h.s_in, h.s_out, || {
+                        let p = &prepared[h.piece];
+                        [h.t_in, h.t_out]
+                            .map(|t| boundary_gradient(&p.poly, o + d * t, p.flat_gradient))
+                    });
                     for (c, sc) in color.iter_mut().zip(seg.color) {
                         *c += trans * sc;
                     }
@@ -136,7 +145,8 @@ pub(super) fn composite_group(
                     depth += seg.depth;
                 }
                 let alpha = -(-depth).exp_m1();
-                if depth > 0.0 && depth.is_finite() && alpha > 0.0 {
+                // An opaque isosurface makes the depth infinite.
+                if depth > 0.0 && alpha > 0.0 && !depth.is_nan() {
                     let c = color.map(|c| c as f32);
                     row.push((i, j, [c[0], c[1], c[2], alpha as f32]));
                 }
@@ -205,7 +215,13 @@ fn prepare(poly: Polyhedron, camera: &Camera) -> Option<GroupPiece> {
     if bbox[0] >= bbox[2] || bbox[1] >= bbox[3] {
         return None;
     }
-    Some(GroupPiece { planes, poly, bbox })
+    let flat_gradient = piece_gradient(&poly);
+    Some(GroupPiece {
+        planes,
+        poly,
+        flat_gradient,
+        bbox,
+    })
 }
 
 /// Clips the ray `o + t d` to the piece (and, in perspective, to the near
@@ -250,6 +266,7 @@ fn clip_ray(p: &GroupPiece, o: DVec3, d: DVec3, camera: &Camera) -> Option<Hit> 
         scalar_on(&p.poly, f_in, o + d * t_in)
     };
     Some(Hit {
+        piece: 0,
         t_in,
         t_out,
         s_in,

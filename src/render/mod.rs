@@ -17,10 +17,13 @@
 
 pub mod breakpoints;
 pub mod driver;
+pub mod gradients;
 mod group;
+pub mod iso;
 pub mod modes;
 mod options;
 pub mod pieces;
+mod projected_mode;
 pub mod scene;
 pub mod stats;
 pub mod steps;
@@ -81,6 +84,14 @@ pub enum RenderError {
     Raycast(#[from] raycast::RaycastError),
     #[error(transparent)]
     TableSize(#[from] modes::preint_tables::TableSizeError),
+    #[error(transparent)]
+    Iso(#[from] iso::IsoError),
+    #[error("--mode {0} cannot draw isosurfaces (it slices pieces per vertex); --mode exact-frag, preint3d, preint2d, preint2d-cyl, iso and raycast can")]
+    IsoUnsupported(&'static str),
+    #[error("the ray caster draws isosurfaces on the faces and tets fields with the walk traversal (--model faces|tets, --traversal walk)")]
+    IsoReference,
+    #[error("--mode iso draws isosurfaces only: give them with --iso V,V,...")]
+    IsoMissing,
     #[error("the {mode} mode cannot draw {model:?} emission (it supports {supported}); modes that can: --mode {alternatives}")]
     Unsupported {
         mode: &'static str,
@@ -88,6 +99,26 @@ pub enum RenderError {
         supported: String,
         alternatives: String,
     },
+}
+
+/// The isosurface mode of a render with `--iso` (or `--mode iso`): the
+/// surfaces resolved against the scene's transfer function, over the
+/// volume of `opts.mode`, with the points' gradients for smooth light.
+fn iso_mode(scene: &Scene, opts: &RenderOptions) -> Result<modes::iso::IsoMode, RenderError> {
+    use modes::iso::{IsoMode, Volume};
+    let ScalarsRef::Point(values) = scene.scalars() else {
+        return Err(iso::IsoError::CellData.into());
+    };
+    let set = iso::IsoSet::new(&opts.iso, &scene.tf);
+    let volume = match opts.mode {
+        _ if opts.iso.alone => Volume::None,
+        Mode::Iso | Mode::Exact => Volume::None,
+        Mode::ExactFrag => Volume::Integral,
+        m => Volume::Table(modes::preint::PreintMode::for_mode(m, opts)?),
+    };
+    let grads = (set.lighting == iso::Lighting::Smooth)
+        .then(|| gradients::point_gradients(&scene.mesh, values));
+    Ok(IsoMode::new(volume, set, grads))
 }
 
 /// State reused across frames of one geometry: the geometry itself, the
@@ -188,6 +219,26 @@ impl Renderer {
         // The frame's scene: the geometry and the field shared, not copied.
         let scene = Scene::new(self.geometry.clone(), shading.clone());
         let (image, detail, setup_s) = match opts.mode {
+            Mode::Exact if opts.iso.any() && !opts.iso.alone => {
+                return Err(RenderError::IsoUnsupported("exact"))
+            }
+            Mode::Iso if !opts.iso.any() => return Err(RenderError::IsoMissing),
+            Mode::Iso
+            | Mode::Exact
+            | Mode::ExactFrag
+            | Mode::Preint3d
+            | Mode::Preint2d
+            | Mode::Preint2dCyl
+                if opts.iso.any() =>
+            {
+                let mode = iso_mode(&scene, opts)?;
+                let (img, mut detail, setup) =
+                    self.projected(&mode, &scene, opts, camera, progress)?;
+                if let ModeStats::Projected(s) = &mut detail {
+                    s.table = mode.take_stats();
+                }
+                (img, detail, setup)
+            }
             Mode::Exact => {
                 self.projected(&modes::exact::ExactMode, &scene, opts, camera, progress)?
             }
@@ -207,6 +258,7 @@ impl Renderer {
                 }
                 (img, detail, setup)
             }
+            Mode::Iso => return Err(RenderError::IsoMissing),
             Mode::Raycast => {
                 let (img, s, setup) = modes::raycast::render(&scene, opts, camera, progress)?;
                 (img, ModeStats::Raycast(s), setup)

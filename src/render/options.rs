@@ -10,6 +10,7 @@ use crate::camera::CameraParams;
 use crate::gpu::{AccumFormat, DrawKind, GpuOptions};
 use crate::raycast::{FieldModel, Traversal};
 
+use super::iso::IsoOptions;
 use super::Mode;
 
 /// Per-render options.
@@ -26,6 +27,9 @@ pub struct RenderOptions {
     /// Options of the pre-integrated table modes (`preint3d`, `preint2d`,
     /// `preint2d-cyl`).
     pub tables: TableOptions,
+    /// Isosurfaces (`--iso`, `--shading`): drawn by `--mode iso`, mixed
+    /// with the volume by the segment modes and the ray caster.
+    pub iso: IsoOptions,
 }
 
 /// How the pre-integration tables are built (`--table-build`).

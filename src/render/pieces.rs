@@ -18,7 +18,8 @@ use super::ties::TieRays;
 use glam::DVec3;
 
 use crate::camera::Camera;
-use crate::integrate::RayMaterial;
+use crate::integrate::segment;
+use crate::integrate::{RayMaterial, SegmentValue};
 use crate::mesh::Mesh;
 use crate::numeric::tolerance::{LEFT_LIMIT_FLOOR, LEFT_LIMIT_REL};
 use crate::projection::coverage::PixelGrid;
@@ -28,6 +29,7 @@ use crate::visibility::bsp::Fragment;
 use crate::visibility::slabs::{band_values, tet_slabs, SlabScratch};
 use crate::visibility::Piece;
 
+use super::iso::IsoSet;
 use super::scene::ScalarsRef;
 
 /// A piece that cannot be made into a polyhedron.
@@ -74,6 +76,16 @@ pub struct PieceSource<'a> {
     /// The frame's pixel rays for the exact decisions next to outlines
     /// ([`super::ties`]).
     pub ties: TieRays,
+    /// The isosurfaces drawn ([`super::iso`]): a piece whose scalar range
+    /// holds one is drawn even where the volume is dark; cycle groups
+    /// composite them.
+    pub iso: Option<&'a IsoSet>,
+    /// Whether the volume is drawn (false for `--mode iso`: only pieces
+    /// holding a surface are).
+    pub volume: bool,
+    /// World-space gradient per point for smooth isosurface shading: the
+    /// parts get [`Polyhedron::gradients`] in view space.
+    pub gradients: Option<&'a [DVec3]>,
 }
 
 /// Scratch of [`PieceSource::parts`], reused from piece to piece.
@@ -163,6 +175,7 @@ impl PieceSource<'_> {
                     return Ok(done);
                 }
                 self.cell(c, poly)?;
+                self.point_gradients(nodes.iter().copied(), poly);
                 draw(poly)?;
             }
             Piece::Tet { tet, .. } => {
@@ -175,11 +188,16 @@ impl PieceSource<'_> {
                 // A tet holding a breakpoint comes as its slabs
                 // (`Piece::Slab`): the TF is linear on this one.
                 poly.set_tet(p, s);
+                self.point_gradients(tet.into_iter(), poly);
                 draw(poly)?;
             }
             Piece::Frag { tet, frag, .. } => {
                 *whole_of = None;
                 self.fragment(cell, tet, frag, whole)?;
+                if let (Some(g), Some(f)) = (self.gradients, self.fragments.get(frag as usize)) {
+                    let corner = tet.map(|n| self.view_gradient(g, n));
+                    whole.gradients = f.positions(&corner);
+                }
                 let (lo, hi) = value_range(whole.scalars.iter().copied());
                 if self.invisible(lo, hi) {
                     done.invisible = true;
@@ -230,6 +248,49 @@ impl PieceSource<'_> {
             }
         }
         Ok(done)
+    }
+
+    /// Fills `poly.gradients` of [`Self::polyhedron`]'s `piece` (not of a
+    /// slab, whose clipped points have none), when the source has
+    /// gradients.
+    pub fn piece_gradients(&self, piece: &Piece, poly: &mut Polyhedron) {
+        let Some(g) = self.gradients else {
+            return;
+        };
+        match *piece {
+            Piece::Cell(c) => {
+                self.point_gradients(self.mesh.cells.nodes(c as usize).iter().copied(), poly)
+            }
+            Piece::Tet { tet, .. } => self.point_gradients(tet.into_iter(), poly),
+            Piece::Frag { tet, frag, .. } => {
+                if let Some(f) = self.fragments.get(frag as usize) {
+                    let corner = tet.map(|n| self.view_gradient(g, n));
+                    poly.gradients = f.positions(&corner);
+                }
+            }
+            Piece::Slab { .. } => {}
+        }
+    }
+
+    /// Fills `poly.gradients` (view space) from the points `ids` of its
+    /// points, in order, when the source has gradients.
+    fn point_gradients(&self, ids: impl Iterator<Item = u32>, poly: &mut Polyhedron) {
+        if let Some(g) = self.gradients {
+            poly.gradients.clear();
+            poly.gradients.extend(ids.map(|n| self.view_gradient(g, n)));
+        }
+    }
+
+    /// The view-space gradient of point `n`.
+    #[inline]
+    fn view_gradient(&self, g: &[DVec3], n: u32) -> DVec3 {
+        let c = self.camera;
+        super::gradients::to_view(
+            g.get(n as usize).copied().unwrap_or(DVec3::ZERO),
+            c.right,
+            c.up,
+            c.forward,
+        )
     }
 
     /// The view-space polyhedron of whole cell `c`.
@@ -300,7 +361,35 @@ impl PieceSource<'_> {
         band_values(self.levels, lo, hi)
     }
 
-    /// Whether the material is dark over the whole scalar interval: zero
+    /// The segment of length `l` from `s_f` to `s_b` of a piece: its volume
+    /// (when drawn) split at the isosurfaces it crosses, whose gradients at
+    /// its two ends `grads` gives (view space, called only for a segment
+    /// that crosses one).
+    pub fn segment_value(
+        &self,
+        l: f64,
+        s_f: f64,
+        s_b: f64,
+        grads: impl FnOnce() -> [DVec3; 2],
+    ) -> SegmentValue {
+        let volume = |l: f64, a: f64, b: f64| {
+            if self.volume {
+                segment(self.tf, l, a, b)
+            } else {
+                SegmentValue::default()
+            }
+        };
+        match self.iso {
+            Some(set) if !set.crossed(s_f, s_b).is_empty() => {
+                set.composite(l, s_f, s_b, grads(), DVec3::Z, volume)
+            }
+            _ => volume(l, s_f, s_b),
+        }
+    }
+
+    /// Whether nothing of a piece with scalars in `[lo, hi]` is drawn: it
+    /// holds no isosurface, and the volume is not drawn or the material is
+    /// dark over the whole interval: zero
     /// extinction and (independent emission) zero emission at both ends and
     /// on both sides of every transfer-function node inside, so (the
     /// function being piecewise linear) everywhere. Every node is checked,
@@ -309,6 +398,12 @@ impl PieceSource<'_> {
     pub fn invisible(&self, lo: f64, hi: f64) -> bool {
         if !(lo.is_finite() && hi.is_finite()) {
             return false;
+        }
+        if self.iso.is_some_and(|set| set.any_in(lo, hi)) {
+            return false;
+        }
+        if !self.volume {
+            return true;
         }
         let dark = |s: f64| {
             let m = self.tf.material(s);

@@ -59,7 +59,9 @@ pub static INFO: ModeInfo = ModeInfo {
 /// the fragment entry points.
 pub static EXACT_FRAG_STAGE: StageDesc = StageDesc {
     name: "exact_frag.wgsl",
+    fragment: "fs_main",
     wgsl: concat!(
+        include_str!("../../../shaders/segment_vertex.wgsl"),
         include_str!("../../../shaders/segment.wgsl"),
         include_str!("../../../shaders/integral.wgsl"),
         include_str!("../../../shaders/exact_frag.wgsl"),
@@ -75,15 +77,27 @@ pub fn bind_exact_frag_stage(
     view: &SegmentView,
     tf: &TfBuffer,
 ) -> Result<Stage, GpuError> {
+    bind_integral_stage(gpu, &EXACT_FRAG_STAGE, view, tf, &[])
+}
+
+/// Binds `stage`, a stage on the segment payload with the closed-form
+/// integral at bindings 1 and 2, with `extra` resources from binding 3 on.
+pub fn bind_integral_stage(
+    gpu: &Context,
+    stage: &'static StageDesc,
+    view: &SegmentView,
+    tf: &TfBuffer,
+    extra: &[Resource],
+) -> Result<Stage, GpuError> {
     let consts = closed_form_constants();
-    gpu.bind_stage(
-        &EXACT_FRAG_STAGE,
-        &[
-            Resource::Uniform(bytemuck::bytes_of(view)),
-            Resource::Storage(&tf.bytes()),
-            Resource::Storage(bytemuck::cast_slice(&consts)),
-        ],
-    )
+    let tf = tf.bytes();
+    let mut res = vec![
+        Resource::Uniform(bytemuck::bytes_of(view)),
+        Resource::Storage(&tf),
+        Resource::Storage(bytemuck::cast_slice(&consts)),
+    ];
+    res.extend_from_slice(extra);
+    gpu.bind_stage(stage, &res)
 }
 
 /// The exact-frag stage's bindings on the CPU (view, transfer function,
@@ -114,6 +128,18 @@ impl ExactFragTwin {
             tf,
             consts: closed_form_constants(),
         }
+    }
+}
+
+impl ExactFragTwin {
+    /// The integral of the segment `(l, s_f, s_b)` (normalised scalars).
+    pub fn volume(&self, l: f32, sf: f32, sb: f32) -> [f32; 4] {
+        self.tf.integrate_segment(&self.consts, l, sf, sb)
+    }
+
+    /// The stage's view and clip mapping.
+    pub fn view(&self) -> (SegmentView, ClipMapper) {
+        (self.view, self.mapper)
     }
 }
 

@@ -27,6 +27,7 @@
 pub mod exact;
 pub mod exact_frag;
 pub mod integral;
+pub mod iso;
 pub mod preint;
 pub mod preint2d;
 pub mod preint2d_cyl;
@@ -67,6 +68,9 @@ pub enum Mode {
     /// Projection of convex pieces, the 3D table re-mapped into cylindrical
     /// 2D planes.
     Preint2dCyl,
+    /// Isosurfaces alone (`--iso`), found per fragment between the
+    /// segment's end scalars, in the exact order.
+    Iso,
     /// The CPU reference ray caster.
     Raycast,
 }
@@ -113,6 +117,7 @@ impl Mode {
         Mode::Preint3d,
         Mode::Preint2d,
         Mode::Preint2dCyl,
+        Mode::Iso,
         Mode::Raycast,
     ];
 
@@ -124,6 +129,7 @@ impl Mode {
             Mode::Preint3d => &preint3d::INFO,
             Mode::Preint2d => &preint2d::INFO,
             Mode::Preint2dCyl => &preint2d_cyl::INFO,
+            Mode::Iso => &iso::INFO,
             Mode::Raycast => &raycast::INFO,
         }
     }
@@ -175,6 +181,11 @@ pub const SHADERS: &[(&str, &str)] = &[
         "integral.wgsl",
         include_str!("../../../shaders/integral.wgsl"),
     ),
+    ("iso.wgsl", include_str!("../../../shaders/iso.wgsl")),
+    (
+        "iso_vertex.wgsl",
+        include_str!("../../../shaders/iso_vertex.wgsl"),
+    ),
     ("layer.wgsl", LAYER_STAGE.wgsl),
     ("preint.wgsl", include_str!("../../../shaders/preint.wgsl")),
     (
@@ -192,6 +203,10 @@ pub const SHADERS: &[(&str, &str)] = &[
     (
         "segment.wgsl",
         include_str!("../../../shaders/segment.wgsl"),
+    ),
+    (
+        "segment_vertex.wgsl",
+        include_str!("../../../shaders/segment_vertex.wgsl"),
     ),
     (
         "table_build.wgsl",

@@ -262,6 +262,19 @@ pub fn fs_main(stage: &PreintTwin, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> 
     ))
 }
 
+impl PreintTwin {
+    /// The segment `(l, s_f, s_b)` (normalised scalars) through
+    /// [`preint_segment`].
+    pub fn volume(&self, l: f32, sf: f32, sb: f32) -> [f32; 4] {
+        preint_segment(&self.params, &self.table, self.lookup, sf, sb, l)
+    }
+
+    /// The stage's view and clip mapping.
+    pub fn view(&self) -> (SegmentView, ClipMapper) {
+        (self.view, self.mapper)
+    }
+}
+
 impl CpuStage<SegmentVertex> for PreintTwin {
     fn shade(&self, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
         fs_main(self, tri, bary)
@@ -330,6 +343,11 @@ impl PreintMode {
         PreintMode::new(kind, stage, lookup, opts)
     }
 
+    /// The kind of table it looks up.
+    pub fn kind(&self) -> TableKind {
+        self.kind
+    }
+
     /// What the last frame's table build did.
     pub fn take_stats(&self) -> Option<TableStats> {
         self.stats.lock().ok().and_then(|mut s| s.take())
@@ -355,14 +373,17 @@ impl PreintMode {
         TableSpec::new(self.kind, self.opts.size, l)
     }
 
-    /// Binds the stage for one frame of `tf` seen by `camera`, with the
-    /// device's cached table.
-    fn bind_stage(
+    /// Binds the stage (the mode's own, or `stage` on the same first three
+    /// bindings, with `extra` from binding 3 on) for one frame of `tf` seen
+    /// by `camera`, with the device's cached table.
+    pub fn bind_stage(
         &self,
         gpu: &Context,
+        stage: Option<&'static StageDesc>,
         mesh: &crate::mesh::Mesh,
         tf: &TransferFunction,
         camera: &Camera,
+        extra: &[Resource],
     ) -> Result<Stage, GpuError> {
         let n = self.opts.size.unwrap_or(self.kind.default_size());
         Table::check_size(gpu.limits(), self.kind.dim(), self.kind.extent(n))?;
@@ -376,14 +397,13 @@ impl PreintMode {
         }
         let view = SegmentView::of(camera);
         let params = PreintParams::new(tf, &spec);
-        gpu.bind_stage(
-            self.stage,
-            &[
-                Resource::Uniform(bytemuck::bytes_of(&view)),
-                Resource::Table(&table),
-                Resource::Uniform(bytemuck::bytes_of(&params)),
-            ],
-        )
+        let mut res = vec![
+            Resource::Uniform(bytemuck::bytes_of(&view)),
+            Resource::Table(&table),
+            Resource::Uniform(bytemuck::bytes_of(&params)),
+        ];
+        res.extend_from_slice(extra);
+        gpu.bind_stage(stage.unwrap_or(self.stage), &res)
     }
 
     /// The CPU twin for one frame (its table built on the CPU, or the
@@ -426,7 +446,7 @@ impl PreintMode {
 
 impl SegmentMode for PreintMode {
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
-        self.bind_stage(gpu, src.mesh, src.tf, src.camera)
+        self.bind_stage(gpu, None, src.mesh, src.tf, src.camera, &[])
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {

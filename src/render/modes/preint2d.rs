@@ -57,7 +57,9 @@ pub static INFO: ModeInfo = ModeInfo {
 /// The preint2d stage.
 pub static PREINT2D_STAGE: StageDesc = StageDesc {
     name: "preint2d.wgsl",
+    fragment: "fs_main",
     wgsl: concat!(
+        include_str!("../../../shaders/segment_vertex.wgsl"),
         include_str!("../../../shaders/segment.wgsl"),
         include_str!("../../../shaders/preint.wgsl"),
         include_str!("../../../shaders/preint2d.wgsl"),

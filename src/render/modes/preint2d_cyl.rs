@@ -58,7 +58,9 @@ pub static INFO: ModeInfo = ModeInfo {
 /// The preint2d-cyl stage.
 pub static PREINT2D_CYL_STAGE: StageDesc = StageDesc {
     name: "preint2d_cyl.wgsl",
+    fragment: "fs_main",
     wgsl: concat!(
+        include_str!("../../../shaders/segment_vertex.wgsl"),
         include_str!("../../../shaders/segment.wgsl"),
         include_str!("../../../shaders/preint.wgsl"),
         include_str!("../../../shaders/preint2d_cyl.wgsl"),

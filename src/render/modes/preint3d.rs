@@ -53,7 +53,9 @@ pub static INFO: ModeInfo = ModeInfo {
 /// The preint3d stage.
 pub static PREINT3D_STAGE: StageDesc = StageDesc {
     name: "preint3d.wgsl",
+    fragment: "fs_main",
     wgsl: concat!(
+        include_str!("../../../shaders/segment_vertex.wgsl"),
         include_str!("../../../shaders/segment.wgsl"),
         include_str!("../../../shaders/preint.wgsl"),
         include_str!("../../../shaders/preint3d.wgsl"),

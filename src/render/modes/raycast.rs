@@ -9,7 +9,11 @@ use std::time::Instant;
 use crate::camera::Camera;
 use crate::image::Image;
 use crate::raycast::brute::Brute;
+use crate::raycast::iso::{Empty, IsoReference};
+use crate::raycast::FieldModel;
 use crate::raycast::{self, RayTracer, RaycastOptions, Raycaster, Traversal};
+use crate::render::gradients::point_gradients;
+use crate::render::iso::{IsoError, IsoSet, Lighting};
 use crate::render::scene::{ScalarsRef, Scene};
 use crate::render::stats::RaycastStats;
 use crate::render::{RenderError, RenderOptions};
@@ -29,13 +33,17 @@ pub static INFO: ModeInfo = ModeInfo {
 };
 
 /// Renders one image with the ray caster; returns it with its statistics
-/// and the seconds spent building the ray caster.
+/// and the seconds spent building the ray caster. With `opts.iso`, the
+/// isosurfaces are mixed with the volume ([`render_iso`]).
 pub(crate) fn render(
     scene: &Scene,
     opts: &RenderOptions,
     camera: &Camera,
     progress: impl FnMut(usize, usize),
 ) -> Result<(Image, RaycastStats, f64), RenderError> {
+    if opts.iso.any() {
+        return render_iso(scene, opts, camera, !opts.iso.alone, progress);
+    }
     let t0 = Instant::now();
     let scalars = match scene.scalars() {
         ScalarsRef::Point(v) => raycast::Scalars::Point(v),
@@ -77,6 +85,53 @@ pub(crate) fn render(
             stats.brute = b.stats().since(&before);
             img
         }
+    };
+    Ok((img, stats, setup_s))
+}
+
+/// The reference with the isosurfaces of `opts.iso`, over the volume
+/// (`volume`) or alone (the reference of `--mode iso`): the walk
+/// traversal, `faces` or `tets` field ([`crate::raycast::iso`]).
+pub fn render_iso(
+    scene: &Scene,
+    opts: &RenderOptions,
+    camera: &Camera,
+    volume: bool,
+    progress: impl FnMut(usize, usize),
+) -> Result<(Image, RaycastStats, f64), RenderError> {
+    let t0 = Instant::now();
+    let ScalarsRef::Point(values) = scene.scalars() else {
+        return Err(IsoError::CellData.into());
+    };
+    if opts.reference.model == FieldModel::Native || opts.reference.traversal != Traversal::Walk {
+        return Err(RenderError::IsoReference);
+    }
+    let rs = raycast::Scene {
+        mesh: &scene.mesh,
+        topology: &scene.topology,
+        scalars: raycast::Scalars::Point(values),
+    };
+    let ro = RaycastOptions {
+        model: opts.reference.model,
+        traversal: opts.reference.traversal,
+        ..Default::default()
+    };
+    let set = IsoSet::new(&opts.iso, &scene.tf);
+    let grads = (set.lighting == Lighting::Smooth).then(|| point_gradients(&scene.mesh, values));
+    let rc = Raycaster::new(rs, opts.reference.model)?;
+    let iso = IsoReference::new(&rc, &set, camera.forward, grads.as_deref(), values);
+    let setup_s = t0.elapsed().as_secs_f64();
+    let img = if volume {
+        iso.render_with_progress(&scene.tf, camera, &ro, progress)
+    } else {
+        iso.render_with_progress(&Empty, camera, &ro, progress)
+    };
+    let stats = RaycastStats {
+        model: opts.reference.model,
+        traversal: opts.reference.traversal,
+        termination_transmittance: ro.early_termination,
+        native: Default::default(),
+        brute: Default::default(),
     };
     Ok((img, stats, setup_s))
 }

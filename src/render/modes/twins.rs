@@ -14,6 +14,8 @@
 //!   struct such as [`super::exact::ExactTwin`], which implements
 //!   [`crate::gpu::cpu::CpuStage`] by calling it) and the triangle and
 //!   barycentric weights the CPU rasteriser hands it, its `VertexOut`;
+//! - a file of untwinned functions only (`segment_vertex.wgsl`,
+//!   `iso_vertex.wgsl`: vertex stages) has no twins at all;
 //! - `vs_main` and `fs_count` have no twin of their own: the CPU frame
 //!   ([`crate::gpu::cpu::CpuFrame`]) plays the vertex stage (clip positions
 //!   pass through; each twin interpolates and scales its attributes) and
@@ -29,7 +31,9 @@ use std::any::type_name_of_val as path;
 
 use super::exact::exptable::{self, ExpTable};
 use super::integral::{self, TfBuffer};
-use super::{exact, exact_frag, preint, preint2d, preint2d_cyl, preint3d, segment, table_build};
+use super::{
+    exact, exact_frag, iso, preint, preint2d, preint2d_cyl, preint3d, segment, table_build,
+};
 use crate::gpu::{common, layer};
 use crate::integrate::cylinder;
 
@@ -55,6 +59,9 @@ pub struct StageTwins {
 }
 
 macro_rules! twins {
+    ($file:literal) => {
+        StageTwins { file: $file, twins: Vec::new() }
+    };
     ($file:literal: $($f:expr),* $(,)?) => {
         StageTwins { file: $file, twins: vec![$(path(&$f)),*] }
     };
@@ -73,6 +80,10 @@ pub fn stage_twins() -> Vec<StageTwins> {
             integral::ends_increasing, integral::ends_decreasing,
             integral::sanitize_thickness, integral::gauss, integral::weights,
             TfBuffer::add_piece, TfBuffer::add_sub, TfBuffer::integrate_segment),
+        twins!("iso.wgsl":
+            iso::count_at_most, iso::iso_light, iso::iso_surface, iso::iso_over,
+            iso::iso_segment, iso::fs_iso),
+        twins!("iso_vertex.wgsl"),
         twins!("layer.wgsl": layer::fs_main),
         twins!("preint.wgsl":
             preint::one_minus_exp_over, preint::homogeneous, preint::over, preint::axis,
@@ -82,6 +93,7 @@ pub fn stage_twins() -> Vec<StageTwins> {
         twins!("preint2d_cyl.wgsl": preint2d_cyl::table_rgba),
         twins!("preint3d.wgsl": preint3d::table_rgba),
         twins!("segment.wgsl": segment::segment_at),
+        twins!("segment_vertex.wgsl"),
         twins!("table_build.wgsl":
             cylinder::cyl_to_table, table_build::optical_depth, table_build::build_main),
     ]
@@ -131,7 +143,11 @@ pub fn check_twins(file: &str, src: &str, twins: &[&str]) -> Vec<String> {
             Some(_) => {}
         }
     }
-    if !twins.iter().any(|p| in_module(p)) {
+    // A file of untwinned functions only (a vertex stage) needs no module.
+    let needs_module = fns
+        .iter()
+        .any(|(f, _)| !NOT_TWINNED.iter().any(|(n, _)| n == f));
+    if needs_module && !twins.iter().any(|p| in_module(p)) {
         errors.push(format!("{file}: no twin in a module named {module}"));
     }
     for p in twins {

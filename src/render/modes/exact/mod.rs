@@ -161,6 +161,7 @@ pub struct ExactParams {
 /// The exact stage.
 pub static EXACT_STAGE: StageDesc = StageDesc {
     name: "exact.wgsl",
+    fragment: "fs_main",
     wgsl: include_str!("../../../../shaders/exact.wgsl"),
     vertex: wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<ExactVertex>() as wgpu::BufferAddress,

@@ -1,0 +1,131 @@
+// Isosurfaces on the segment payload, alone or mixed with the volume
+// (Roettger, Kraus, Ertl 2000, sections 7-10, without extracted triangles;
+// src/render/iso.rs states the rules). The fragment rebuilds its segment
+// (s_f, s_b, l; shaders/segment.wgsl) and the gradients at its ends
+// (shaders/iso_vertex.wgsl), finds by binary search the isovalues V with
+// min(s_f, s_b) < V <= max(s_f, s_b), and composites front to back: the
+// volume up to the first crossing, the lit surface, the volume up to the
+// next, ..., the volume after the last. `volume(l, s0, s1)` is the stage's
+// volume integral (the exact-frag integral, a table lookup, or nothing for
+// `--mode iso`), defined by the stage next to this file. Only the values a
+// segment crosses are visited.
+//
+// Bindings 3 and 4 (after the volume's own 0-2). Twin: render::modes::iso.
+
+// Keep in sync with `IsoParams` in src/render/modes/iso.rs.
+struct IsoParams {
+    // Number of surfaces.
+    count: u32,
+    // 0: no light, 1: flat, 2: smooth (the gradients differ, not the light).
+    lighting: u32,
+    ambient: f32,
+    diffuse: f32,
+}
+
+// Keep in sync with `IsoSurface` in src/render/modes/iso.rs.
+struct IsoSurface {
+    // x: the normalised isovalue (increasing with the index).
+    value: vec4<f32>,
+    // Straight colour and opacity of the front (rising) and back sides.
+    front: vec4<f32>,
+    back: vec4<f32>,
+}
+
+@group(0) @binding(3) var<uniform> iso: IsoParams;
+@group(0) @binding(4) var<storage, read> surfaces: array<IsoSurface>;
+
+// The number of isovalues <= x.
+fn count_at_most(x: f32) -> u32 {
+    var lo = 0u;
+    var hi = iso.count;
+    loop {
+        if lo >= hi {
+            break;
+        }
+        let mid = (lo + hi) / 2u;
+        if surfaces[mid].value.x <= x {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// The headlight's factor for gradient g (view space: the view direction is
+// +z); 1 without light or without a gradient.
+fn iso_light(g: vec3<f32>) -> f32 {
+    if iso.lighting == 0u {
+        return 1.0;
+    }
+    let n = length(g);
+    if !(n > 0.0) || !finite(n) {
+        return 1.0;
+    }
+    return iso.ambient + iso.diffuse * min(abs(g.z) / n, 1.0);
+}
+
+// Premultiplied colour and opacity of surface k crossed rising or falling.
+fn iso_surface(k: u32, rising: bool, g: vec3<f32>) -> vec4<f32> {
+    var c = surfaces[k].back;
+    if rising {
+        c = surfaces[k].front;
+    }
+    return vec4<f32>(c.xyz * (iso_light(g) * c.w), c.w);
+}
+
+// `back` behind `front` (premultiplied).
+fn iso_over(front: vec4<f32>, back: vec4<f32>) -> vec4<f32> {
+    let t = 1.0 - front.w;
+    return vec4<f32>(front.xyz + t * back.xyz, front.w + t * back.w);
+}
+
+// The segment with its surfaces, front to back.
+fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>) -> vec4<f32> {
+    let lo = min(seg.s_f, seg.s_b);
+    let hi = max(seg.s_f, seg.s_b);
+    var a = 0u;
+    var b = 0u;
+    if lo < hi {
+        a = count_at_most(lo);
+        b = count_at_most(hi);
+    }
+    if a >= b {
+        return volume(seg.l, seg.s_f, seg.s_b);
+    }
+    let rising = seg.s_f < seg.s_b;
+    var acc = vec4<f32>(0.0);
+    var u0 = 0.0;
+    var s0 = seg.s_f;
+    for (var i = a; i < b; i++) {
+        var k = i;
+        if !rising {
+            k = a + b - 1u - i;
+        }
+        let v = surfaces[k].value.x;
+        let u = clamp((v - seg.s_f) / (seg.s_b - seg.s_f), 0.0, 1.0);
+        acc = iso_over(acc, volume((u - u0) * seg.l, s0, v));
+        acc = iso_over(acc, iso_surface(k, rising, mix(gf, gb, u)));
+        u0 = u;
+        s0 = v;
+    }
+    return iso_over(acc, volume((1.0 - u0) * seg.l, s0, seg.s_b));
+}
+
+@fragment
+fn fs_iso(f: VertexOut) -> FragOut {
+    let seg = segment_at(f, f.clip.xy);
+    if !seg.ok {
+        discard;
+    }
+    var gf = f.grad_front;
+    var gb = f.grad_back;
+    if view.ortho != 1u {
+        gf = gf / f.front.y;
+        gb = gb / f.back.y;
+    }
+    var out: FragOut;
+    out.color = iso_segment(seg, gf, gb);
+    out.depth = piece_depth(f.piece);
+    return out;
+}

@@ -1,0 +1,616 @@
+//! Isosurfaces on the projected-cell driver: `--mode iso` (surfaces alone)
+//! and `--iso` with `exact-frag` or a table mode (surfaces mixed with the
+//! volume, in each piece's place in the exact order). The rules (what a
+//! crossing is, the sides, the light, the mixing) are in
+//! [`crate::render::iso`]; this is the GPU stage and its twin.
+//!
+//! On the shared driver ([`crate::render::driver`]) the mode supplies:
+//! - **split policy**: none (as the segment modes: the fragment finds its
+//!   crossings between `s_f` and `s_b`, so no cell is split for a surface);
+//! - **skipping**: pieces whose scalar range holds no isovalue are drawn
+//!   only for the volume, and not at all in `--mode iso`
+//!   ([`ProjectedMode::isosurfaces`], [`ProjectedMode::draws_volume`]);
+//! - **payload**: the segment payload ([`super::segment`]) and the gradient
+//!   at each region vertex's entry and exit points ([`IsoVertex`]): flat
+//!   (the part's least-squares gradient) or smooth (the points' gradients
+//!   interpolated on the boundary triangle holding the point,
+//!   [`crate::render::gradients`]); in perspective multiplied by `q = 1/z`
+//!   like the scalars, so they interpolate exactly;
+//! - **stage**: `shaders/iso_vertex.wgsl`, `shaders/segment.wgsl`, the
+//!   volume's files, a one-line `volume(l, s0, s1)` (the closed-form
+//!   integral, the table lookup, or zero), and `shaders/iso.wgsl` with the
+//!   entry point `fs_iso` ([`fs_iso`] is its twin, on the same volume
+//!   twins as the segment modes).
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec2, DVec3};
+
+use crate::gpu::cpu::{lerp, CpuStage};
+use crate::gpu::{Binding, ClipMapper, Context, GpuError, GpuVertex, Resource, Stage, StageDesc};
+use crate::numeric::tolerance::ISO_LEVEL_F32;
+use crate::projection::{Polyhedron, Projected};
+use crate::render::driver::ProjectedMode;
+use crate::render::gradients::{boundary_gradient, piece_gradient};
+use crate::render::iso::{IsoSet, Lighting, AMBIENT, DIFFUSE};
+use crate::render::pieces::PieceSource;
+use crate::tf::{EmissionModel, TransferFunction};
+
+use super::exact_frag::{bind_integral_stage, ExactFragTwin};
+use super::integral::TfBuffer;
+use super::preint::{PreintMode, PreintTwin};
+use super::preint_tables::{TableKind, TableStats};
+use super::segment::{segment_at, ScalarMap, Seg, SegmentPayload, SegmentVertex, SegmentView};
+use super::{Bounds, ModeInfo};
+use crate::raycast::FieldModel;
+
+/// The registry entry of `--mode iso`.
+pub static INFO: ModeInfo = ModeInfo {
+    name: "iso",
+    summary: "isosurfaces alone (--iso), found per fragment between the segment's end scalars, in the exact order",
+    gpu: true,
+    emission: &[EmissionModel::Glow, EmissionModel::Independent],
+    slices_at_breakpoints: false,
+    stage: Some(&ISO_STAGE),
+    bounds: Some(Bounds {
+        reference: FieldModel::Faces,
+        // Measured in tests/iso.rs (f32 crossings and light; silhouettes of
+        // surfaces may differ on single pixels, counted there).
+        split_max: 2.0 / 255.0,
+        whole_max: 2.0 / 255.0,
+    }),
+};
+
+/// One vertex of the isosurface stages: the segment vertex and the
+/// gradients at the entry and exit points. Keep in sync with `VertexIn` in
+/// `shaders/iso_vertex.wgsl`.
+#[repr(C)]
+#[derive(Pod, Zeroable, Clone, Copy, Debug, Default, PartialEq)]
+pub struct IsoVertex {
+    pub seg: SegmentVertex,
+    /// `g_f` (orthographic) or `g_f q_f` (perspective), view space,
+    /// normalised scalar units.
+    pub grad_front: [f32; 3],
+    /// `g_b` or `g_b q_b`.
+    pub grad_back: [f32; 3],
+}
+
+impl IsoVertex {
+    /// Vertex attributes (`@location`s of `VertexIn`).
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 7] = wgpu::vertex_attr_array![
+        0 => Float32x4,
+        1 => Float32x2,
+        2 => Float32x2,
+        3 => Float32,
+        4 => Uint32,
+        5 => Float32x3,
+        6 => Float32x3,
+    ];
+
+    /// The vertex buffer layout of the isosurface stages.
+    pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<IsoVertex>() as wgpu::BufferAddress,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &IsoVertex::ATTRIBUTES,
+    };
+}
+
+impl GpuVertex for IsoVertex {
+    fn clip(&self) -> [f32; 4] {
+        self.seg.pos
+    }
+    fn piece(&self) -> u32 {
+        self.seg.piece
+    }
+    fn with_piece(self, piece: u32) -> Self {
+        IsoVertex {
+            seg: self.seg.with_piece(piece),
+            ..self
+        }
+    }
+    fn is_finite(&self) -> bool {
+        self.seg.is_finite()
+            && self.grad_front.iter().all(|v| v.is_finite())
+            && self.grad_back.iter().all(|v| v.is_finite())
+    }
+    fn with_clip(self, pos: [f32; 4]) -> Self {
+        IsoVertex {
+            seg: self.seg.with_clip(pos),
+            ..self
+        }
+    }
+    fn lerp3(tri: [&Self; 3], bary: [f64; 3]) -> Self {
+        IsoVertex {
+            seg: SegmentVertex::lerp3(tri.map(|v| &v.seg), bary),
+            grad_front: [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_front[k])),
+            grad_back: [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_back[k])),
+        }
+    }
+    fn transparent(self) -> Self {
+        // The empty segment at one scalar: no volume, no crossing.
+        IsoVertex {
+            seg: SegmentVertex {
+                back: self.seg.front,
+                ..self.seg.transparent()
+            },
+            ..self
+        }
+    }
+}
+
+/// The isosurface uniform. Keep in sync with `IsoParams` in
+/// `shaders/iso.wgsl`.
+#[repr(C)]
+#[derive(Pod, Zeroable, Clone, Copy, Debug, Default, PartialEq)]
+pub struct IsoParams {
+    pub count: u32,
+    pub lighting: u32,
+    pub ambient: f32,
+    pub diffuse: f32,
+}
+
+/// One surface as the stage reads it. Keep in sync with `IsoSurface` in
+/// `shaders/iso.wgsl`.
+#[repr(C)]
+#[derive(Pod, Zeroable, Clone, Copy, Debug, Default, PartialEq)]
+pub struct IsoSurface {
+    /// `x`: the normalised isovalue.
+    pub value: [f32; 4],
+    pub front: [f32; 4],
+    pub back: [f32; 4],
+}
+
+/// The uniform and the surface list of `set`, its values through `map`
+/// (one zero surface when the set is empty: a storage binding is never
+/// empty).
+pub fn iso_buffers(set: &IsoSet, map: &ScalarMap) -> (IsoParams, Vec<IsoSurface>) {
+    let params = IsoParams {
+        count: set.values.len() as u32,
+        lighting: set.lighting.code(),
+        ambient: AMBIENT as f32,
+        diffuse: DIFFUSE as f32,
+    };
+    let mut surfaces: Vec<IsoSurface> = set
+        .values
+        .iter()
+        .zip(&set.sides)
+        .map(|(&v, sides)| IsoSurface {
+            value: [gpu_level(map.apply(v)), 0.0, 0.0, 0.0],
+            front: sides[0].map(|c| c as f32),
+            back: sides[1].map(|c| c as f32),
+        })
+        .collect();
+    if surfaces.is_empty() {
+        surfaces.push(IsoSurface::default());
+    }
+    (params, surfaces)
+}
+
+/// The level the stage compares with for normalised isovalue `v`: `v` in
+/// `f32` less [`ISO_LEVEL_F32`] of its scale (see [`IsoSet::levels`]).
+pub fn gpu_level(v: f64) -> f32 {
+    let v32 = v as f32;
+    (v32 as f64 - ISO_LEVEL_F32 * v.abs().max(1.0)) as f32
+}
+
+macro_rules! iso_stage {
+    ($name:literal, [$($file:literal),*], $glue:literal, $bindings:expr) => {
+        StageDesc {
+            name: $name,
+            fragment: "fs_iso",
+            wgsl: concat!(
+                include_str!("../../../shaders/iso_vertex.wgsl"),
+                include_str!("../../../shaders/segment.wgsl"),
+                $(include_str!(concat!("../../../shaders/", $file)),)*
+                $glue,
+                include_str!("../../../shaders/iso.wgsl"),
+            ),
+            vertex: IsoVertex::LAYOUT,
+            bindings: $bindings,
+        }
+    };
+}
+
+const INTEGRAL_BINDINGS: &[Binding] = &[
+    Binding::Uniform,
+    Binding::Storage,
+    Binding::Storage,
+    Binding::Uniform,
+    Binding::Storage,
+];
+
+/// `--mode iso`: no volume (the integral's bindings are bound, unused).
+pub static ISO_STAGE: StageDesc = iso_stage!(
+    "iso.wgsl",
+    ["integral.wgsl"],
+    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return vec4<f32>(0.0);\n}\n",
+    INTEGRAL_BINDINGS
+);
+
+/// `--iso` with `exact-frag`: the closed-form integral between crossings.
+pub static ISO_EXACT_FRAG_STAGE: StageDesc = iso_stage!(
+    "iso.wgsl+exact_frag",
+    ["integral.wgsl"],
+    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return integrate_segment(l, sf, sb);\n}\n",
+    INTEGRAL_BINDINGS
+);
+
+/// `--iso` with `preint3d`.
+pub static ISO_PREINT3D_STAGE: StageDesc = iso_stage!(
+    "iso.wgsl+preint3d",
+    ["preint.wgsl", "preint3d.wgsl"],
+    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
+    &[
+        Binding::Uniform,
+        Binding::Table3d,
+        Binding::Uniform,
+        Binding::Uniform,
+        Binding::Storage
+    ]
+);
+
+/// `--iso` with `preint2d`.
+pub static ISO_PREINT2D_STAGE: StageDesc = iso_stage!(
+    "iso.wgsl+preint2d",
+    ["preint.wgsl", "preint2d.wgsl"],
+    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
+    &[
+        Binding::Uniform,
+        Binding::Table2d,
+        Binding::Uniform,
+        Binding::Uniform,
+        Binding::Storage
+    ]
+);
+
+/// `--iso` with `preint2d-cyl`.
+pub static ISO_PREINT2D_CYL_STAGE: StageDesc = iso_stage!(
+    "iso.wgsl+preint2d_cyl",
+    ["preint.wgsl", "preint2d_cyl.wgsl"],
+    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
+    &[
+        Binding::Uniform,
+        Binding::Table2dArray,
+        Binding::Uniform,
+        Binding::Uniform,
+        Binding::Storage
+    ]
+);
+
+/// The volume between the crossings.
+pub enum Volume {
+    /// None (`--mode iso`).
+    None,
+    /// The closed-form integral per fragment (`exact-frag`).
+    Integral,
+    /// A pre-integrated table mode.
+    Table(PreintMode),
+}
+
+/// The volume's twin.
+pub enum VolumeTwin {
+    None,
+    Integral(ExactFragTwin),
+    Table(PreintTwin),
+}
+
+impl VolumeTwin {
+    /// Twin of the stage's `volume`.
+    pub fn volume(&self, l: f32, sf: f32, sb: f32) -> [f32; 4] {
+        match self {
+            VolumeTwin::None => [0.0; 4],
+            VolumeTwin::Integral(t) => t.volume(l, sf, sb),
+            VolumeTwin::Table(t) => t.volume(l, sf, sb),
+        }
+    }
+}
+
+/// The isosurface stage's bindings on the CPU, for its twin [`fs_iso`].
+pub struct IsoTwin {
+    view: SegmentView,
+    mapper: ClipMapper,
+    params: IsoParams,
+    surfaces: Vec<IsoSurface>,
+    volume: VolumeTwin,
+}
+
+/// Twin of `count_at_most`: the number of isovalues `<= x`.
+pub fn count_at_most(stage: &IsoTwin, x: f32) -> u32 {
+    let (mut lo, mut hi) = (0u32, stage.params.count);
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if stage.surfaces[mid as usize].value[0] <= x {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// Twin of `iso_light`.
+pub fn iso_light(stage: &IsoTwin, g: [f32; 3]) -> f32 {
+    if stage.params.lighting == 0 {
+        return 1.0;
+    }
+    let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+    if n.is_nan() || n <= 0.0 || !n.is_finite() {
+        return 1.0;
+    }
+    stage.params.ambient + stage.params.diffuse * (g[2].abs() / n).min(1.0)
+}
+
+/// Twin of `iso_surface`.
+pub fn iso_surface(stage: &IsoTwin, k: u32, rising: bool, g: [f32; 3]) -> [f32; 4] {
+    let s = &stage.surfaces[k as usize];
+    let c = if rising { s.front } else { s.back };
+    let i = iso_light(stage, g) * c[3];
+    [c[0] * i, c[1] * i, c[2] * i, c[3]]
+}
+
+/// Twin of `iso_over`.
+pub fn iso_over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
+    let t = 1.0 - front[3];
+    std::array::from_fn(|k| front[k] + t * back[k])
+}
+
+/// Twin of `iso_segment`.
+pub fn iso_segment(stage: &IsoTwin, seg: &Seg, gf: [f32; 3], gb: [f32; 3]) -> [f32; 4] {
+    let (lo, hi) = (seg.s_f.min(seg.s_b), seg.s_f.max(seg.s_b));
+    let (mut a, mut b) = (0, 0);
+    if lo < hi {
+        a = count_at_most(stage, lo);
+        b = count_at_most(stage, hi);
+    }
+    let volume = |l: f32, s0: f32, s1: f32| stage.volume.volume(l, s0, s1);
+    if a >= b {
+        return volume(seg.l, seg.s_f, seg.s_b);
+    }
+    let rising = seg.s_f < seg.s_b;
+    let mut acc = [0.0f32; 4];
+    let (mut u0, mut s0) = (0.0f32, seg.s_f);
+    for i in a..b {
+        let k = if rising { i } else { a + b - 1 - i };
+        let v = stage.surfaces[k as usize].value[0];
+        let u = ((v - seg.s_f) / (seg.s_b - seg.s_f)).clamp(0.0, 1.0);
+        acc = iso_over(acc, volume((u - u0) * seg.l, s0, v));
+        let g = std::array::from_fn(|c| gf[c] + (gb[c] - gf[c]) * u);
+        acc = iso_over(acc, iso_surface(stage, k, rising, g));
+        (u0, s0) = (u, v);
+    }
+    iso_over(acc, volume((1.0 - u0) * seg.l, s0, seg.s_b))
+}
+
+/// Twin of `fs_iso` in `shaders/iso.wgsl`, the fragment at weights `bary`
+/// of `tri` drawn with `stage`'s bindings.
+pub fn fs_iso(stage: &IsoTwin, tri: [&IsoVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
+    let seg = segment_at(&stage.view, &stage.mapper, tri.map(|v| &v.seg), bary);
+    if !seg.ok {
+        return None;
+    }
+    let mut gf = [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_front[k]));
+    let mut gb = [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_back[k]));
+    if stage.view.ortho != 1 {
+        let qf = lerp(tri, bary, |v| v.seg.front[1]);
+        let qb = lerp(tri, bary, |v| v.seg.back[1]);
+        gf = gf.map(|g| g / qf);
+        gb = gb.map(|g| g / qb);
+    }
+    Some(iso_segment(stage, &seg, gf, gb))
+}
+
+impl CpuStage<IsoVertex> for IsoTwin {
+    fn shade(&self, tri: [&IsoVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
+        fs_iso(self, tri, bary)
+    }
+
+    fn describe(&self, tri: [&IsoVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {
+        let seg = segment_at(&self.view, &self.mapper, tri.map(|v| &v.seg), bary);
+        vec![("s_f", seg.s_f), ("s_b", seg.s_b), ("l", seg.l)]
+    }
+}
+
+/// The payload of one part: the segment payload, and the entry and exit
+/// gradients of every vertex (normalised scalar units, view space).
+#[derive(Default)]
+pub struct IsoPayload {
+    seg: SegmentPayload,
+    grads: Vec<[DVec3; 2]>,
+}
+
+/// Isosurfaces alone or over a volume, on the projected-cell driver.
+pub struct IsoMode {
+    volume: Volume,
+    set: IsoSet,
+    /// World-space point gradients (smooth light).
+    gradients: Option<Vec<DVec3>>,
+}
+
+impl IsoMode {
+    /// The surfaces `set` over `volume`; `gradients` are the points'
+    /// (needed for smooth light, [`crate::render::gradients::point_gradients`]).
+    pub fn new(volume: Volume, set: IsoSet, gradients: Option<Vec<DVec3>>) -> IsoMode {
+        IsoMode {
+            volume,
+            set,
+            gradients,
+        }
+    }
+
+    /// What the last frame's table build did (a table volume).
+    pub fn take_stats(&self) -> Option<TableStats> {
+        match &self.volume {
+            Volume::Table(p) => p.take_stats(),
+            _ => None,
+        }
+    }
+
+    fn stage(&self) -> &'static StageDesc {
+        match &self.volume {
+            Volume::None => &ISO_STAGE,
+            Volume::Integral => &ISO_EXACT_FRAG_STAGE,
+            Volume::Table(p) => match p.kind() {
+                TableKind::Cube => &ISO_PREINT3D_STAGE,
+                TableKind::Flat => &ISO_PREINT2D_STAGE,
+                TableKind::Cylinder => &ISO_PREINT2D_CYL_STAGE,
+            },
+        }
+    }
+
+    /// The twin for one frame of `tf` seen by `camera` over `mesh`.
+    pub fn twin_for(
+        &self,
+        mesh: &crate::mesh::Mesh,
+        tf: &TransferFunction,
+        camera: &crate::camera::Camera,
+    ) -> IsoTwin {
+        let map = ScalarMap::of(tf);
+        let (params, surfaces) = iso_buffers(&self.set, &map);
+        let volume = match &self.volume {
+            Volume::None => VolumeTwin::None,
+            Volume::Integral => VolumeTwin::Integral(ExactFragTwin::new(tf, camera)),
+            Volume::Table(p) => VolumeTwin::Table(p.twin_for(mesh, tf, camera)),
+        };
+        IsoTwin {
+            view: SegmentView::of(camera),
+            mapper: ClipMapper::for_camera(camera),
+            params,
+            surfaces,
+            volume,
+        }
+    }
+}
+
+/// A region vertex's entry (`side` 0) or exit point in view space.
+fn view_point(proj: &Projected, i: usize, side: usize) -> DVec3 {
+    let v = &proj.vertices[i];
+    let z = if side == 0 { v.z_front } else { v.z_back };
+    let u = proj.view.plane(DVec2::new(v.px, v.py));
+    if proj.view.ortho {
+        DVec3::new(u.x, u.y, z)
+    } else {
+        DVec3::new(u.x * z, u.y * z, z)
+    }
+}
+
+impl ProjectedMode for IsoMode {
+    type Vertex = IsoVertex;
+    type Payload = IsoPayload;
+
+    fn split_points(&self, _tf: &TransferFunction) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn perspective_refine(&self) -> bool {
+        SegmentVertex::needs_perspective_refinement()
+    }
+
+    fn isosurfaces(&self) -> Option<&IsoSet> {
+        Some(&self.set)
+    }
+
+    fn draws_volume(&self) -> bool {
+        !matches!(self.volume, Volume::None)
+    }
+
+    fn point_gradients(&self) -> Option<&[DVec3]> {
+        match self.set.lighting {
+            Lighting::Smooth => self.gradients.as_deref(),
+            _ => None,
+        }
+    }
+
+    fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
+        let map = ScalarMap::of(src.tf);
+        let (params, surfaces) = iso_buffers(&self.set, &map);
+        let extra = [
+            Resource::Uniform(bytemuck::bytes_of(&params)),
+            Resource::Storage(bytemuck::cast_slice(&surfaces)),
+        ];
+        let view = SegmentView::of(src.camera);
+        match &self.volume {
+            Volume::None | Volume::Integral => {
+                let tf = TfBuffer::new(src.tf, &map);
+                bind_integral_stage(gpu, self.stage(), &view, &tf, &extra)
+            }
+            Volume::Table(p) => p.bind_stage(
+                gpu,
+                Some(self.stage()),
+                src.mesh,
+                src.tf,
+                src.camera,
+                &extra,
+            ),
+        }
+    }
+
+    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<IsoVertex>> {
+        Box::new(self.twin_for(src.mesh, src.tf, src.camera))
+    }
+
+    fn payload(
+        &self,
+        src: &PieceSource,
+        part: &Polyhedron,
+        proj: &mut Projected,
+        used: &mut Vec<bool>,
+        payload: &mut IsoPayload,
+        _refined: &mut usize,
+    ) {
+        payload.seg.set(src);
+        let scale = payload.seg.map.scale;
+        payload.grads.clear();
+        payload.grads.resize(proj.vertices.len(), [DVec3::ZERO; 2]);
+        if self.set.lighting == Lighting::None {
+            return;
+        }
+        let flat = piece_gradient(part) * scale;
+        let smooth =
+            self.set.lighting == Lighting::Smooth && part.gradients.len() == part.points.len();
+        for (i, g) in payload.grads.iter_mut().enumerate() {
+            if !used.get(i).copied().unwrap_or(true) {
+                continue;
+            }
+            *g = if smooth {
+                [0, 1].map(|side| {
+                    boundary_gradient(part, view_point(proj, i, side), flat / scale) * scale
+                })
+            } else {
+                [flat; 2]
+            };
+        }
+    }
+
+    fn vertex(&self, payload: &IsoPayload, proj: &Projected, i: usize, ndc: [f32; 2]) -> IsoVertex {
+        let seg = SegmentVertex::of(proj, i, ndc, &payload.seg.map, payload.seg.ortho);
+        let g = payload.grads.get(i).copied().unwrap_or([DVec3::ZERO; 2]);
+        let v = &proj.vertices[i];
+        let (zf, zb) = (v.z_front, v.z_back.max(v.z_front));
+        let (qf, qb) = if payload.seg.ortho || !(zf > 0.0 && zb.is_finite()) {
+            (1.0, 1.0)
+        } else {
+            (1.0 / zf, 1.0 / zb)
+        };
+        let f32x3 = |g: DVec3, q: f64| {
+            let g = g * q;
+            [g.x as f32, g.y as f32, g.z as f32].map(|c| if c.is_finite() { c } else { 0.0 })
+        };
+        IsoVertex {
+            seg,
+            grad_front: f32x3(g[0], qf),
+            grad_back: f32x3(g[1], qb),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layout_matches_struct() {
+        assert_eq!(std::mem::size_of::<IsoVertex>(), 64);
+        let offs: Vec<u64> = IsoVertex::ATTRIBUTES.iter().map(|a| a.offset).collect();
+        assert_eq!(offs, vec![0, 16, 24, 32, 36, 40, 52]);
+        assert_eq!(std::mem::size_of::<IsoSurface>(), 48);
+    }
+}

@@ -1,0 +1,113 @@
+//! `zoovr render --iso` through the real binary: surfaces drawn in every
+//! mode that draws them, and the bad inputs (exit 2 naming the value, a
+//! warning for values outside the field's range, a clear error for cell
+//! data).
+
+mod cli_util;
+
+use cli_util::{no_adapter, render, stderr};
+use zoovr::image::Image;
+use zoovr::testdata::mesh_file;
+
+fn lit_pixels(png: &std::path::Path) -> usize {
+    let img = Image::read(png).unwrap();
+    img.pixels.iter().filter(|p| p[0] > 0.1).count()
+}
+
+#[test]
+fn surfaces_render_alone_and_mixed() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = mesh_file("zoo_3x3x3.vtu");
+    for (mode, extra) in [
+        ("iso", vec![]),
+        ("exact-frag", vec![]),
+        ("preint2d", vec![]),
+        ("raycast", vec!["--iso-only"]),
+        ("exact", vec!["--iso-only"]),
+    ] {
+        let out = dir.path().join(format!("{mode}.png"));
+        let mut args = vec![
+            "--mode",
+            mode,
+            "--iso",
+            "0.5:#ff0000,0.8:#00ff00:0.5",
+            "--size",
+            "64x64",
+            "--shading",
+            "flat",
+        ];
+        args.extend(extra);
+        let o = render(&file, &out, &args);
+        if no_adapter(&o) {
+            continue;
+        }
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        assert!(lit_pixels(&out) > 200, "{mode}: no surface");
+    }
+}
+
+#[test]
+fn bad_isovalues_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let file = mesh_file("zoo_3x3x3.vtu");
+    let many = vec!["0.5"; 1025].join(",");
+    for (args, says) in [
+        (vec!["--iso", "nan"], "'nan'"),
+        (vec!["--iso", "0.5,abc"], "'abc'"),
+        (vec!["--iso", "0.5:#12345"], "#12345"),
+        (vec!["--iso", "0.5:tf:1.5"], "1.5"),
+        (vec!["--iso", &many], "1025"),
+        (vec!["--mode", "iso"], "--iso"),
+        (vec!["--mode", "exact", "--iso", "0.5"], "exact"),
+        (
+            vec!["--mode", "raycast", "--model", "native", "--iso", "0.5"],
+            "native",
+        ),
+    ] {
+        let o = render(&file, &out, &args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{args:?}: {}", stderr(&o));
+    }
+}
+
+#[test]
+fn isovalues_outside_the_range_warn_and_draw_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let o = render(
+        &mesh_file("zoo_3x3x3.vtu"),
+        &out,
+        &[
+            "--mode",
+            "raycast",
+            "--iso-only",
+            "--iso",
+            "7.5",
+            "--size",
+            "32x32",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("outside the range"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("7.5"), "{}", stderr(&o));
+    assert_eq!(lit_pixels(&out), 0);
+}
+
+#[test]
+fn cell_data_is_refused_with_a_hint() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let mesh = zoovr::generate::ghost_grid(3, &zoovr::generate::Warp::default());
+    let file = dir.path().join("cells.vtu");
+    zoovr::io::writer::write_vtu(&file, &mesh, zoovr::io::writer::Compression::None).unwrap();
+    let o = render(
+        &file,
+        &out,
+        &[
+            "--mode", "raycast", "--field", "value", "--iso", "1", "--size", "16x16",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--cell-to-point"), "{}", stderr(&o));
+}
