@@ -80,36 +80,73 @@ fn iso_over(front: vec4<f32>, back: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(front.xyz + t * back.xyz, front.w + t * back.w);
 }
 
-// The segment with its surfaces, front to back.
-fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>) -> vec4<f32> {
+// Whether the segment crosses surface k at level v: exactly (lo < v <= hi),
+// or, for an opaque surface, within the snap bound e_f of its front end. Where
+// pieces meet at a face, the piece behind claims a crossing its front end
+// is that close to, so the pixel sees the surface at least once: when the
+// piece in front crossed it too, its copy (the true one, drawn first in
+// front-to-back order) hides this one; when the snap made the piece in
+// front miss it, this one fills the crack.
+fn iso_crosses(k: u32, v: f32, seg: Seg, e: vec2<f32>) -> bool {
     let lo = min(seg.s_f, seg.s_b);
     let hi = max(seg.s_f, seg.s_b);
+    if v > lo && v <= hi {
+        return true;
+    }
+    let s = surfaces[k];
+    let opaque = s.front.w >= 1.0 && s.back.w >= 1.0;
+    return opaque && abs(seg.s_f - v) <= e.x;
+}
+
+// The segment with its surfaces, front to back. One loop, one call of
+// `volume` (inlined once: the volume integral is the stage's largest
+// function): step i < b ends the volume at crossing k and adds the surface,
+// step b ends it at the segment's back.
+fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, e: vec2<f32>) -> vec4<f32> {
+    let lo = min(seg.s_f, seg.s_b);
+    let hi = max(seg.s_f, seg.s_b);
+    let m = max(e.x, e.y);
+    // Most segments cross nothing: two reads decide it before any search.
     var a = 0u;
     var b = 0u;
-    if lo < hi {
-        a = count_at_most(lo);
-        b = count_at_most(hi);
+    if iso.count > 0u && hi + m >= surfaces[0].value.x
+        && lo - m <= surfaces[iso.count - 1u].value.x {
+        a = count_at_most(lo - m);
+        b = max(count_at_most(hi + m), a);
     }
-    if a >= b {
-        return volume(seg.l, seg.s_f, seg.s_b);
-    }
-    let rising = seg.s_f < seg.s_b;
+    let rising = seg.s_f <= seg.s_b;
+    let d = seg.s_b - seg.s_f;
     var acc = vec4<f32>(0.0);
     var u0 = 0.0;
     var s0 = seg.s_f;
-    for (var i = a; i < b; i++) {
-        var k = i;
-        if !rising {
-            k = a + b - 1u - i;
+    for (var i = a; i <= b; i++) {
+        var u = 1.0;
+        var sv = seg.s_b;
+        var k = 0u;
+        if i < b {
+            k = i;
+            if !rising {
+                k = a + b - 1u - i;
+            }
+            let v = surfaces[k].value.x;
+            if !iso_crosses(k, v, seg, e) {
+                continue;
+            }
+            u = 0.0;
+            if d != 0.0 {
+                u = clamp((v - seg.s_f) / d, 0.0, 1.0);
+            }
+            // The scalar there: v, or the end a near crossing snaps to.
+            sv = clamp(v, lo, hi);
         }
-        let v = surfaces[k].value.x;
-        let u = clamp((v - seg.s_f) / (seg.s_b - seg.s_f), 0.0, 1.0);
-        acc = iso_over(acc, volume((u - u0) * seg.l, s0, v));
-        acc = iso_over(acc, iso_surface(k, rising, mix(gf, gb, u)));
+        acc = iso_over(acc, volume((u - u0) * seg.l, s0, sv));
+        if i < b {
+            acc = iso_over(acc, iso_surface(k, rising, mix(gf, gb, u)));
+        }
         u0 = u;
-        s0 = v;
+        s0 = sv;
     }
-    return iso_over(acc, volume((1.0 - u0) * seg.l, s0, seg.s_b));
+    return acc;
 }
 
 @fragment
@@ -125,7 +162,7 @@ fn fs_iso(f: VertexOut) -> FragOut {
         gb = gb / f.back.y;
     }
     var out: FragOut;
-    out.color = iso_segment(seg, gf, gb);
+    out.color = iso_segment(seg, gf, gb, f.snap);
     out.depth = piece_depth(f.piece);
     return out;
 }

@@ -402,3 +402,17 @@ pub const ISO_LEVEL_F64: f64 = 1e-12;
 /// units (`f32`, about 16 ulps of 1), relative to `max(1, |V|)`: the
 /// fragment's `s = (s q) / q` is interpolated in `f32`.
 pub const ISO_LEVEL_F32: f64 = 1e-6;
+
+/// How far (pixels) the snap of region corners to the 1/256-pixel grid can
+/// move where a fragment's boundary-triangle values are evaluated, with a
+/// margin: a corner moves at most 1/512 pixel per axis (sqrt(2)/512 in all),
+/// and a pixel centre within 1/256 pixel of a region's edge may be drawn by
+/// the neighbouring region, whose face is extrapolated that far. An opaque
+/// isosurface within this times the face's screen gradient of a segment's
+/// end counts as crossed (shaders/iso.wgsl `iso_crosses`).
+pub const ISO_SNAP_PX: f64 = 1.0 / 128.0;
+
+/// The largest snap bound (normalised scalar units): faces seen edge-on
+/// have unbounded screen gradients over slivers that colour no pixel of
+/// their own; past this an opaque surface would grow visibly.
+pub const ISO_SNAP_MAX: f64 = 1e-3;

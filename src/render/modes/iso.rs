@@ -27,10 +27,10 @@ use glam::{DVec2, DVec3};
 
 use crate::gpu::cpu::{lerp, CpuStage};
 use crate::gpu::{Binding, ClipMapper, Context, GpuError, GpuVertex, Resource, Stage, StageDesc};
-use crate::numeric::tolerance::ISO_LEVEL_F32;
-use crate::projection::{Polyhedron, Projected};
+use crate::numeric::tolerance::{ISO_LEVEL_F32, ISO_SNAP_MAX, ISO_SNAP_PX};
+use crate::projection::{FaceTri, Polyhedron, Projected};
 use crate::render::driver::ProjectedMode;
-use crate::render::gradients::{boundary_gradient, piece_gradient};
+use crate::render::gradients::{barycentric, boundary_gradient, piece_gradient};
 use crate::render::iso::{IsoSet, Lighting, AMBIENT, DIFFUSE};
 use crate::render::pieces::PieceSource;
 use crate::tf::{EmissionModel, TransferFunction};
@@ -72,11 +72,14 @@ pub struct IsoVertex {
     pub grad_front: [f32; 3],
     /// `g_b` or `g_b q_b`.
     pub grad_back: [f32; 3],
+    /// How far the snap of region corners to the sub-pixel grid can move
+    /// `s_f` and `s_b` here ([`snap_bound`]), normalised units.
+    pub snap: [f32; 2],
 }
 
 impl IsoVertex {
     /// Vertex attributes (`@location`s of `VertexIn`).
-    pub const ATTRIBUTES: [wgpu::VertexAttribute; 7] = wgpu::vertex_attr_array![
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 8] = wgpu::vertex_attr_array![
         0 => Float32x4,
         1 => Float32x2,
         2 => Float32x2,
@@ -84,6 +87,7 @@ impl IsoVertex {
         4 => Uint32,
         5 => Float32x3,
         6 => Float32x3,
+        7 => Float32x2,
     ];
 
     /// The vertex buffer layout of the isosurface stages.
@@ -111,6 +115,7 @@ impl GpuVertex for IsoVertex {
         self.seg.is_finite()
             && self.grad_front.iter().all(|v| v.is_finite())
             && self.grad_back.iter().all(|v| v.is_finite())
+            && self.snap.iter().all(|v| v.is_finite())
     }
     fn with_clip(self, pos: [f32; 4]) -> Self {
         IsoVertex {
@@ -123,15 +128,18 @@ impl GpuVertex for IsoVertex {
             seg: SegmentVertex::lerp3(tri.map(|v| &v.seg), bary),
             grad_front: [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_front[k])),
             grad_back: [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_back[k])),
+            snap: [0, 1].map(|k| lerp(tri, bary, |v| v.snap[k])),
         }
     }
     fn transparent(self) -> Self {
-        // The empty segment at one scalar: no volume, no crossing.
+        // The empty segment at one scalar: no volume, no crossing (not
+        // even a near one).
         IsoVertex {
             seg: SegmentVertex {
                 back: self.seg.front,
                 ..self.seg.transparent()
             },
+            snap: [-1.0; 2],
             ..self
         }
     }
@@ -353,31 +361,60 @@ pub fn iso_over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
     std::array::from_fn(|k| front[k] + t * back[k])
 }
 
-/// Twin of `iso_segment`.
-pub fn iso_segment(stage: &IsoTwin, seg: &Seg, gf: [f32; 3], gb: [f32; 3]) -> [f32; 4] {
+/// Twin of `iso_crosses`.
+pub fn iso_crosses(stage: &IsoTwin, k: u32, v: f32, seg: &Seg, e: [f32; 2]) -> bool {
     let (lo, hi) = (seg.s_f.min(seg.s_b), seg.s_f.max(seg.s_b));
+    if v > lo && v <= hi {
+        return true;
+    }
+    let s = &stage.surfaces[k as usize];
+    let opaque = s.front[3] >= 1.0 && s.back[3] >= 1.0;
+    opaque && (seg.s_f - v).abs() <= e[0]
+}
+
+/// Twin of `iso_segment`.
+pub fn iso_segment(
+    stage: &IsoTwin,
+    seg: &Seg,
+    gf: [f32; 3],
+    gb: [f32; 3],
+    e: [f32; 2],
+) -> [f32; 4] {
+    let (lo, hi) = (seg.s_f.min(seg.s_b), seg.s_f.max(seg.s_b));
+    let m = e[0].max(e[1]);
+    let n = stage.params.count as usize;
     let (mut a, mut b) = (0, 0);
-    if lo < hi {
-        a = count_at_most(stage, lo);
-        b = count_at_most(stage, hi);
+    if n > 0 && hi + m >= stage.surfaces[0].value[0] && lo - m <= stage.surfaces[n - 1].value[0] {
+        a = count_at_most(stage, lo - m);
+        b = count_at_most(stage, hi + m).max(a);
     }
-    let volume = |l: f32, s0: f32, s1: f32| stage.volume.volume(l, s0, s1);
-    if a >= b {
-        return volume(seg.l, seg.s_f, seg.s_b);
-    }
-    let rising = seg.s_f < seg.s_b;
+    let rising = seg.s_f <= seg.s_b;
+    let d = seg.s_b - seg.s_f;
     let mut acc = [0.0f32; 4];
     let (mut u0, mut s0) = (0.0f32, seg.s_f);
-    for i in a..b {
-        let k = if rising { i } else { a + b - 1 - i };
-        let v = stage.surfaces[k as usize].value[0];
-        let u = ((v - seg.s_f) / (seg.s_b - seg.s_f)).clamp(0.0, 1.0);
-        acc = iso_over(acc, volume((u - u0) * seg.l, s0, v));
-        let g = std::array::from_fn(|c| gf[c] + (gb[c] - gf[c]) * u);
-        acc = iso_over(acc, iso_surface(stage, k, rising, g));
-        (u0, s0) = (u, v);
+    for i in a..=b {
+        let (mut u, mut sv, mut k) = (1.0f32, seg.s_b, 0);
+        if i < b {
+            k = if rising { i } else { a + b - 1 - i };
+            let v = stage.surfaces[k as usize].value[0];
+            if !iso_crosses(stage, k, v, seg, e) {
+                continue;
+            }
+            u = if d != 0.0 {
+                ((v - seg.s_f) / d).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            sv = v.clamp(lo, hi);
+        }
+        acc = iso_over(acc, stage.volume.volume((u - u0) * seg.l, s0, sv));
+        if i < b {
+            let g = std::array::from_fn(|c| gf[c] + (gb[c] - gf[c]) * u);
+            acc = iso_over(acc, iso_surface(stage, k, rising, g));
+        }
+        (u0, s0) = (u, sv);
     }
-    iso_over(acc, volume((1.0 - u0) * seg.l, s0, seg.s_b))
+    acc
 }
 
 /// Twin of `fs_iso` in `shaders/iso.wgsl`, the fragment at weights `bary`
@@ -395,7 +432,8 @@ pub fn fs_iso(stage: &IsoTwin, tri: [&IsoVertex; 3], bary: [f64; 3]) -> Option<[
         gf = gf.map(|g| g / qf);
         gb = gb.map(|g| g / qb);
     }
-    Some(iso_segment(stage, &seg, gf, gb))
+    let e = [0, 1].map(|k| lerp(tri, bary, |v| v.snap[k]));
+    Some(iso_segment(stage, &seg, gf, gb, e))
 }
 
 impl CpuStage<IsoVertex> for IsoTwin {
@@ -410,11 +448,38 @@ impl CpuStage<IsoVertex> for IsoTwin {
 }
 
 /// The payload of one part: the segment payload, and the entry and exit
-/// gradients of every vertex (normalised scalar units, view space).
+/// gradients of every vertex (normalised scalar units, view space) with
+/// their snap bounds.
 #[derive(Default)]
 pub struct IsoPayload {
     seg: SegmentPayload,
     grads: Vec<[DVec3; 2]>,
+    snap: Vec<[f64; 2]>,
+    /// Scratch: the vertices whose gradients are set.
+    done: Vec<bool>,
+}
+
+/// How far the scalar a fragment rebuilds on a boundary triangle can move
+/// when the region corners are snapped to the sub-pixel grid: the
+/// triangle's scalar gradient across the screen (per pixel) times
+/// [`ISO_SNAP_PX`], capped at [`ISO_SNAP_MAX`] (a face seen edge-on has an
+/// unbounded screen gradient over a sliver of no area).
+pub fn snap_bound(face: &FaceTri, scale: f64) -> f64 {
+    let [a, b, c] = face.p;
+    let (e1, e2) = (b - a, c - a);
+    let det = e1.perp_dot(e2);
+    if det == 0.0 || !det.is_finite() {
+        return ISO_SNAP_MAX;
+    }
+    let (d1, d2) = (face.s[1] - face.s[0], face.s[2] - face.s[0]);
+    // Solve [e1; e2] g = [d1; d2] for the screen gradient g.
+    let g = DVec2::new(d1 * e2.y - d2 * e1.y, e1.x * d2 - e2.x * d1) / det;
+    let bound = g.length() * scale * ISO_SNAP_PX;
+    if bound.is_finite() {
+        bound.min(ISO_SNAP_MAX)
+    } else {
+        ISO_SNAP_MAX
+    }
 }
 
 /// Isosurfaces alone or over a volume, on the projected-cell driver.
@@ -478,6 +543,21 @@ impl IsoMode {
             volume,
         }
     }
+}
+
+/// The smooth gradient at `x` on boundary triangle `t` of `part`.
+fn face_gradient(part: &Polyhedron, t: u32, x: DVec3) -> Option<DVec3> {
+    let tri = part.triangles.get(t as usize)?;
+    let p = tri.map(|i| part.points.get(i as usize).copied());
+    let g = tri.map(|i| part.gradients.get(i as usize).copied());
+    let (Some(p0), Some(p1), Some(p2)) = (p[0], p[1], p[2]) else {
+        return None;
+    };
+    let (Some(g0), Some(g1), Some(g2)) = (g[0], g[1], g[2]) else {
+        return None;
+    };
+    let w = barycentric([p0, p1, p2], x);
+    Some(g0 * w[0] + g1 * w[1] + g2 * w[2])
 }
 
 /// A region vertex's entry (`side` 0) or exit point in view space.
@@ -558,6 +638,25 @@ impl ProjectedMode for IsoMode {
     ) {
         payload.seg.set(src);
         let scale = payload.seg.map.scale;
+        // The snap bound of a vertex: the largest of its regions' faces'
+        // (tie-quad vertices, which have no regions, are exact: 0).
+        payload.snap.clear();
+        payload.snap.resize(proj.vertices.len(), [0.0; 2]);
+        for (r, reg) in proj.regions.iter().enumerate() {
+            let Some(&[f, b]) = proj.region_faces.get(r) else {
+                continue;
+            };
+            let e = [f, b].map(|t| {
+                proj.faces
+                    .get(t as usize)
+                    .map_or(ISO_SNAP_MAX, |face| snap_bound(face, scale))
+            });
+            for &v in reg {
+                let s = &mut payload.snap[v as usize];
+                s[0] = s[0].max(e[0]);
+                s[1] = s[1].max(e[1]);
+            }
+        }
         payload.grads.clear();
         payload.grads.resize(proj.vertices.len(), [DVec3::ZERO; 2]);
         if self.set.lighting == Lighting::None {
@@ -566,18 +665,43 @@ impl ProjectedMode for IsoMode {
         let flat = piece_gradient(part) * scale;
         let smooth =
             self.set.lighting == Lighting::Smooth && part.gradients.len() == part.points.len();
+        if !smooth {
+            payload.grads.fill([flat; 2]);
+            return;
+        }
+        // A region vertex lies on its regions' front and back triangles
+        // (any of them: the smooth field is continuous): interpolate on the
+        // first region's; a vertex without a region (a tie quad's) searches
+        // the boundary.
+        let mut done = std::mem::take(&mut payload.done);
+        done.clear();
+        done.resize(proj.vertices.len(), false);
+        for (r, reg) in proj.regions.iter().enumerate() {
+            let Some(&faces) = proj.region_faces.get(r) else {
+                continue;
+            };
+            for &v in reg {
+                let v = v as usize;
+                if done[v] {
+                    continue;
+                }
+                done[v] = true;
+                payload.grads[v] = [0, 1].map(|side| {
+                    face_gradient(part, faces[side], view_point(proj, v, side))
+                        .unwrap_or(flat / scale)
+                        * scale
+                });
+            }
+        }
         for (i, g) in payload.grads.iter_mut().enumerate() {
-            if !used.get(i).copied().unwrap_or(true) {
+            if done[i] || !used.get(i).copied().unwrap_or(true) {
                 continue;
             }
-            *g = if smooth {
-                [0, 1].map(|side| {
-                    boundary_gradient(part, view_point(proj, i, side), flat / scale) * scale
-                })
-            } else {
-                [flat; 2]
-            };
+            *g = [0, 1].map(|side| {
+                boundary_gradient(part, view_point(proj, i, side), flat / scale) * scale
+            });
         }
+        payload.done = done;
     }
 
     fn vertex(&self, payload: &IsoPayload, proj: &Projected, i: usize, ndc: [f32; 2]) -> IsoVertex {
@@ -594,10 +718,12 @@ impl ProjectedMode for IsoMode {
             let g = g * q;
             [g.x as f32, g.y as f32, g.z as f32].map(|c| if c.is_finite() { c } else { 0.0 })
         };
+        let e = payload.snap.get(i).copied().unwrap_or([0.0; 2]);
         IsoVertex {
             seg,
             grad_front: f32x3(g[0], qf),
             grad_back: f32x3(g[1], qb),
+            snap: e.map(|x| x as f32),
         }
     }
 }
@@ -608,9 +734,9 @@ mod tests {
 
     #[test]
     fn layout_matches_struct() {
-        assert_eq!(std::mem::size_of::<IsoVertex>(), 64);
+        assert_eq!(std::mem::size_of::<IsoVertex>(), 72);
         let offs: Vec<u64> = IsoVertex::ATTRIBUTES.iter().map(|a| a.offset).collect();
-        assert_eq!(offs, vec![0, 16, 24, 32, 36, 40, 52]);
+        assert_eq!(offs, vec![0, 16, 24, 32, 36, 40, 52, 64]);
         assert_eq!(std::mem::size_of::<IsoSurface>(), 48);
     }
 }

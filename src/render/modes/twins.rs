@@ -82,7 +82,7 @@ pub fn stage_twins() -> Vec<StageTwins> {
             TfBuffer::add_piece, TfBuffer::add_sub, TfBuffer::integrate_segment),
         twins!("iso.wgsl":
             iso::count_at_most, iso::iso_light, iso::iso_surface, iso::iso_over,
-            iso::iso_segment, iso::fs_iso),
+            iso::iso_crosses, iso::iso_segment, iso::fs_iso),
         twins!("iso_vertex.wgsl"),
         twins!("layer.wgsl": layer::fs_main),
         twins!("preint.wgsl":
