@@ -101,12 +101,13 @@ fn bench(c: &mut Criterion) {
         eprintln!("no GPU adapter: nothing to bench");
         return;
     }
-    // Every GPU mode of the registry (RENDER_BENCH_MODES=a,b to pick).
+    // Every GPU volume mode of the registry (RENDER_BENCH_MODES=a,b to
+    // pick; isosurfaces: benches/iso.rs).
     let picked = std::env::var("RENDER_BENCH_MODES").ok();
     let modes: Vec<Mode> = Mode::ALL
         .iter()
         .copied()
-        .filter(|m| m.info().gpu)
+        .filter(|m| m.info().gpu && *m != Mode::Iso)
         .filter(|m| {
             picked
                 .as_deref()
