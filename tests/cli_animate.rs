@@ -10,8 +10,12 @@
 //! adapter; the exact mode is checked where an adapter exists and skipped
 //! otherwise, as in `cli_render.rs`.
 
+mod cli_util;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+use cli_util::{no_adapter, stderr, zoovr};
 
 use zoovr::generate::{time_series, warped_hex_grid, Warp};
 use zoovr::image::Image;
@@ -19,25 +23,8 @@ use zoovr::io::writer::{write_pvd, write_series, write_vtu, Compression};
 use zoovr::mesh::Mesh;
 use zoovr::testdata::shared_file;
 
-fn zoovr(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_zoovr"))
-        .args(args)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .expect("run zoovr")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-/// Whether a run failed only for want of a GPU adapter.
-fn no_adapter(o: &Output) -> bool {
-    !o.status.success() && stderr(o).contains("adapter")
 }
 
 /// Writes `meshes` as `step_K.vtu` and a `.pvd` of them into `dir`; returns
