@@ -291,6 +291,12 @@ fn whole_cells_match_the_faces_reference() {
         format!("{}:tf:0.5,{}:#00ff00:1:#ff00ff:1", at(0.3), at(0.6)),
     ];
     compare_with_reference(&scene, "grid 5, nonlinear", &lists, false);
+    // A radial field: nested closed surfaces (spheres, as the faces field
+    // draws them).
+    let c = DVec3::new(0.45, 0.5, 0.55);
+    let scene = box_scene(6, |p| (p - c).length());
+    let lists = [format!("0.2:#ff0000:0.5,0.35,0.5:tf:0.4")];
+    compare_with_reference(&scene, "grid 6, radial", &lists, false);
 }
 
 fn compare_with_reference(scene: &Scene, name: &str, lists: &[String], split: bool) {
@@ -416,4 +422,90 @@ fn styles_parse_into_linear_colours() {
     let s: IsoSpec = "1.5:#ffffff:0.5:#000000:1".parse().unwrap();
     assert_eq!(s.front.color, Some([1.0; 3]));
     assert_eq!(s.back.opacity, 1.0);
+}
+
+/// The nearest hit of `o + t d` (t > 0) on `tris`, Moller-Trumbore.
+fn nearest_hit(o: DVec3, d: DVec3, tris: &[[DVec3; 3]]) -> Option<f64> {
+    let mut best: Option<f64> = None;
+    for t in tris {
+        let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+        let p = d.cross(e2);
+        let det = e1.dot(p);
+        if det.abs() < 1e-300 {
+            continue;
+        }
+        let s = o - t[0];
+        let u = s.dot(p) / det;
+        let q = s.cross(e1);
+        let v = d.dot(q) / det;
+        let w = e2.dot(q) / det;
+        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && w > 0.0 && best.is_none_or(|b| w < b) {
+            best = Some(w);
+        }
+    }
+    best
+}
+
+/// The cross-check: marching tetrahedra of the same isovalues, drawn with a
+/// depth test (a ray per pixel centre, nearest triangle), against `--mode
+/// iso --split all` (the same `tets` field) with opaque, unlit surfaces.
+/// The surfaces are the same piecewise-planar sheets, so the images agree
+/// except on single pixels at the sheets' edges and where they meet mesh
+/// faces: measured 2 to 8 of 9,216 pixels (about 4,300 covered) on
+/// zoo_3x3x3 and curvilinear_4x4x4, both projections.
+#[test]
+fn marching_tetrahedra_agree_with_mode_iso() {
+    for name in ["zoo_3x3x3.vtu", "curvilinear_4x4x4.vtu"] {
+        let mesh = io::read(&mesh_file(name), &ReadOptions::default()).unwrap();
+        let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        let (lo, hi) = scene.range;
+        let values = [lo + 0.35 * (hi - lo), lo + 0.65 * (hi - lo)];
+        let colours = [[1.0f32, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        let zoovr::render::ScalarsRef::Point(s) = scene.scalars() else {
+            panic!("point field")
+        };
+        let tris: Vec<Vec<[DVec3; 3]>> = values
+            .iter()
+            .map(|&v| zoovr::render::marching::marching_tets(&scene.mesh, s, v))
+            .collect();
+        let set = iso(
+            &format!("{}:#ff0000,{}:#0000ff", values[0], values[1]),
+            Lighting::None,
+            true,
+        );
+        let mut r = Renderer::new(scene.geometry());
+        for ortho in [false, true] {
+            let cam = Camera::fit(scene.mesh.bounds(), &camera_params(ortho));
+            let mut opts = options(Mode::Iso, ortho, &set, Compositor::Cpu);
+            opts.projected.split_all = true;
+            let img = render(&mut r, &scene, &opts);
+            let (mut differ, mut covered) = (0, 0);
+            for j in 0..SIZE {
+                for i in 0..SIZE {
+                    let ray = cam.ray_at(i as f64 + 0.5, j as f64 + 0.5);
+                    let hit = (0..2)
+                        .filter_map(|k| nearest_hit(ray.origin, ray.dir, &tris[k]).map(|t| (t, k)))
+                        .min_by(|a, b| a.0.total_cmp(&b.0));
+                    let want = match hit {
+                        Some((_, k)) => {
+                            covered += 1;
+                            let c = colours[k];
+                            [c[0], c[1], c[2], 1.0]
+                        }
+                        None => [0.0; 4],
+                    };
+                    let got = img.pixels[(j * SIZE + i) as usize];
+                    if (0..4).any(|c| (got[c] - want[c]).abs() > 1e-4) {
+                        differ += 1;
+                    }
+                }
+            }
+            eprintln!(
+                "{name} ortho={ortho}: {differ} of {} pixels differ ({covered} covered)",
+                SIZE * SIZE
+            );
+            assert!(covered > 1000, "{name}: {covered}");
+            assert!(differ <= 12, "{name} ortho={ortho}: {differ} pixels differ");
+        }
+    }
 }

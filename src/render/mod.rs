@@ -20,6 +20,7 @@ pub mod driver;
 pub mod gradients;
 mod group;
 pub mod iso;
+pub mod marching;
 pub mod modes;
 mod options;
 pub mod pieces;
