@@ -295,7 +295,7 @@ fn whole_cells_match_the_faces_reference() {
     // draws them).
     let c = DVec3::new(0.45, 0.5, 0.55);
     let scene = box_scene(6, |p| (p - c).length());
-    let lists = [format!("0.2:#ff0000:0.5,0.35,0.5:tf:0.4")];
+    let lists = ["0.2:#ff0000:0.5,0.35,0.5:tf:0.4".to_string()];
     compare_with_reference(&scene, "grid 6, radial", &lists, false);
 }
 
