@@ -59,6 +59,7 @@ fn isovalues(n: usize, (lo, hi): (f64, f64)) -> IsoOptions {
             .collect(),
         lighting: Lighting::Smooth,
         alone: false,
+        mix: Default::default(),
     }
 }
 

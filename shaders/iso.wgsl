@@ -20,6 +20,11 @@ struct IsoParams {
     lighting: u32,
     ambient: f32,
     diffuse: f32,
+    // 0: exact mixing, 1: RKE's blend (src/render/iso.rs `IsoMix`).
+    mix: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // Keep in sync with `IsoSurface` in src/render/modes/iso.rs.
@@ -65,13 +70,15 @@ fn iso_light(g: vec3<f32>) -> f32 {
     return iso.ambient + iso.diffuse * min(abs(g.z) / n, 1.0);
 }
 
-// Premultiplied colour and opacity of surface k crossed rising or falling.
-fn iso_surface(k: u32, rising: bool, g: vec3<f32>) -> vec4<f32> {
+// Premultiplied colour and opacity of surface k crossed rising or falling,
+// its opacity times w.
+fn iso_surface(k: u32, rising: bool, g: vec3<f32>, w: f32) -> vec4<f32> {
     var c = surfaces[k].back;
     if rising {
         c = surfaces[k].front;
     }
-    return vec4<f32>(c.xyz * (iso_light(g) * c.w), c.w);
+    let a = clamp(c.w * w, 0.0, 1.0);
+    return vec4<f32>(c.xyz * (iso_light(g) * a), a);
 }
 
 // `back` behind `front` (premultiplied).
@@ -101,7 +108,9 @@ fn iso_crosses(k: u32, v: f32, seg: Seg, e: vec2<f32>) -> bool {
 // The segment with its surfaces, front to back. One loop, one call of
 // `volume` (inlined once: the volume integral is the stage's largest
 // function): step i < b ends the volume at crossing k and adds the surface,
-// step b ends it at the segment's back.
+// step b ends it at the segment's back. RKE's blend (iso.mix 1) instead
+// draws every surface's front-face layer (opacity times 1 - u), the whole
+// segment's volume at step b, then the back-face layers (times u).
 fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, e: vec2<f32>) -> vec4<f32> {
     let lo = min(seg.s_f, seg.s_b);
     let hi = max(seg.s_f, seg.s_b);
@@ -115,8 +124,10 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, e: vec2<f32>) -> vec4<f32
         b = max(count_at_most(hi + m), a);
     }
     let rising = seg.s_f <= seg.s_b;
+    let blend = iso.mix == 1u;
     let d = seg.s_b - seg.s_f;
     var acc = vec4<f32>(0.0);
+    var back = vec4<f32>(0.0);
     var u0 = 0.0;
     var s0 = seg.s_f;
     for (var i = a; i <= b; i++) {
@@ -139,14 +150,28 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, e: vec2<f32>) -> vec4<f32
             // The scalar there: v, or the end a near crossing snaps to.
             sv = clamp(v, lo, hi);
         }
-        acc = iso_over(acc, volume((u - u0) * seg.l, s0, sv));
+        if !blend || i == b {
+            var from_u = u0;
+            var from_s = s0;
+            if blend {
+                from_u = 0.0;
+                from_s = seg.s_f;
+            }
+            acc = iso_over(acc, volume((u - from_u) * seg.l, from_s, sv));
+        }
         if i < b {
-            acc = iso_over(acc, iso_surface(k, rising, mix(gf, gb, u)));
+            let g = mix(gf, gb, u);
+            if blend {
+                acc = iso_over(acc, iso_surface(k, rising, g, 1.0 - u));
+                back = iso_over(back, iso_surface(k, rising, g, u));
+            } else {
+                acc = iso_over(acc, iso_surface(k, rising, g, 1.0));
+            }
         }
         u0 = u;
         s0 = sv;
     }
-    return acc;
+    return iso_over(acc, back);
 }
 
 @fragment

@@ -24,7 +24,7 @@ use zoovr::image::Image;
 use zoovr::io::{self, ReadOptions};
 use zoovr::mesh::Mesh;
 use zoovr::raycast::FieldModel;
-use zoovr::render::iso::{IsoOptions, IsoSpec, Lighting};
+use zoovr::render::iso::{IsoMix, IsoOptions, IsoSpec, Lighting};
 use zoovr::render::{
     Compositor, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
 };
@@ -55,6 +55,7 @@ fn iso(list: &str, lighting: Lighting, alone: bool) -> IsoOptions {
         surfaces: zoovr::render::iso::parse_list(list).unwrap(),
         lighting,
         alone,
+        mix: Default::default(),
     }
 }
 
@@ -508,4 +509,44 @@ fn marching_tetrahedra_agree_with_mode_iso() {
             assert!(differ <= 12, "{name} ortho={ortho}: {differ} pixels differ");
         }
     }
+}
+
+/// RKE's blend (`--iso-mix blend`), the approximation it replaces, renders
+/// as its own reference does (the same formula in the ray caster), and
+/// differs visibly from the exact mixing where surfaces cut thick cells.
+#[test]
+fn rke_blend_matches_its_reference_and_differs_from_exact() {
+    let mesh = io::read(&mesh_file("zoo_3x3x3.vtu"), &ReadOptions::default()).unwrap();
+    let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+    let (lo, hi) = scene.range;
+    let list = format!(
+        "{}:#ff8000:0.6,{}",
+        lo + 0.35 * (hi - lo),
+        lo + 0.7 * (hi - lo)
+    );
+    let mut r = Renderer::new(scene.geometry());
+    let mut images = Vec::new();
+    for mix in [IsoMix::Exact, IsoMix::Blend] {
+        let mut set = iso(&list, Lighting::Smooth, false);
+        set.mix = mix;
+        let mut ref_opts = options(Mode::Raycast, false, &set, Compositor::Cpu);
+        ref_opts.reference.model = FieldModel::Tets;
+        let expected = render(&mut r, &scene, &ref_opts);
+        for c in compositors() {
+            let mut opts = options(Mode::ExactFrag, false, &set, c);
+            opts.projected.split_all = true;
+            let got = render(&mut r, &scene, &opts);
+            let (off, max) = off_pixels(&got, &expected);
+            eprintln!("{mix:?} {c:?}: {} off, max {max:.2e} elsewhere", off.len());
+            assert!(max <= PIXEL_TOL && off.len() <= MAX_OFF, "{mix:?} {c:?}");
+        }
+        images.push(expected);
+    }
+    let (off, _) = off_pixels(&images[1], &images[0]);
+    let worst = off.iter().map(|o| o.2).fold(0.0, f64::max);
+    eprintln!(
+        "blend against exact: {} pixels differ by more than {PIXEL_TOL}, at most {worst:.3}",
+        off.len()
+    );
+    assert!(off.len() > 100 && worst > 0.05, "{} {worst}", off.len());
 }

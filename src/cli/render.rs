@@ -15,7 +15,7 @@ use zoovr::render::{
     SceneSpec, Shading, TableBuild, TableOptions,
 };
 
-use zoovr::render::iso::{IsoOptions, IsoSpec, Lighting};
+use zoovr::render::iso::{IsoMix, IsoOptions, IsoSpec, Lighting};
 
 use super::args::{parse_finite, parse_positive, parse_range, parse_rgb, parse_size};
 
@@ -139,6 +139,14 @@ pub struct ViewArgs {
     /// iso draws; with --mode raycast, its reference).
     #[arg(long, requires = "iso")]
     pub iso_only: bool,
+    /// How the volume and the --iso surfaces combine inside a cell: exact
+    /// (default: the volume split at each crossing, in order along the ray)
+    /// or blend (Roettger-Kraus-Ertl's smooth approximation: the cell's
+    /// whole volume between the surfaces' front layer, weighted by the
+    /// crossing's distance from the back, and their back layer; for
+    /// comparison).
+    #[arg(long, value_enum, default_value_t = IsoMix::Exact, requires = "iso")]
+    pub iso_mix: IsoMix,
     /// `--split all`: draw every cell as its consistent tetrahedra.
     #[arg(long, value_parser = ["all"])]
     pub split: Option<String>,
@@ -216,6 +224,7 @@ impl ViewArgs {
                 surfaces: self.iso.as_ref().map(|l| l.0.clone()).unwrap_or_default(),
                 lighting: self.shading,
                 alone: self.iso_only,
+                mix: self.iso_mix,
             },
         }
     }

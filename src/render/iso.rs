@@ -97,6 +97,31 @@ impl Lighting {
     }
 }
 
+/// How a segment's volume and its surfaces are combined (`--iso-mix`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum IsoMix {
+    /// The volume split at the crossings, composited in their order along
+    /// the ray (exact).
+    #[default]
+    Exact,
+    /// Roettger, Kraus and Ertl's smooth approximation (section 10): the
+    /// whole segment's volume between the surfaces' front-face layer
+    /// (opacity weighted by `1 - u`, the crossing's distance from the back)
+    /// and back-face layer (weighted by `u`), for comparison.
+    Blend,
+}
+
+impl IsoMix {
+    /// The name `--iso-mix` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            IsoMix::Exact => "exact",
+            IsoMix::Blend => "blend",
+        }
+    }
+}
+
 /// The colour (linear RGB in `[0, 1]`) and opacity of one side.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct SideStyle {
@@ -232,6 +257,8 @@ pub struct IsoOptions {
     /// what `--mode iso` always draws, so with `--mode raycast` its
     /// reference).
     pub alone: bool,
+    /// How volume and surfaces combine within a segment (`--iso-mix`).
+    pub mix: IsoMix,
 }
 
 impl IsoOptions {
@@ -266,6 +293,7 @@ pub struct IsoSet {
     /// Front and back side of each: `[r, g, b, opacity]`, not premultiplied.
     pub sides: Vec<[[f64; 4]; 2]>,
     pub lighting: Lighting,
+    pub mix: IsoMix,
 }
 
 impl IsoSet {
@@ -291,6 +319,7 @@ impl IsoSet {
                 .map(|s| [side(s.value, &s.front), side(s.value, &s.back)])
                 .collect(),
             lighting: opts.lighting,
+            mix: opts.mix,
         }
     }
 
@@ -333,9 +362,14 @@ impl IsoSet {
     /// Surface `k` crossed rising or falling, with gradient `g`, as a
     /// segment value (its opacity as an optical depth).
     pub fn surface(&self, k: usize, rising: bool, g: DVec3, d: DVec3) -> SegmentValue {
+        self.surface_weighted(k, rising, g, d, 1.0)
+    }
+
+    /// [`Self::surface`] with its opacity times `w`.
+    fn surface_weighted(&self, k: usize, rising: bool, g: DVec3, d: DVec3, w: f64) -> SegmentValue {
         let c = self.sides[k][if rising { 0 } else { 1 }];
         let i = self.light(g, d);
-        let a = c[3].clamp(0.0, 1.0);
+        let a = (c[3] * w).clamp(0.0, 1.0);
         SegmentValue {
             color: [c[0] * i * a, c[1] * i * a, c[2] * i * a],
             alpha: a,
@@ -365,6 +399,21 @@ impl IsoSet {
         let mut acc = SegmentValue::default();
         let (mut u0, mut s0) = (0.0, s_f);
         let n = range.len();
+        if self.mix == IsoMix::Blend {
+            let mut back = SegmentValue::default();
+            for i in 0..n {
+                let k = if rising {
+                    range.start + i
+                } else {
+                    range.end - 1 - i
+                };
+                let u = ((self.levels[k] - s_f) / (s_b - s_f)).clamp(0.0, 1.0);
+                let g = g[0].lerp(g[1], u);
+                acc = over(acc, self.surface_weighted(k, rising, g, d, 1.0 - u));
+                back = over(back, self.surface_weighted(k, rising, g, d, u));
+            }
+            return over(over(acc, volume(l, s_f, s_b)), back);
+        }
         for i in 0..n {
             let k = if rising {
                 range.start + i
@@ -405,6 +454,7 @@ mod tests {
                 .map(|_| [[1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.5]])
                 .collect(),
             lighting: Lighting::None,
+            mix: IsoMix::Exact,
         }
     }
 

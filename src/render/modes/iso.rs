@@ -31,7 +31,7 @@ use crate::numeric::tolerance::{ISO_LEVEL_F32, ISO_SNAP_MAX, ISO_SNAP_PX};
 use crate::projection::{FaceTri, Polyhedron, Projected};
 use crate::render::driver::ProjectedMode;
 use crate::render::gradients::{barycentric, boundary_gradient, piece_gradient};
-use crate::render::iso::{IsoSet, Lighting, AMBIENT, DIFFUSE};
+use crate::render::iso::{IsoMix, IsoSet, Lighting, AMBIENT, DIFFUSE};
 use crate::render::pieces::PieceSource;
 use crate::tf::{EmissionModel, TransferFunction};
 
@@ -154,6 +154,9 @@ pub struct IsoParams {
     pub lighting: u32,
     pub ambient: f32,
     pub diffuse: f32,
+    /// 0: exact mixing, 1: RKE's blend ([`crate::render::iso::IsoMix`]).
+    pub mix: u32,
+    pub _pad: [u32; 3],
 }
 
 /// One surface as the stage reads it. Keep in sync with `IsoSurface` in
@@ -176,6 +179,11 @@ pub fn iso_buffers(set: &IsoSet, map: &ScalarMap) -> (IsoParams, Vec<IsoSurface>
         lighting: set.lighting.code(),
         ambient: AMBIENT as f32,
         diffuse: DIFFUSE as f32,
+        mix: match set.mix {
+            IsoMix::Exact => 0,
+            IsoMix::Blend => 1,
+        },
+        _pad: [0; 3],
     };
     let mut surfaces: Vec<IsoSurface> = set
         .values
@@ -348,11 +356,12 @@ pub fn iso_light(stage: &IsoTwin, g: [f32; 3]) -> f32 {
 }
 
 /// Twin of `iso_surface`.
-pub fn iso_surface(stage: &IsoTwin, k: u32, rising: bool, g: [f32; 3]) -> [f32; 4] {
+pub fn iso_surface(stage: &IsoTwin, k: u32, rising: bool, g: [f32; 3], w: f32) -> [f32; 4] {
     let s = &stage.surfaces[k as usize];
     let c = if rising { s.front } else { s.back };
-    let i = iso_light(stage, g) * c[3];
-    [c[0] * i, c[1] * i, c[2] * i, c[3]]
+    let a = (c[3] * w).clamp(0.0, 1.0);
+    let i = iso_light(stage, g) * a;
+    [c[0] * i, c[1] * i, c[2] * i, a]
 }
 
 /// Twin of `iso_over`.
@@ -389,8 +398,9 @@ pub fn iso_segment(
         b = count_at_most(stage, hi + m).max(a);
     }
     let rising = seg.s_f <= seg.s_b;
+    let blend = stage.params.mix == 1;
     let d = seg.s_b - seg.s_f;
-    let mut acc = [0.0f32; 4];
+    let (mut acc, mut back) = ([0.0f32; 4], [0.0f32; 4]);
     let (mut u0, mut s0) = (0.0f32, seg.s_f);
     for i in a..=b {
         let (mut u, mut sv, mut k) = (1.0f32, seg.s_b, 0);
@@ -407,14 +417,22 @@ pub fn iso_segment(
             };
             sv = v.clamp(lo, hi);
         }
-        acc = iso_over(acc, stage.volume.volume((u - u0) * seg.l, s0, sv));
+        if !blend || i == b {
+            let (from_u, from_s) = if blend { (0.0, seg.s_f) } else { (u0, s0) };
+            acc = iso_over(acc, stage.volume.volume((u - from_u) * seg.l, from_s, sv));
+        }
         if i < b {
             let g = std::array::from_fn(|c| gf[c] + (gb[c] - gf[c]) * u);
-            acc = iso_over(acc, iso_surface(stage, k, rising, g));
+            if blend {
+                acc = iso_over(acc, iso_surface(stage, k, rising, g, 1.0 - u));
+                back = iso_over(back, iso_surface(stage, k, rising, g, u));
+            } else {
+                acc = iso_over(acc, iso_surface(stage, k, rising, g, 1.0));
+            }
         }
         (u0, s0) = (u, sv);
     }
-    acc
+    iso_over(acc, back)
 }
 
 /// Twin of `fs_iso` in `shaders/iso.wgsl`, the fragment at weights `bary`
