@@ -81,23 +81,22 @@ pub fn point_gradients(mesh: &Mesh, scalars: &[f64]) -> Vec<DVec3> {
     let mut sum = vec![DVec3::ZERO; n];
     let mut weight = vec![0.0f64; n];
     let mut tets = Vec::new();
-    let get = |i: u32| mesh.points.get(i as usize).copied();
-    let val = |i: u32| scalars.get(i as usize).copied();
     for c in 0..mesh.cells.len() {
         tets.clear();
         tetrahedralize_cell(&mesh.cells, c, &mut tets);
-        for t in &tets {
-            let (Some(p), Some(s)) = (
-                t.iter().map(|&i| get(i)).collect::<Option<Vec<_>>>(),
-                t.iter().map(|&i| val(i)).collect::<Option<Vec<_>>>(),
-            ) else {
-                continue;
-            };
+        'tet: for t in &tets {
+            let (mut p, mut s) = ([DVec3::ZERO; 4], [0.0; 4]);
+            for k in 0..4 {
+                match (mesh.points.get(t[k] as usize), scalars.get(t[k] as usize)) {
+                    (Some(&pk), Some(&sk)) if sk.is_finite() => (p[k], s[k]) = (pk, sk),
+                    _ => continue 'tet,
+                }
+            }
             let vol = ((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0).abs();
-            if vol.is_nan() || vol <= 0.0 || s.iter().any(|v| !v.is_finite()) {
+            if vol.is_nan() || vol <= 0.0 {
                 continue;
             }
-            let g = tet_gradient([p[0], p[1], p[2], p[3]], [s[0], s[1], s[2], s[3]]);
+            let g = tet_gradient(p, s);
             for &i in t {
                 sum[i as usize] += g * vol;
                 weight[i as usize] += vol;
