@@ -86,44 +86,38 @@ impl RayTracer for IsoReference<'_, '_> {
         opts: &RaycastOptions,
         scratch: &mut Scratch,
     ) -> RayAccumulator {
-        let mut acc = RayAccumulator::default();
         let stop = stop_depth(opts);
-        self.rc.for_each_segment(ray, t_near, scratch, |s, raw| {
-            let grads = || match self.set.lighting {
-                Lighting::None => [DVec3::ZERO; 2],
-                Lighting::Flat => {
-                    [self.flat
-                        .get(raw.cell as usize)
-                        .copied()
-                        .unwrap_or_default(); 2]
-                }
-                Lighting::Smooth => {
-                    let gi = self.point_gradient(raw.v_in, raw.w_in);
-                    let go = self.point_gradient(raw.v_out, raw.w_out);
-                    // The segment may start later than the walk's (clipped
-                    // at the near plane).
-                    let span = raw.t_out - raw.t_in;
-                    let x = if span > 0.0 {
-                        ((s.t_in - raw.t_in) / span).clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    };
-                    [gi.lerp(go, x), go]
-                }
-            };
-            let l = s.t_out - s.t_in;
-            let v = if self.set.crossed(s.s_in, s.s_out).is_empty() {
-                material.segment(l, s.s_in, s.s_out)
-            } else {
+        let acc = RayAccumulator::default();
+        self.rc
+            .composite(ray, t_near, stop, scratch, acc, |s, raw| {
+                let grads = || match self.set.lighting {
+                    Lighting::None => [DVec3::ZERO; 2],
+                    Lighting::Flat => {
+                        [self.flat
+                            .get(raw.cell as usize)
+                            .copied()
+                            .unwrap_or_default(); 2]
+                    }
+                    Lighting::Smooth => {
+                        let gi = self.point_gradient(raw.v_in, raw.w_in);
+                        let go = self.point_gradient(raw.v_out, raw.w_out);
+                        // The segment may start later than the walk's (clipped
+                        // at the near plane).
+                        let span = raw.t_out - raw.t_in;
+                        let x = if span > 0.0 {
+                            ((s.t_in - raw.t_in) / span).clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
+                        [gi.lerp(go, x), go]
+                    }
+                };
+                let l = s.t_out - s.t_in;
                 self.set
                     .composite(l, s.s_in, s.s_out, grads(), self.forward, |l, a, b| {
                         material.segment(l, a, b)
                     })
-            };
-            acc.add(&v);
-            acc.depth < stop
-        });
-        acc
+            })
     }
 }
 

@@ -634,15 +634,32 @@ impl<'a> Raycaster<'a> {
         opts: &RaycastOptions,
         scratch: &mut Scratch,
     ) -> RayAccumulator {
-        let mut acc = RayAccumulator::default();
+        let acc = RayAccumulator::default();
         let stop_depth = stop_depth(opts);
         if self.model == FieldModel::Native {
             if let Some(acc) = self.trace_native(material, ray, t_near, stop_depth, scratch) {
                 return acc;
             }
         }
-        self.for_each_segment(ray, t_near, scratch, |s, _| {
-            acc.add(&material.segment(s.t_out - s.t_in, s.s_in, s.s_out));
+        self.composite(ray, t_near, stop_depth, scratch, acc, |s, _| {
+            material.segment(s.t_out - s.t_in, s.s_in, s.s_out)
+        })
+    }
+
+    /// Composites onto `acc` the value `value` gives each walk segment of
+    /// `ray` from `t_near` on, front to back, until the optical depth
+    /// reaches `stop_depth`.
+    pub(crate) fn composite(
+        &self,
+        ray: &Ray,
+        t_near: f64,
+        stop_depth: f64,
+        scratch: &mut Scratch,
+        mut acc: RayAccumulator,
+        mut value: impl FnMut(&Segment, &RawSegment) -> crate::integrate::SegmentValue,
+    ) -> RayAccumulator {
+        self.for_each_segment(ray, t_near, scratch, |s, raw| {
+            acc.add(&value(s, raw));
             acc.depth < stop_depth
         });
         acc
