@@ -52,6 +52,8 @@ pub static INFO: ModeInfo = ModeInfo {
         // field differs from the `faces` model there. Elsewhere whole cells
         // integrate the `faces` field itself (within 5.4e-4).
         whole_max: 0.02,
+        split_outliers: 0,
+        whole_outliers: 0,
     }),
 };
 

@@ -53,10 +53,22 @@ pub static INFO: ModeInfo = ModeInfo {
     stage: Some(&ISO_STAGE),
     bounds: Some(Bounds {
         reference: FieldModel::Faces,
-        // Measured in tests/iso.rs (f32 crossings and light; silhouettes of
-        // surfaces may differ on single pixels, counted there).
+        // tests/modes.rs (one opaque surface mid-range, lit smooth, the
+        // reference drawing the surfaces alone; measured 8.7e-3 at most
+        // elsewhere on the outliers' edges) and tests/iso.rs (2e-3 beyond
+        // them, more surfaces): f32 crossings and light.
         split_max: 2.0 / 255.0,
         whole_max: 2.0 / 255.0,
+        // Where a surface meets a face or the mesh boundary within the
+        // 1/256-pixel snap of region corners, the crossing sits at the very
+        // end of a segment whose end scalar the snap moves: the surface's
+        // edge may there move by a pixel. Measured at most 6.
+        split_outliers: 8,
+        // Whole cells against `faces`: in the cells the order splits into
+        // tets (zoo_3x3x3's nonplanar cells) the surface is the `tets`
+        // field's, elsewhere than the `faces` field's. Measured 45 there,
+        // at most 6 on meshes without split cells.
+        whole_outliers: 48,
     }),
 };
 

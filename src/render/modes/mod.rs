@@ -89,6 +89,13 @@ pub struct Bounds {
     /// (problem cells, cells holding a breakpoint), where it integrates the
     /// `tets` field.
     pub whole_max: f64,
+    /// Pixels of one harness image (96 x 80) allowed beyond `split_max`,
+    /// for a named reason the mode's entry states (0 for the volume modes:
+    /// the bound holds over every pixel).
+    pub split_outliers: usize,
+    /// The same beyond `whole_max` (where the model difference inside the
+    /// cells the mode splits moves a surface, not only a colour).
+    pub whole_outliers: usize,
 }
 
 /// What the registry knows of a mode.

@@ -51,6 +51,8 @@ pub static INFO: ModeInfo = ModeInfo {
         // Measured 4.54e-2 (zoo_3x3x3, orthographic): the same scaling
         // error (the model difference of split cells is 1.2e-2).
         whole_max: 0.06,
+        split_outliers: 0,
+        whole_outliers: 0,
     }),
 };
 

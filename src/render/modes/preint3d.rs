@@ -47,6 +47,8 @@ pub static INFO: ModeInfo = ModeInfo {
         // exact-frag modes: cells the order splits into tets integrate the
         // `tets` field there, not `faces`.
         whole_max: 0.02,
+        split_outliers: 0,
+        whole_outliers: 0,
     }),
 };
 

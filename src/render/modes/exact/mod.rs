@@ -60,6 +60,8 @@ pub static INFO: ModeInfo = ModeInfo {
         // Measured up to 7.65e-2 where cells are split (ring_hole,
         // perspective, a TF with kinks; tests/render_exact.rs MODEL_DIFF).
         whole_max: 0.1,
+        split_outliers: 0,
+        whole_outliers: 0,
     }),
 };
 
