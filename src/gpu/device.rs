@@ -68,10 +68,16 @@ pub struct Context {
 /// A [`Context`] being opened on another thread ([`Context::spawn`]):
 /// opening a device takes a few tenths of a second that a caller can
 /// overlap with reading and sorting a mesh.
+///
+/// Dropping one that was never waited for still joins its thread: a process
+/// that exits (an error found while the device opens) while Mesa's drivers
+/// are being loaded on the other thread can abort inside LLVM's option
+/// registry ("Option ... registered more than once"), since `exit` tears
+/// down the registry the loading thread is filling.
 #[derive(Debug)]
 pub struct PendingContext {
     opts: GpuOptions,
-    handle: std::thread::JoinHandle<Result<Context, GpuError>>,
+    handle: Option<std::thread::JoinHandle<Result<Context, GpuError>>>,
 }
 
 impl PendingContext {
@@ -81,10 +87,28 @@ impl PendingContext {
     }
 
     /// Waits for the context.
-    pub fn wait(self) -> Result<Context, GpuError> {
-        self.handle
-            .join()
-            .unwrap_or_else(|_| Err(GpuError::Wgpu("opening the device panicked".into())))
+    pub fn wait(mut self) -> Result<Context, GpuError> {
+        Self::join(self.handle.take())
+    }
+
+    fn join(
+        handle: Option<std::thread::JoinHandle<Result<Context, GpuError>>>,
+    ) -> Result<Context, GpuError> {
+        match handle {
+            Some(h) => h
+                .join()
+                .unwrap_or_else(|_| Err(GpuError::Wgpu("opening the device panicked".into()))),
+            None => Err(GpuError::Wgpu("the device was already taken".into())),
+        }
+    }
+}
+
+impl Drop for PendingContext {
+    fn drop(&mut self) {
+        if let Some(h) = self.handle.take() {
+            // The context (or its error) is not wanted; only the thread's end.
+            drop(Self::join(Some(h)));
+        }
     }
 }
 
@@ -94,7 +118,7 @@ impl Context {
         let o = *opts;
         PendingContext {
             opts: o,
-            handle: std::thread::spawn(move || Context::new(&o)),
+            handle: Some(std::thread::spawn(move || Context::new(&o))),
         }
     }
 
