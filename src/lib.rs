@@ -5,6 +5,7 @@
 //! [`io`] -> [`mesh`] -> [`field`] -> [`visibility`] -> [`projection`] ->
 //! [`integrate`] -> [`gpu`], with [`raycast`] as the independent reference.
 
+pub mod bench;
 pub mod camera;
 pub mod field;
 #[doc(hidden)]

@@ -4,6 +4,7 @@
 mod animate;
 mod args;
 mod assemble;
+mod bench;
 mod compare;
 mod info;
 mod interrupt;
@@ -33,6 +34,11 @@ enum Command {
     /// numbered PNG frames, and optionally a GIF or an MP4, reusing the
     /// topology, sort and GPU state across frames where the steps allow.
     Animate(Box<animate::AnimateArgs>),
+    /// Time every mode against its error: each mode at the settings that
+    /// trade time for error, at several sizes and views, against the ray
+    /// caster on the same field and on the native field; a table, CSV,
+    /// JSON and a log-log plot, with VTK's mappers as external points.
+    Bench(Box<bench::BenchArgs>),
     /// Compare two images: max absolute, RMS and PSNR over pixels and
     /// channels (float values for two EXR files, else PNG display values).
     Compare(compare::CompareArgs),
@@ -51,6 +57,7 @@ pub fn run() -> i32 {
     let (name, view) = match &cli.command {
         Command::Render(args) => ("render", Some(&args.view)),
         Command::Animate(args) => ("animate", Some(&args.view)),
+        Command::Bench(_) => ("bench", None),
         _ => ("", None),
     };
     if let Some(msg) = view.and_then(|v| v.usage_error()) {
@@ -60,6 +67,7 @@ pub fn run() -> i32 {
         Command::Info(args) => info::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Animate(args) => animate::run(&args),
+        Command::Bench(args) => bench::run(&args),
         Command::Compare(args) => compare::run(&args),
     };
     match result {

@@ -23,7 +23,7 @@ use super::args::{parse_finite, parse_positive, parse_range, parse_rgb, parse_si
 #[derive(Clone, Debug)]
 pub struct IsoList(pub Vec<IsoSpec>);
 
-fn parse_iso(s: &str) -> Result<IsoList, String> {
+pub fn parse_iso(s: &str) -> Result<IsoList, String> {
     zoovr::render::iso::parse_list(s)
         .map(IsoList)
         .map_err(|e| e.to_string())
@@ -150,6 +150,12 @@ pub struct ViewArgs {
     /// `--split all`: draw every cell as its consistent tetrahedra.
     #[arg(long, value_parser = ["all"])]
     pub split: Option<String>,
+    /// Exact mode: colour refinement tolerance (default 0.004). A region
+    /// triangle whose optical depth times glow spread exceeds T is split
+    /// at its edge midpoints (up to 6 levels): lower is slower and closer
+    /// to the ray caster, higher draws fewer triangles.
+    #[arg(long, value_name = "T", value_parser = parse_positive)]
+    pub refine_tol: Option<f64>,
     /// Background colour R,G,B in [0,1] for PNG output.
     #[arg(long, value_parser = parse_rgb, default_value = "0,0,0")]
     pub background: [f32; 3],
@@ -209,6 +215,9 @@ impl ViewArgs {
             },
             projected: ProjectedOptions {
                 split_all: self.split.is_some(),
+                refine_tol: self
+                    .refine_tol
+                    .unwrap_or(zoovr::numeric::tolerance::COLOR_REFINE_TOL),
                 ..Default::default()
             },
             gpu: GpuOptions {
@@ -383,6 +392,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         eprintln!(
             "zoovr: note: --split all is for the projected-cell modes; the ray caster's field \
              is --model (`--model tets` integrates the consistent tets)"
+        );
+    }
+    if opts.mode != Mode::Exact && args.view.refine_tol.is_some() {
+        eprintln!(
+            "zoovr: note: --refine-tol is the exact mode's; the {} mode does not interpolate \
+             vertex colours",
+            info.name
         );
     }
     if info.gpu && args.view.traversal.is_some() {

@@ -730,7 +730,7 @@ mod tests {
         let mut degenerate = 0;
         for piece in &order.pieces {
             let out = process_chunk(
-                &ExactMode,
+                &ExactMode::default(),
                 &ctx,
                 std::slice::from_ref(piece),
                 ChunkOut::default(),
@@ -795,7 +795,7 @@ mod tests {
             .pieces
             .chunks(chunk)
             .map(|c| {
-                let out = process_chunk(&ExactMode, &ctx, c, ChunkOut::default());
+                let out = process_chunk(&ExactMode::default(), &ctx, c, ChunkOut::default());
                 (out.vertices, out.indices)
             })
             .collect();
@@ -804,7 +804,7 @@ mod tests {
         for workers in [1, 2, 3] {
             let mut got = Vec::new();
             pipeline(
-                &ExactMode,
+                &ExactMode::default(),
                 &ctx,
                 &order.pieces,
                 chunk,
@@ -820,7 +820,7 @@ mod tests {
             assert!(got == serial, "{workers} workers");
             let mut calls = 0;
             let r = pipeline(
-                &ExactMode,
+                &ExactMode::default(),
                 &ctx,
                 &order.pieces,
                 chunk,

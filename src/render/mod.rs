@@ -161,6 +161,11 @@ impl Renderer {
         self.geometry = geometry;
     }
 
+    /// The adapter of the GPU device, once one is open.
+    pub fn gpu_info(&self) -> Option<String> {
+        self.gpu.as_ref().map(|g| g.info().to_string())
+    }
+
     /// Hands over a GPU context that is still opening ([`Context::spawn`]);
     /// the exact mode waits for it after sorting, when its options are the
     /// render's (otherwise it opens its own).
@@ -241,7 +246,10 @@ impl Renderer {
                 (img, detail, setup)
             }
             Mode::Exact => {
-                self.projected(&modes::exact::ExactMode, &scene, opts, camera, progress)?
+                let mode = modes::exact::ExactMode {
+                    refine_tol: opts.projected.refine_tol,
+                };
+                self.projected(&mode, &scene, opts, camera, progress)?
             }
             Mode::ExactFrag => self.projected(
                 &modes::exact_frag::ExactFragMode,

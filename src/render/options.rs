@@ -94,7 +94,7 @@ pub enum Compositor {
 }
 
 /// Options of the projected-cell modes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ProjectedOptions {
     /// `--split all`: every cell drawn as its consistent tets.
     pub split_all: bool,
@@ -110,6 +110,10 @@ pub struct ProjectedOptions {
     /// On the CPU twin: the pixel whose fragments are listed in
     /// [`super::ProjectedStats::watched`].
     pub watch: Option<(u32, u32)>,
+    /// The exact mode's colour refinement tolerance (`--refine-tol`;
+    /// [`crate::numeric::tolerance::COLOR_REFINE_TOL`] by default): lower
+    /// refines more region triangles, for less colour interpolation error.
+    pub refine_tol: f64,
 }
 
 impl Default for ProjectedOptions {
@@ -120,6 +124,7 @@ impl Default for ProjectedOptions {
             compositor: Compositor::Gpu,
             draw: DrawKind::Composite,
             watch: None,
+            refine_tol: crate::numeric::tolerance::COLOR_REFINE_TOL,
         }
     }
 }

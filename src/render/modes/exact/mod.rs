@@ -271,7 +271,21 @@ impl CpuStage<ExactVertex> for ExactTwin {
 }
 
 /// The exact mode on the projected-cell driver.
-pub struct ExactMode;
+#[derive(Clone, Copy, Debug)]
+pub struct ExactMode {
+    /// Colour refinement tolerance (`--refine-tol`, default
+    /// [`COLOR_REFINE_TOL`]): a region triangle whose optical depth times
+    /// glow spread exceeds it is split at its edge midpoints.
+    pub refine_tol: f64,
+}
+
+impl Default for ExactMode {
+    fn default() -> Self {
+        ExactMode {
+            refine_tol: COLOR_REFINE_TOL,
+        }
+    }
+}
 
 /// The exact payload of one piece: the vertex integrals and the piece's
 /// depth balance.
@@ -337,7 +351,8 @@ impl ProjectedMode for ExactMode {
                 hi - lo
             })
             .fold(0.0, f64::max);
-        if depth * spread > COLOR_REFINE_TOL {
+        let tol = self.refine_tol;
+        if depth * spread > tol {
             let before = proj.triangles.len();
             refine(proj, COLOR_REFINE_MAX_DEPTH, |a, b| {
                 let va = vertex_values(tf, a.l, a.s_front, a.s_back);
@@ -346,7 +361,7 @@ impl ProjectedMode for ExactMode {
                 let spread = (0..3)
                     .map(|k| (va.glow[k] - vb.glow[k]).abs())
                     .fold(0.0, f64::max);
-                depth * spread > COLOR_REFINE_TOL
+                depth * spread > tol
             });
             if src.cull {
                 proj.cull_to_pixels(&src.grid);
