@@ -450,3 +450,50 @@ fn table_modes_flags_stats_and_refused_sizes() {
         assert!(t["texels_built"].as_u64().unwrap() > 0);
     }
 }
+
+/// `--refine-tol`: a lower tolerance refines more region triangles of the
+/// exact mode (and a note says it is the exact mode's elsewhere).
+#[test]
+fn refine_tolerance_trades_triangles() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("r.png");
+    let mesh = mesh_file("zoo_3x3x3.vtu");
+    let refined = |tol: &str| -> Option<u64> {
+        let o = render(
+            &mesh,
+            &png,
+            &["--size", "48x48", "--refine-tol", tol, "--stats", "--json"],
+        );
+        if no_adapter(&o) {
+            return None;
+        }
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["detail"]["refined_triangles"].as_u64()
+    };
+    if let (Some(coarse), Some(fine)) = (refined("0.05"), refined("0.001")) {
+        assert!(fine > coarse, "{coarse} -> {fine}");
+    } else {
+        eprintln!("GPU part skipped: no adapter");
+    }
+    let o = render(
+        &mesh,
+        &png,
+        &[
+            "--size",
+            "16x16",
+            "--mode",
+            "raycast",
+            "--refine-tol",
+            "0.01",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--refine-tol is the exact mode's"),
+        "{}",
+        stderr(&o)
+    );
+    let o = render(&mesh, &png, &["--refine-tol", "0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
