@@ -157,7 +157,8 @@ fn rows_columns_errors_and_plot() {
         }
     }
     let p = image::open(&plot).unwrap();
-    assert_eq!((p.width(), p.height()), (1400, 640));
+    // One row of panels per size.
+    assert_eq!((p.width(), p.height()), (1400, 40 + 2 * 440));
 }
 
 #[test]

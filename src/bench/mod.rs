@@ -229,6 +229,9 @@ pub struct BenchConfig {
     pub load_s: f64,
     /// Cap on the estimated time of the whole bench.
     pub max_seconds: f64,
+    /// Keep every frame's reference images in [`BenchOutput::frames`]
+    /// (for external points; they cost 16 bytes per pixel each).
+    pub keep_references: bool,
 }
 
 impl BenchConfig {
@@ -371,6 +374,7 @@ pub fn run(
         * config.views.len()
         * (config.entries.len() * runs_per_entry + refs_per_frame);
     let mut done = 0;
+    progress(&format!("estimated about {estimate_s:.0} s"), done, total);
     let mut rows = Vec::new();
     for &size in &config.sizes {
         for (vi, &view) in config.views.iter().enumerate() {
@@ -471,7 +475,11 @@ pub fn run(
                 size,
                 view: vi,
                 camera,
-                images: refs,
+                images: if config.keep_references {
+                    refs
+                } else {
+                    Vec::new()
+                },
             });
         }
     }

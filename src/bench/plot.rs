@@ -1,12 +1,13 @@
 //! The bench's plot: time per frame against error, log-log, drawn with the
 //! `plotters` crate into an RGB buffer and written as PNG.
 //!
-//! Two panels share the time axis: on the left the error against the ray
-//! caster on the same field (algorithm error), on the right against the
-//! `native` field (algorithm plus model error). One series per (source,
-//! mode, size): its points are the mode's settings in order (coarse to
-//! fine), joined by a line; a point's time is the median over the views of
-//! the rows' median times, its error the largest over the views. Errors
+//! One row of two panels per image size: on the left the error against
+//! the ray caster on the same field (algorithm error), on the right against
+//! the `native` field (algorithm plus model error). One series per (source,
+//! mode), with its own colour and marker in every panel and one legend
+//! beside the panels: its points are the mode's settings in order (coarse
+//! to fine), joined by a line; a point's time is the median over the views
+//! of the rows' median times, its error the largest over the views. Errors
 //! below [`ERROR_FLOOR`] (an exact match) are drawn on the floor. Text uses
 //! the Ubuntu Light font embedded by `epaint_default_fonts`, registered
 //! with plotters' `ab_glyph` text backend, so no system font is needed.
@@ -27,6 +28,8 @@ pub const ERROR_FLOOR: f64 = 1e-6;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Series {
     pub label: String,
+    /// `WxH` of its rows.
+    pub size: String,
     /// `(seconds, algorithm error, native error)` per setting, in order.
     pub points: Vec<(f64, Option<f64>, Option<f64>)>,
 }
@@ -74,9 +77,9 @@ pub fn series(rows: &[Row]) -> Vec<Series> {
             settings.sort_by(|a, b| a.0.total_cmp(&b.0));
             let (source, mode, size) = key;
             let label = if source == "zoovr" {
-                format!("{mode} {size}")
+                mode
             } else {
-                format!("{source} {mode} {size}")
+                format!("{source} {mode}")
             };
             let points = settings
                 .into_iter()
@@ -88,7 +91,11 @@ pub fn series(rows: &[Row]) -> Vec<Series> {
                     )
                 })
                 .collect();
-            Series { label, points }
+            Series {
+                label,
+                size,
+                points,
+            }
         })
         .collect()
 }
@@ -127,33 +134,103 @@ const COLOURS: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
-/// Writes the plot of `rows` as a `width` x `height` PNG.
-pub fn write_plot(
-    path: &Path,
-    rows: &[Row],
-    title: &str,
-    (width, height): (u32, u32),
-) -> Result<(), BenchError> {
+/// Height of one row of panels (one image size), in pixels.
+const ROW_HEIGHT: u32 = 440;
+/// Width of the figure and of its legend column.
+const WIDTH: u32 = 1400;
+const LEGEND_WIDTH: u32 = 210;
+
+/// The size of the plot of `rows`: one row of panels per image size.
+pub fn plot_size(rows: &[Row]) -> (u32, u32) {
+    let sizes = distinct(series(rows).iter().map(|s| s.size.clone()));
+    (WIDTH, 40 + ROW_HEIGHT * sizes.len().max(1) as u32)
+}
+
+fn distinct(v: impl Iterator<Item = String>) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for x in v {
+        if !out.contains(&x) {
+            out.push(x);
+        }
+    }
+    out
+}
+
+/// Draws the points `pts` on `chart` with marker `shape` (the same four
+/// shapes as the legend).
+macro_rules! markers {
+    ($chart:expr, $pts:expr, $shape:expr, $colour:expr) => {
+        match $shape % 4 {
+            0 => $chart.draw_series($pts.iter().map(|&p| Circle::new(p, 4, $colour.filled()))),
+            1 => $chart.draw_series(
+                $pts.iter()
+                    .map(|&p| TriangleMarker::new(p, 5, $colour.filled())),
+            ),
+            2 => $chart.draw_series(
+                $pts.iter()
+                    .map(|&p| Cross::new(p, 5, $colour.stroke_width(2))),
+            ),
+            _ => $chart.draw_series($pts.iter().map(|&p| {
+                EmptyElement::at(p) + Rectangle::new([(-4, -4), (4, 4)], $colour.filled())
+            })),
+        }
+    };
+}
+
+/// Writes the plot of `rows` as a PNG of [`plot_size`].
+pub fn write_plot(path: &Path, rows: &[Row], title: &str) -> Result<(), BenchError> {
     let err = |e: &dyn std::fmt::Display| BenchError::Write {
         path: path.display().to_string(),
         msg: e.to_string(),
     };
     register_font()?;
     let all = series(rows);
+    let sizes = distinct(all.iter().map(|s| s.size.clone()));
+    let labels = distinct(all.iter().map(|s| s.label.clone()));
+    let style_of = |label: &str| labels.iter().position(|l| l == label).unwrap_or(0);
+    let (width, height) = plot_size(rows);
     let mut buf = vec![255u8; width as usize * height as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(&e))?;
-        let (top, body) = root.split_vertically(36);
-        top.titled(title, ("sans-serif", 22)).map_err(|e| err(&e))?;
-        let panels = body.split_evenly((1, 2));
+        let (top, body) = root.split_vertically(40);
+        top.titled(title, ("sans-serif", 20)).map_err(|e| err(&e))?;
+        let (plots, legend) = body.split_horizontally(width - LEGEND_WIDTH);
+        // The legend: one line per series label, its marker and colour.
+        for (i, label) in labels.iter().enumerate() {
+            let colour = COLOURS[i % COLOURS.len()];
+            let y = 60 + 20 * i as i32;
+            legend
+                .draw(&PathElement::new(
+                    vec![(8, y), (36, y)],
+                    colour.stroke_width(2),
+                ))
+                .map_err(|e| err(&e))?;
+            let p = (22, y);
+            match (i / COLOURS.len() + i) % 4 {
+                0 => legend.draw(&Circle::new(p, 4, colour.filled())),
+                1 => legend.draw(&TriangleMarker::new(p, 5, colour.filled())),
+                2 => legend.draw(&Cross::new(p, 5, colour.stroke_width(2))),
+                _ => legend.draw(&Rectangle::new(
+                    [(p.0 - 4, p.1 - 4), (p.0 + 4, p.1 + 4)],
+                    colour.filled(),
+                )),
+            }
+            .map_err(|e| err(&e))?;
+            legend
+                .draw(&Text::new(label.clone(), (44, y - 7), ("sans-serif", 14)))
+                .map_err(|e| err(&e))?;
+        }
+        let panels = plots.split_evenly((sizes.len().max(1), 2));
         let times: Vec<f64> = all
             .iter()
             .flat_map(|s| s.points.iter().map(|p| p.0))
             .filter(|t| t.is_finite() && *t > 0.0)
             .collect();
         let (tmin, tmax) = bounds(&times, 1e-3);
-        for (k, panel) in panels.iter().enumerate() {
+        for (n, panel) in panels.iter().enumerate() {
+            let (row, k) = (n / 2, n % 2);
+            let Some(size) = sizes.get(row) else { continue };
             let pick = |p: &(f64, Option<f64>, Option<f64>)| if k == 0 { p.1 } else { p.2 };
             let errors: Vec<f64> = all
                 .iter()
@@ -162,9 +239,9 @@ pub fn write_plot(
                 .collect();
             let (emin, emax) = bounds(&errors, ERROR_FLOOR);
             let caption = if k == 0 {
-                "error against the ray caster, same field"
+                format!("{size}: error against the ray caster, same field")
             } else {
-                "error against the ray caster, native field"
+                format!("{size}: error against the ray caster, native field")
             };
             let mut chart = ChartBuilder::on(panel)
                 .caption(caption, ("sans-serif", 16))
@@ -177,12 +254,13 @@ pub fn write_plot(
                 .configure_mesh()
                 .x_desc("time per frame, s (median)")
                 .y_desc("max abs error, display values (1e-6: at most)")
-                .x_label_formatter(&|v| format!("{v:.2e}"))
+                .x_label_formatter(&|v| format!("{v:.0e}"))
                 .y_label_formatter(&|v| format!("{v:.0e}"))
                 .label_style(("sans-serif", 12))
                 .draw()
                 .map_err(|e| err(&e))?;
-            for (i, s) in all.iter().enumerate() {
+            for s in all.iter().filter(|s| &s.size == size) {
+                let i = style_of(&s.label);
                 let colour = COLOURS[i % COLOURS.len()];
                 let pts: Vec<(f64, f64)> = s
                     .points
@@ -190,39 +268,12 @@ pub fn write_plot(
                     .filter_map(|p| pick(p).map(|e| (p.0, e.max(ERROR_FLOOR))))
                     .filter(|p| p.0 > 0.0 && p.0.is_finite())
                     .collect();
-                if pts.is_empty() {
-                    continue;
-                }
-                let style = colour.stroke_width(2);
                 chart
-                    .draw_series(LineSeries::new(pts.clone(), style))
-                    .map_err(|e| err(&e))?
-                    .label(s.label.clone())
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
-                    });
-                let shape = i / COLOURS.len() % 3;
-                match shape {
-                    0 => chart.draw_series(pts.iter().map(|p| Circle::new(*p, 4, colour.filled()))),
-                    1 => chart.draw_series(
-                        pts.iter()
-                            .map(|p| TriangleMarker::new(*p, 5, colour.filled())),
-                    ),
-                    _ => chart.draw_series(
-                        pts.iter()
-                            .map(|p| Cross::new(*p, 5, colour.stroke_width(2))),
-                    ),
-                }
-                .map_err(|e| err(&e))?;
+                    .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
+                    .map_err(|e| err(&e))?;
+                let shape = i / COLOURS.len() + i;
+                markers!(chart, pts, shape, colour).map_err(|e| err(&e))?;
             }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .label_font(("sans-serif", 12))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(|e| err(&e))?;
         }
         root.present().map_err(|e| err(&e))?;
     }
@@ -273,16 +324,17 @@ mod tests {
         ];
         let s = series(&rows);
         assert_eq!(s.len(), 2);
-        assert_eq!(s[0].label, "preint3d 64x64");
+        assert_eq!(s[0].label, "preint3d");
+        assert_eq!(s[0].size, "64x64");
         // table=32 first (coarser), its time the median of 0.1 and 0.3,
         // its error the larger of the two views.
         assert_eq!(s[0].points[0], (0.2, Some(0.05), Some(0.1)));
         assert_eq!(s[0].points[1], (0.2, Some(0.01), Some(0.02)));
         let dir = tempfile::tempdir().unwrap();
         let png = dir.path().join("p.png");
-        write_plot(&png, &rows, "test", (900, 450)).unwrap();
+        write_plot(&png, &rows, "test").unwrap();
         let img = image::open(&png).unwrap().to_rgb8();
-        assert_eq!(img.dimensions(), (900, 450));
+        assert_eq!(img.dimensions(), (WIDTH, 40 + ROW_HEIGHT));
         // Something besides white was drawn (axes, text, markers).
         let dark = img
             .pixels()

@@ -294,6 +294,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         background: args.background,
         load_s,
         max_seconds: args.max_seconds,
+        keep_references: args.with_vtk.is_some(),
     };
     let mut renderer = Renderer::new(geometry.clone());
     if let Some(p) = pending {
@@ -374,7 +375,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 )
             })
         );
-        bench::plot::write_plot(p, &rows, &title, (1400, 640))?;
+        bench::plot::write_plot(p, &rows, &title)?;
     }
     std::mem::forget(renderer);
     Ok(())
@@ -392,6 +393,10 @@ fn progress() -> impl FnMut(&str, usize, usize) {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
     move |what, done, total| {
+        if done == 0 && what.starts_with("estimated") {
+            // One line, also off a terminal: what the run will cost.
+            bar.suspend(|| eprintln!("zoovr: bench: {what} for {total} renders"));
+        }
         bar.set_length(total as u64);
         bar.set_position(done as u64);
         bar.set_message(what.to_string());
