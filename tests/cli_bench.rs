@@ -304,3 +304,43 @@ fn with_vtk_adds_vtk_rows() {
         assert!(e > 0.0 && rms < 0.05, "{r:?}");
     }
 }
+
+/// With `--iso`, `all` means the modes that draw surfaces (iso in, exact
+/// out) and the references are the ray caster's surfaces (no `native`).
+#[test]
+fn isosurfaces_join_every_mode_that_draws_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("i.csv");
+    let file = mesh_file("zoo_3x3x3.vtu");
+    let o = zoovr(&[
+        "bench",
+        file.to_str().unwrap(),
+        "--iso",
+        "0.5:#ff8000:0.6",
+        "--sizes",
+        "24",
+        "--warmup",
+        "0",
+        "--repeats",
+        "1",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let (head, rows) = csv_rows(&csv);
+    let modes: Vec<&str> = rows.iter().map(|r| col(&head, r, "mode")).collect();
+    assert!(
+        modes.contains(&"iso") && !modes.contains(&"exact"),
+        "{modes:?}"
+    );
+    // raycast: faces and tets only.
+    assert_eq!(modes.iter().filter(|m| **m == "raycast").count(), 2);
+    let gpu = render_util::gpu_available();
+    for r in &rows {
+        assert!(col(&head, r, "native_max_err").is_empty(), "{r:?}");
+        if gpu || col(&head, r, "mode") == "raycast" {
+            assert!(col(&head, r, "error").is_empty(), "{r:?}");
+            assert!(!col(&head, r, "max_err").is_empty(), "{r:?}");
+        }
+    }
+}

@@ -18,7 +18,7 @@
 //! 3. **Run.** For each size and view: the references first (the ray
 //!    caster on `faces`, and on `native` when the scene has no surfaces),
 //!    then each entry: `warmup` untimed renders and `repeats` timed ones;
-//!    a row keeps the median run's stage times and the spread of the
+//!    a row keeps the (lower) median run's stage times and the spread of the
 //!    totals, the triangles and pieces, the process's peak resident memory
 //!    over the row ([`memory`]) and the errors of the median run's image.
 //! 4. **Error.** Display values (PNG values in [0, 1] over the background,
@@ -553,7 +553,8 @@ fn run_entry(
     row.repeats = runs.len();
     row.total_min_s = runs.first().map_or(f64::NAN, |r| r.0);
     row.total_max_s = runs.last().map_or(f64::NAN, |r| r.0);
-    let mid = runs.len() / 2;
+    // The lower median: a run's own stage times, never an average.
+    let mid = (runs.len() - 1) / 2;
     let (t, stats, image) = &mut runs[mid];
     row.total_s = *t;
     fill_stages(&mut row, stats);
