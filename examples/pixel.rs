@@ -4,7 +4,7 @@
 //! interpolated thickness, extinction, glow) and the ray caster's segments.
 //!
 //! ```sh
-//! cargo run --release --example pixel -- FILE I J [WIDTH] [--height H] [--ortho] [--azimuth A] [--elevation E] [--zoom Z] [--split] [--mode NAME] [--no-cull]
+//! cargo run --release --example pixel -- FILE I J [WIDTH] [--height H] [--ortho] [--azimuth A] [--elevation E] [--zoom Z] [--split] [--mode NAME] [--no-cull] [--tf FILE] [--refine-tol T]
 //! ```
 
 use anyhow::{anyhow, Context as _, Result};
@@ -54,7 +54,16 @@ fn main() -> Result<()> {
         None => Mode::Exact,
     };
     let mesh = io::read(std::path::Path::new(file), &ReadOptions::default())?;
-    let scene = Scene::build(mesh, &SceneSpec::default())?;
+    let tf_file = args
+        .iter()
+        .position(|a| a == "--tf")
+        .and_then(|k| args.get(k + 1))
+        .map(std::path::PathBuf::from);
+    let spec = SceneSpec {
+        tf_file,
+        ..Default::default()
+    };
+    let scene = Scene::build(mesh, &spec)?;
     let mut renderer = Renderer::new(scene.geometry());
     let opts = RenderOptions {
         camera,
@@ -64,6 +73,7 @@ fn main() -> Result<()> {
             compositor: Compositor::Cpu,
             watch: Some((i, j)),
             cull_to_pixels: !args.iter().any(|a| a == "--no-cull"),
+            refine_tol: flag("--refine-tol").unwrap_or(zoovr::numeric::tolerance::COLOR_REFINE_TOL),
             ..Default::default()
         },
         ..Default::default()
