@@ -11,8 +11,10 @@
 //! (`RAYCAST_BENCH_MODELS`, default `faces,tets,native`), then walk against
 //! brute-force traversal (`raycast_walk_vs_brute`: perspective, models
 //! `RAYCAST_BENCH_BRUTE_MODELS`, default `faces,tets`; the largest
-//! difference between the two images is printed). `RAYCAST_BENCH_SIZE`
-//! sets the image size (default 512).
+//! difference between the two images is printed), then early ray
+//! termination on and off on an opaque front layer
+//! (`raycast_early_termination`; `RAYCAST_BENCH_TERMINATION=none` skips
+//! it). `RAYCAST_BENCH_SIZE` sets the image size (default 512).
 
 use std::time::Instant;
 
@@ -316,5 +318,50 @@ fn walk_vs_brute(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, walk_vs_brute);
+/// Early ray termination (transmittance 1e-6) against none, `faces` walk,
+/// perspective, on the hex_shell scene with an opaque front layer: the
+/// `bench_tf.json` colours with extinction 40 per unit below f = 0.3
+/// (where most rays enter) and 0.5 above. Prints the rays that stopped.
+fn early_termination(c: &mut Criterion) {
+    if std::env::var("RAYCAST_BENCH_TERMINATION").is_ok_and(|v| v == "none") {
+        return;
+    }
+    let (mesh, f) = hex_shell();
+    let topology = Topology::build(&mesh.cells);
+    let scene = Scene {
+        mesh: &mesh,
+        topology: &topology,
+        scalars: Scalars::Point(&f),
+    };
+    let tf = TransferFunction::from_channels(
+        &[(0.0, [40.0]), (0.3, [40.0]), (0.31, [0.5]), (1.0, [0.5])],
+        &[(0.0, [1.0, 0.9, 0.0]), (1.0, [0.0, 0.3, 1.0])],
+        None,
+        zoovr::tf::EmissionModel::Glow,
+    )
+    .expect("tf");
+    let size = bench_size();
+    let cam = camera(&mesh, false, size);
+    let walk = Raycaster::new(scene, FieldModel::Faces).unwrap();
+    let mut g = c.benchmark_group("raycast_early_termination");
+    g.sample_size(10);
+    for (name, t) in [("on", 1e-6), ("off", 0.0)] {
+        let opts = RaycastOptions {
+            model: FieldModel::Faces,
+            early_termination: t,
+            ..Default::default()
+        };
+        let (_, stopped) = walk.render_counting(&tf, &cam, &opts, |_, _| {});
+        eprintln!(
+            "termination {name}: {stopped} of {} rays stopped early",
+            size * size
+        );
+        g.bench_function(format!("faces_walk_{size}_{name}"), |bch| {
+            bch.iter(|| walk.render(&tf, &cam, &opts))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, walk_vs_brute, early_termination);
 criterion_main!(benches);

@@ -130,3 +130,61 @@ fn early_termination_loses_at_most_its_threshold() {
     // A large threshold really stops early: some opacity is left out.
     assert!(full(0.5)[3] < exact[3]);
 }
+
+/// Early ray termination, measured: on a scene opaque enough that most rays
+/// reach transmittance 1e-6, stopping there leaves every pixel within that
+/// fraction of the brightest glow (1) of the full integral, and the stats
+/// count the rays that stopped (none with it off). A termination that
+/// dropped visible cells would move some pixel by more.
+#[test]
+fn early_termination_changes_no_pixel_beyond_its_bound() {
+    use zoovr::io::{self, ReadOptions};
+    use zoovr::render::{Mode, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec};
+    let mesh = io::read(
+        &zoovr::testdata::mesh_file("zoo_3x3x3.vtu"),
+        &ReadOptions::default(),
+    )
+    .unwrap();
+    let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+    let mut shading = scene.shading();
+    let b = scene.mesh.bounds();
+    let diag = ((b[1] - b[0]).powi(2) + (b[3] - b[2]).powi(2) + (b[5] - b[4]).powi(2)).sqrt();
+    let (lo, hi) = shading.range;
+    // Extinction up to 400 per diagonal: rays through the middle are
+    // opaque well before they leave.
+    shading.tf = TransferFunction::from_channels(
+        &[(lo, [40.0 / diag]), (hi, [400.0 / diag])],
+        &[(lo, [0.2, 0.4, 1.0]), (hi, [1.0, 0.8, 0.1])],
+        None,
+        EmissionModel::Glow,
+    )
+    .unwrap();
+    let mut renderer = Renderer::new(scene.geometry());
+    let render = |renderer: &mut Renderer, on: bool| {
+        let opts = RenderOptions {
+            mode: Mode::Raycast,
+            camera: zoovr::camera::CameraParams {
+                width: 64,
+                height: 64,
+                azimuth: 30.0,
+                elevation: 20.0,
+                ..Default::default()
+            },
+            reference: ReferenceOptions {
+                early_termination: on,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        renderer.render(&shading, &opts, |_, _| {}).unwrap()
+    };
+    let (with, s_with) = render(&mut renderer, true);
+    let (without, s_without) = render(&mut renderer, false);
+    let stopped = s_with.raycast().unwrap().terminated_rays;
+    assert!(stopped > 500, "{stopped} rays stopped early");
+    assert_eq!(s_without.raycast().unwrap().terminated_rays, 0);
+    let (d, _) = zoovr::image::compare_float(&with, &without).unwrap();
+    // 1e-6 of a glow of at most 1, plus f32 rounding of the pixel values.
+    assert!(d.max_abs <= 1e-6 + 2e-7, "{d:?}");
+    assert!(d.max_abs > 0.0, "the termination changed nothing: {d:?}");
+}

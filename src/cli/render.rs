@@ -212,6 +212,7 @@ impl ViewArgs {
             reference: ReferenceOptions {
                 model: self.model.unwrap_or_default(),
                 traversal: self.traversal.unwrap_or_default(),
+                early_termination: true,
             },
             projected: ProjectedOptions {
                 split_all: self.split.is_some(),

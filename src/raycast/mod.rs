@@ -703,9 +703,29 @@ pub trait RayTracer: Sync {
         opts: &RaycastOptions,
         progress: impl FnMut(usize, usize),
     ) -> Image {
-        render_tiles(camera, opts, progress, |ray, t_near, scratch| {
-            self.integrate(material, ray, t_near, opts, scratch).rgba()
-        })
+        self.render_counting(material, camera, opts, progress).0
+    }
+
+    /// [`RayTracer::render_with_progress`], also counting the rays that
+    /// stopped early: those whose optical depth reached the termination
+    /// depth of `opts.early_termination` (0 when it is off).
+    fn render_counting<M: RayMaterial>(
+        &self,
+        material: &M,
+        camera: &Camera,
+        opts: &RaycastOptions,
+        progress: impl FnMut(usize, usize),
+    ) -> (Image, u64) {
+        let stop = stop_depth(opts);
+        let terminated = std::sync::atomic::AtomicU64::new(0);
+        let img = render_tiles(camera, opts, progress, |ray, t_near, scratch| {
+            let acc = self.integrate(material, ray, t_near, opts, scratch);
+            if acc.depth >= stop {
+                terminated.fetch_add(1, Ordering::Relaxed);
+            }
+            acc.rgba()
+        });
+        (img, terminated.into_inner())
     }
 }
 

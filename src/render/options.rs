@@ -151,13 +151,28 @@ impl fmt::Display for ProjectedOptions {
 }
 
 /// Options of the reference ray caster.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct ReferenceOptions {
     /// Field model of the ray caster.
     pub model: FieldModel,
     /// How the ray caster finds the pieces along a ray (walk by adjacency,
     /// or brute force: `faces` and `tets` only).
     pub traversal: Traversal,
+    /// Stop a ray once its transmittance falls below
+    /// [`crate::numeric::tolerance::RAY_TERMINATION_TRANSMITTANCE`] (on by
+    /// default; the colour it leaves out is at most that fraction of the
+    /// brightest glow). Off only to measure what it saves.
+    pub early_termination: bool,
+}
+
+impl Default for ReferenceOptions {
+    fn default() -> Self {
+        ReferenceOptions {
+            model: FieldModel::default(),
+            traversal: Traversal::default(),
+            early_termination: true,
+        }
+    }
 }
 
 impl fmt::Display for ReferenceOptions {

@@ -110,6 +110,10 @@ pub struct RaycastStats {
     /// Rays stop once their transmittance falls below this (0: never), so
     /// a pixel's opacity may fall short of the full integral by at most it.
     pub termination_transmittance: f64,
+    /// Rays that stopped there (their optical depth reached
+    /// `-ln(termination_transmittance)`): the work the early termination
+    /// saved lies behind them.
+    pub terminated_rays: u64,
     /// Native model: intervals integrated and what fell back from the
     /// exact method during this render (zero for other models).
     pub native: NativeStats,
@@ -123,10 +127,12 @@ impl fmt::Display for RaycastStats {
         let r = self;
         write!(
             f,
-            "raycast      model {}, traversal {}, early ray termination below transmittance {:e}",
+            "raycast      model {}, traversal {}, early ray termination below transmittance {:e} \
+             ({} rays stopped there)",
             r.model.name(),
             r.traversal.name(),
-            r.termination_transmittance
+            r.termination_transmittance,
+            r.terminated_rays
         )?;
         if r.traversal == Traversal::Brute {
             let b = &r.brute;

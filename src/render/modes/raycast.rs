@@ -58,12 +58,18 @@ pub(crate) fn render(
     let ro = RaycastOptions {
         model: opts.reference.model,
         traversal: opts.reference.traversal,
+        early_termination: if opts.reference.early_termination {
+            crate::numeric::tolerance::RAY_TERMINATION_TRANSMITTANCE
+        } else {
+            0.0
+        },
         ..Default::default()
     };
     let mut stats = RaycastStats {
         model: opts.reference.model,
         traversal: opts.reference.traversal,
         termination_transmittance: ro.early_termination,
+        terminated_rays: 0,
         native: Default::default(),
         brute: Default::default(),
     };
@@ -73,16 +79,18 @@ pub(crate) fn render(
             let rc = Raycaster::new(rs, opts.reference.model)?;
             setup_s = t0.elapsed().as_secs_f64();
             let before = rc.native_stats();
-            let img = rc.render_with_progress(&scene.tf, camera, &ro, progress);
+            let (img, n) = rc.render_counting(&scene.tf, camera, &ro, progress);
             stats.native = rc.native_stats().since(&before);
+            stats.terminated_rays = n;
             img
         }
         Traversal::Brute => {
             let b = Brute::new(rs, opts.reference.model)?;
             setup_s = t0.elapsed().as_secs_f64();
             let before = b.stats();
-            let img = b.render_with_progress(&scene.tf, camera, &ro, progress);
+            let (img, n) = b.render_counting(&scene.tf, camera, &ro, progress);
             stats.brute = b.stats().since(&before);
+            stats.terminated_rays = n;
             img
         }
     };
@@ -114,6 +122,11 @@ pub fn render_iso(
     let ro = RaycastOptions {
         model: opts.reference.model,
         traversal: opts.reference.traversal,
+        early_termination: if opts.reference.early_termination {
+            crate::numeric::tolerance::RAY_TERMINATION_TRANSMITTANCE
+        } else {
+            0.0
+        },
         ..Default::default()
     };
     let set = IsoSet::new(&opts.iso, &scene.tf);
@@ -121,15 +134,16 @@ pub fn render_iso(
     let rc = Raycaster::new(rs, opts.reference.model)?;
     let iso = IsoReference::new(&rc, &set, camera.forward, grads.as_deref(), values);
     let setup_s = t0.elapsed().as_secs_f64();
-    let img = if volume {
-        iso.render_with_progress(&scene.tf, camera, &ro, progress)
+    let (img, terminated_rays) = if volume {
+        iso.render_counting(&scene.tf, camera, &ro, progress)
     } else {
-        iso.render_with_progress(&Empty, camera, &ro, progress)
+        iso.render_counting(&Empty, camera, &ro, progress)
     };
     let stats = RaycastStats {
         model: opts.reference.model,
         traversal: opts.reference.traversal,
         termination_transmittance: ro.early_termination,
+        terminated_rays,
         native: Default::default(),
         brute: Default::default(),
     };
