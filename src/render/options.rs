@@ -110,6 +110,11 @@ pub struct ProjectedOptions {
     /// On the CPU twin: the pixel whose fragments are listed in
     /// [`super::ProjectedStats::watched`].
     pub watch: Option<(u32, u32)>,
+    /// Leave out pieces whose scalar range maps to zero extinction (and
+    /// zero emission) and holds no isosurface: they neither emit nor
+    /// absorb, so the image is the same (on by default; off only to
+    /// measure what it saves).
+    pub skip_invisible: bool,
     /// The exact mode's colour refinement tolerance (`--refine-tol`;
     /// [`crate::numeric::tolerance::COLOR_REFINE_TOL`] by default): lower
     /// refines more region triangles, for less colour interpolation error.
@@ -124,6 +129,7 @@ impl Default for ProjectedOptions {
             compositor: Compositor::Gpu,
             draw: DrawKind::Composite,
             watch: None,
+            skip_invisible: true,
             refine_tol: crate::numeric::tolerance::COLOR_REFINE_TOL,
         }
     }

@@ -72,6 +72,9 @@ pub struct PieceSource<'a> {
     /// Leave out triangles that colour no pixel centre of `grid`
     /// ([`crate::projection::coverage`]).
     pub cull: bool,
+    /// Leave out pieces that draw nothing ([`PieceSource::invisible`]; on
+    /// by default, off only to measure what it saves).
+    pub skip_invisible: bool,
     pub grid: PixelGrid,
     /// The frame's pixel rays for the exact decisions next to outlines
     /// ([`super::ties`]).
@@ -396,7 +399,7 @@ impl PieceSource<'_> {
     /// not only the mode's split points: a mode that slices at none still
     /// skips only what is truly dark.
     pub fn invisible(&self, lo: f64, hi: f64) -> bool {
-        if !(lo.is_finite() && hi.is_finite()) {
+        if !self.skip_invisible || !(lo.is_finite() && hi.is_finite()) {
             return false;
         }
         if self.iso.is_some_and(|set| set.any_in(lo, hi)) {
