@@ -399,7 +399,7 @@ impl PieceSource<'_> {
     /// not only the mode's split points: a mode that slices at none still
     /// skips only what is truly dark.
     pub fn invisible(&self, lo: f64, hi: f64) -> bool {
-        if !self.skip_invisible || !(lo.is_finite() && hi.is_finite()) {
+        if !(self.skip_invisible && lo.is_finite() && hi.is_finite()) {
             return false;
         }
         if self.iso.is_some_and(|set| set.any_in(lo, hi)) {
