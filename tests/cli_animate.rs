@@ -600,3 +600,48 @@ fn the_example_flow_series_animates_with_values_reused() {
     assert_eq!(changes, ["none", "values", "values", "values"]);
     assert_eq!(lines[3]["time"].as_f64(), Some(0.75));
 }
+
+/// `--iso` values outside the range the field takes over the series are
+/// named in a warning (their surface is in no frame); values inside are not.
+#[test]
+fn isovalues_outside_the_series_range_are_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let pvd = write_steps(dir.path(), &time_series(3, 2));
+    let out = dir.path().join("frames");
+    let o = zoovr(&[
+        "animate",
+        s(&pvd),
+        "-o",
+        s(&out),
+        "--mode",
+        "raycast",
+        "--iso",
+        "1e9,0.5",
+        "--size",
+        "16x16",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("isovalue 1000000000 is outside the range") && e.contains("in no frame"),
+        "{e}"
+    );
+    assert!(!e.contains("isovalue 0.5 is outside"), "{e}");
+    // With --range the data range is unknown: no warning.
+    let o = zoovr(&[
+        "animate",
+        s(&pvd),
+        "-o",
+        s(&out),
+        "--mode",
+        "raycast",
+        "--iso",
+        "1e9",
+        "--range",
+        "0,1",
+        "--size",
+        "16x16",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("outside the range"), "{}", stderr(&o));
+}

@@ -253,6 +253,28 @@ fn colour_range(
     Ok(range)
 }
 
+/// A warning for each `--iso` value outside the range the field takes over
+/// the whole series (that surface is drawn in no frame). Only where that
+/// range was read from every step (not `--range`, a range file or
+/// `--range-from first`).
+fn iso_range_warnings(args: &AnimateArgs, range: Option<(f64, f64)>) {
+    let whole_series = args.view.range.is_none()
+        && args.range_file.is_none()
+        && args.range_from.unwrap_or(RangeFrom::All) == RangeFrom::All;
+    let (Some(list), Some((lo, hi)), true) = (&args.view.iso, range, whole_series) else {
+        return;
+    };
+    for s in &list.0 {
+        if !(s.value >= lo && s.value <= hi) {
+            eprintln!(
+                "zoovr: warning: isovalue {} is outside the range [{lo}, {hi}] the field takes \
+                 over the series: that surface is drawn in no frame",
+                s.value
+            );
+        }
+    }
+}
+
 /// The range of a `--range-only` file.
 fn read_range_file(file: &Path) -> Result<Option<(f64, f64)>> {
     #[derive(serde::Deserialize)]
@@ -343,6 +365,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         .gpu
         .then(|| zoovr::gpu::Context::spawn(&opts.gpu));
     let range = colour_range(args, &steps, &ropts)?;
+    iso_range_warnings(args, range);
     let mut spec = args.view.scene_spec();
     if range.is_some() {
         spec.range = range;
