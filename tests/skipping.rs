@@ -80,3 +80,79 @@ fn dark_pieces_are_skipped_and_the_image_is_unchanged() {
         }
     }
 }
+
+/// A frame that asks for the order of the frame before (same camera, split
+/// policy, scalars) takes it without sorting again, with the image the same
+/// bit for bit; a new camera, new split points or new values sort again.
+#[test]
+fn the_last_order_is_reused_only_when_nothing_it_depends_on_changed() {
+    let mesh = warped_hex_grid(
+        6,
+        &Warp {
+            amplitude: 0.08,
+            seed: 5,
+        },
+    );
+    let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+    let shading = scene.shading();
+    let mut renderer = Renderer::new(scene.geometry());
+    let opts = |mode: Mode, azimuth: f64| RenderOptions {
+        mode,
+        camera: zoovr::camera::CameraParams {
+            width: 48,
+            height: 48,
+            azimuth,
+            ..Default::default()
+        },
+        projected: ProjectedOptions {
+            compositor: Compositor::Cpu,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let frame = |renderer: &mut Renderer, shading: &zoovr::render::Shading, az: f64| {
+        let (img, stats) = renderer
+            .render(shading, &opts(Mode::Exact, az), |_, _| {})
+            .unwrap();
+        (img, stats.projected().unwrap().order_reused)
+    };
+    let (first, reused) = frame(&mut renderer, &shading, 30.0);
+    assert!(!reused);
+    let (again, reused) = frame(&mut renderer, &shading, 30.0);
+    assert!(reused, "the same frame sorts again");
+    assert_eq!(first.pixels, again.pixels);
+    // Another camera.
+    let (_, reused) = frame(&mut renderer, &shading, 31.0);
+    assert!(!reused);
+    // New colours, same split points: the order stands.
+    let mut recoloured = shading.clone();
+    let nodes: Vec<_> = shading.tf.nodes();
+    let tau: Vec<(f64, [f64; 1])> = nodes.iter().map(|n| (n.s, [n.tau])).collect();
+    let col: Vec<(f64, [f64; 3])> = nodes
+        .iter()
+        .map(|n| (n.s, [n.color[2], n.color[1], n.color[0]]))
+        .collect();
+    recoloured.tf = TransferFunction::from_channels(&tau, &col, None, EmissionModel::Glow).unwrap();
+    let (_, reused) = frame(&mut renderer, &recoloured, 31.0);
+    assert!(reused, "colours alone do not change the order");
+    // New values: sorted again.
+    let mut revalued = shading.clone();
+    if let Some(f) = &shading.field {
+        let mut f2 = (**f).clone();
+        for v in &mut f2.values {
+            *v = 1.0 - *v;
+        }
+        revalued.field = Some(std::sync::Arc::new(f2));
+    }
+    let (_, reused) = frame(&mut renderer, &revalued, 31.0);
+    assert!(!reused, "new values sort again where they decide splits");
+    // exact-frag splits at no value: new values keep its order.
+    let mut frag = |shading: &zoovr::render::Shading| {
+        let (_, stats) = renderer
+            .render(shading, &opts(Mode::ExactFrag, 31.0), |_, _| {})
+            .unwrap();
+        stats.projected().unwrap().order_reused
+    };
+    frag(&shading);
+    assert!(frag(&revalued), "exact-frag: values alone keep the order");
+}

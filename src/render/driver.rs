@@ -510,6 +510,7 @@ pub fn render_projected<M: ProjectedMode>(
     sorter: &mut Sorter,
     gpu: &mut Option<Context>,
     pending: &mut Option<PendingContext>,
+    orders: &mut super::order_cache::OrderCache,
     opts: &RenderOptions,
     camera: &Camera,
     mut progress: impl FnMut(usize, usize),
@@ -526,7 +527,8 @@ pub fn render_projected<M: ProjectedMode>(
         breakpoints: &breakpoints,
         point_scalars,
     };
-    let order = sorter.order(camera, &policy)?;
+    let (order, reused) = orders.order(sorter, camera, &policy)?;
+    stats.order_reused = reused;
     stats.sort_s = t0.elapsed().as_secs_f64();
     stats.pieces = order.pieces.len();
     stats.order = order.stats.clone();

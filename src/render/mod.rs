@@ -23,6 +23,7 @@ pub mod iso;
 pub mod marching;
 pub mod modes;
 mod options;
+mod order_cache;
 pub mod pieces;
 mod projected_mode;
 pub mod scene;
@@ -128,6 +129,8 @@ fn iso_mode(scene: &Scene, opts: &RenderOptions) -> Result<modes::iso::IsoMode, 
 pub struct Renderer {
     geometry: Geometry,
     sorter: Option<Sorter>,
+    /// The last order, reused by a frame that asks for the same one.
+    orders: order_cache::OrderCache,
     gpu: Option<Context>,
     pending_gpu: Option<PendingContext>,
 }
@@ -138,6 +141,7 @@ impl Renderer {
         Renderer {
             geometry,
             sorter: None,
+            orders: Default::default(),
             gpu: None,
             pending_gpu: None,
         }
@@ -158,6 +162,7 @@ impl Renderer {
         if !matches!(change, StepChange::None | StepChange::Values) {
             self.sorter = None;
         }
+        self.orders.clear();
         self.geometry = geometry;
     }
 
@@ -307,6 +312,7 @@ impl Renderer {
             sorter,
             &mut self.gpu,
             &mut self.pending_gpu,
+            &mut self.orders,
             opts,
             camera,
             progress,

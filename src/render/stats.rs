@@ -30,6 +30,10 @@ pub struct ProjectedStats {
     /// ([`super::group`]).
     pub group_pixels: usize,
     pub sort_s: f64,
+    /// The frame took the renderer's last order, made for the same camera,
+    /// split policy, scalars and sorter options, without sorting again
+    /// (`order` then holds the statistics of the sort that made it).
+    pub order_reused: bool,
     /// Time spent opening (or waiting for) the GPU context.
     pub gpu_open_s: f64,
     /// Projection, payloads and the draw calls, which overlap (workers
@@ -55,8 +59,9 @@ impl fmt::Display for ProjectedStats {
         let (e, o) = (self, &self.order);
         writeln!(
             f,
-            "sort         {:.3} s  ({} pieces, {} split cells, {} problem cells, {} cycles, {} cut by planes into {} fragments, {} cycle groups of {} pieces over {} pixels)",
+            "sort         {:.3} s{}  ({} pieces, {} split cells, {} problem cells, {} cycles, {} cut by planes into {} fragments, {} cycle groups of {} pieces over {} pixels)",
             e.sort_s,
+            if e.order_reused { ", order reused" } else { "" },
             e.pieces,
             o.split_cells,
             o.problem_cells,
