@@ -444,9 +444,9 @@ pub fn run(
                     if let Setting::Model(m) = entry.setting {
                         refs.push((m, img.clone()));
                     }
-                    frame_rows.push((row, Some(img)));
+                    frame_rows.push((row, Some(img), same));
                 } else {
-                    frame_rows.push((row, None));
+                    frame_rows.push((row, None, same));
                 }
             }
             // Any reference no entry needed before (a bench of the ray
@@ -458,16 +458,9 @@ pub fn run(
                 refs.push((m, reference_image(renderer, shading, &base, m)?));
             }
             let find = |m: FieldModel| refs.iter().find(|(r, _)| *r == m).map(|(_, i)| i);
-            for (mut row, image) in frame_rows {
+            for (mut row, image, same) in frame_rows {
                 if let Some(img) = &image {
-                    let same = find(
-                        config
-                            .entries
-                            .iter()
-                            .find(|e| e.mode.name() == row.mode && e.setting.label() == row.setting)
-                            .map_or(FieldModel::Faces, |e| e.same_field(&config.base)),
-                    );
-                    row.set_errors(img, same, find(FieldModel::Native), config.background);
+                    row.set_errors(img, find(same), find(FieldModel::Native), config.background);
                 }
                 rows.push(row);
             }

@@ -103,15 +103,16 @@ pub fn table(rows: &[Row]) -> String {
     ];
     let mut cells: Vec<Vec<String>> = vec![head.iter().map(|s| s.to_string()).collect()];
     for r in rows {
+        let mut line = vec![
+            r.source.clone(),
+            r.mode.clone(),
+            r.setting.clone(),
+            r.size.clone(),
+            r.view.to_string(),
+        ];
         if let Some(e) = &r.error {
-            cells.push(vec![
-                r.source.clone(),
-                r.mode.clone(),
-                r.setting.clone(),
-                r.size.clone(),
-                r.view.to_string(),
-                format!("failed: {e}"),
-            ]);
+            line.push(format!("failed: {e}"));
+            cells.push(line);
             continue;
         }
         let spread = if r.total_s > 0.0 {
@@ -122,12 +123,7 @@ pub fn table(rows: &[Row]) -> String {
         } else {
             "-".into()
         };
-        cells.push(vec![
-            r.source.clone(),
-            r.mode.clone(),
-            r.setting.clone(),
-            r.size.clone(),
-            r.view.to_string(),
+        line.extend([
             format!("{:.3}", r.total_s),
             spread,
             format!("{:.3}", r.first_s),
@@ -146,6 +142,7 @@ pub fn table(rows: &[Row]) -> String {
             opt(r.native_max_err, sci),
             opt(r.native_rms_err, sci),
         ]);
+        cells.push(line);
     }
     let cols = head.len();
     let width: Vec<usize> = (0..cols)

@@ -216,7 +216,7 @@ fn colour_range(
     steps: &[TimeStep],
     ropts: &ReadOptions,
 ) -> Result<Option<(f64, f64)>> {
-    if let Some(r) = args.view.range {
+    if let Some(r) = args.view.scene.range {
         return Ok(Some(r));
     }
     if let Some(file) = &args.range_file {
@@ -258,7 +258,7 @@ fn colour_range(
 /// range was read from every step (not `--range`, a range file or
 /// `--range-from first`).
 fn iso_range_warnings(args: &AnimateArgs, range: Option<(f64, f64)>) {
-    let whole_series = args.view.range.is_none()
+    let whole_series = args.view.scene.range.is_none()
         && args.range_file.is_none()
         && args.range_from.unwrap_or(RangeFrom::All) == RangeFrom::All;
     let (Some(list), Some((lo, hi)), true) = (&args.view.iso, range, whole_series) else {
@@ -328,9 +328,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     }
     if let (Some(series), Some(file)) = (&args.series, &args.range_only) {
         let steps = io::sequence::list_steps(series)?;
-        let ropts = ReadOptions {
-            q_file: args.view.q.clone(),
-        };
+        let ropts = args.view.scene.read_options();
         let range = colour_range(args, &steps, &ropts)?;
         let text = serde_json::to_string(&serde_json::json!({ "range": range }))?;
         std::fs::write(file, text + "\n")
@@ -355,9 +353,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     }
     std::fs::create_dir_all(out)
         .with_context(|| format!("{}: cannot make the output folder", out.display()))?;
-    let ropts = ReadOptions {
-        q_file: args.view.q.clone(),
-    };
+    let ropts = args.view.scene.read_options();
     let mut opts = args.view.render_options();
     let pending = opts
         .mode

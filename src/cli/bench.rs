@@ -11,14 +11,12 @@ use clap::Args;
 use zoovr::bench::{self, report, vtk, BenchConfig};
 use zoovr::camera::CameraParams;
 use zoovr::gpu::{AccumFormat, Backend, GpuOptions};
-use zoovr::io::{self, ReadOptions};
 use zoovr::render::iso::{IsoOptions, Lighting};
-use zoovr::render::{
-    Geometry, Mode, ProjectedOptions, RenderOptions, Renderer, SceneSpec, Shading,
-};
+use zoovr::render::{Geometry, Mode, ProjectedOptions, RenderOptions, Renderer, Shading};
 
 use super::args::{parse_positive, parse_rgb, parse_size};
 use super::render::IsoList;
+use super::scene::SceneArgs;
 
 /// `--modes`: `all` or a comma-separated list of mode names.
 #[derive(Clone, Debug)]
@@ -129,27 +127,8 @@ pub struct BenchArgs {
     /// is over this many seconds.
     #[arg(long, value_parser = parse_positive, default_value_t = 3600.0)]
     pub max_seconds: f64,
-    /// Field to render: NAME, point:NAME or cell:NAME, with :mag or :N.
-    #[arg(long)]
-    pub field: Option<String>,
-    /// Transfer function file (zoovr JSON or ParaView colour map JSON).
-    #[arg(long)]
-    pub tf: Option<PathBuf>,
-    /// Built-in colour map preset over the scalar range.
-    #[arg(long)]
-    pub preset: Option<String>,
-    /// Scalar range LO,HI for presets and the default transfer function.
-    #[arg(long, value_parser = super::args::parse_range, allow_hyphen_values = true)]
-    pub range: Option<(f64, f64)>,
-    /// Average cell data to the points.
-    #[arg(long)]
-    pub cell_to_point: bool,
-    /// Draw cells vtkGhostType marks hidden or duplicate.
-    #[arg(long)]
-    pub show_hidden: bool,
-    /// PLOT3D solution file.
-    #[arg(long)]
-    pub q: Option<PathBuf>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
     /// Camera azimuth in degrees (views turn from it).
     #[arg(long, value_parser = super::args::parse_finite, default_value_t = 0.0, allow_hyphen_values = true)]
     pub azimuth: f64,
@@ -189,24 +168,7 @@ pub struct BenchArgs {
 
 fn load(args: &BenchArgs) -> Result<(Geometry, Shading, f64)> {
     let t0 = std::time::Instant::now();
-    let mesh = io::read(
-        &args.file,
-        &ReadOptions {
-            q_file: args.q.clone(),
-        },
-    )?;
-    let spec = SceneSpec {
-        field: args.field.clone(),
-        tf_file: args.tf.clone(),
-        preset: args.preset.clone(),
-        range: args.range,
-        cell_to_point: args.cell_to_point,
-        show_hidden: args.show_hidden,
-    };
-    let geometry = Geometry::build(mesh, spec.show_hidden)
-        .with_context(|| format!("{}", args.file.display()))?;
-    let shading =
-        Shading::build(&geometry, &spec).with_context(|| format!("{}", args.file.display()))?;
+    let (geometry, shading) = args.scene.load(&args.file)?;
     Ok((geometry, shading, t0.elapsed().as_secs_f64()))
 }
 

@@ -10,6 +10,7 @@ mod info;
 mod interrupt;
 mod legend;
 mod render;
+mod scene;
 
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser, Subcommand};

@@ -8,7 +8,6 @@ use clap::Args;
 
 use zoovr::camera::CameraParams;
 use zoovr::gpu::{AccumFormat, Backend, GpuOptions};
-use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::{FieldModel, Traversal};
 use zoovr::render::{
     Geometry, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, RenderStats, Renderer,
@@ -17,7 +16,8 @@ use zoovr::render::{
 
 use zoovr::render::iso::{IsoMix, IsoOptions, IsoSpec, Lighting};
 
-use super::args::{parse_finite, parse_positive, parse_range, parse_rgb, parse_size};
+use super::args::{parse_finite, parse_positive, parse_rgb, parse_size};
+use super::scene::SceneArgs;
 
 /// The parsed `--iso` list.
 #[derive(Clone, Debug)]
@@ -33,32 +33,8 @@ pub fn parse_iso(s: &str) -> Result<IsoList, String> {
 /// camera, mode and output encoding.
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
-    /// Field to render: NAME, point:NAME or cell:NAME, with :mag, :x, :y, :z or
-    /// :N for vectors. Default: the docs/conventions.md default-field rule.
-    #[arg(long)]
-    pub field: Option<String>,
-    /// Transfer-function file: zoovr JSON or a ParaView colour map (absolute
-    /// scalar values).
-    #[arg(long, conflicts_with = "preset")]
-    pub tf: Option<PathBuf>,
-    /// Colour-map preset normalised onto the range, opacity ramp 0 -> 1.
-    #[arg(long)]
-    pub preset: Option<String>,
-    /// Scalar range LO,HI for presets and the default transfer function.
-    #[arg(long, value_parser = parse_range, allow_hyphen_values = true)]
-    pub range: Option<(f64, f64)>,
-    /// Average cell data to points.
-    #[arg(long)]
-    pub cell_to_point: bool,
-    /// Draw the cells that the file's `vtkGhostType` cell array flags hidden
-    /// (32) or duplicate (1). By default they are left out, as ParaView does
-    /// (and the default range is over the cells drawn); point flags never
-    /// remove cells.
-    #[arg(long)]
-    pub show_hidden: bool,
-    /// PLOT3D solution file for a PLOT3D grid.
-    #[arg(long)]
-    pub q: Option<PathBuf>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
     /// Image size WxH.
     #[arg(long, value_parser = parse_size, default_value = "512x512")]
     pub size: (u32, u32),
@@ -185,14 +161,7 @@ pub struct ViewArgs {
 impl ViewArgs {
     /// The scene specification.
     pub fn scene_spec(&self) -> SceneSpec {
-        SceneSpec {
-            field: self.field.clone(),
-            tf_file: self.tf.clone(),
-            preset: self.preset.clone(),
-            range: self.range,
-            cell_to_point: self.cell_to_point,
-            show_hidden: self.show_hidden,
-        }
+        self.scene.spec()
     }
 
     /// The render options (camera from the flags).
@@ -293,18 +262,7 @@ impl ViewArgs {
 
     /// Reads the file and builds its geometry and shading.
     pub fn load_scene(&self, file: &std::path::Path) -> Result<(Geometry, Shading)> {
-        let mesh = io::read(
-            file,
-            &ReadOptions {
-                q_file: self.q.clone(),
-            },
-        )?;
-        let spec = self.scene_spec();
-        let geometry = Geometry::build(mesh, spec.show_hidden)
-            .with_context(|| format!("{}", file.display()))?;
-        let shading =
-            Shading::build(&geometry, &spec).with_context(|| format!("{}", file.display()))?;
-        Ok((geometry, shading))
+        self.scene.load(file)
     }
 }
 
