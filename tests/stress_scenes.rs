@@ -320,6 +320,42 @@ fn edge_on_faces_and_coincident_projections() {
     );
 }
 
+/// The exact tie decisions (src/render/ties.rs) are what puts the
+/// outline pixels right: on the CPU twin, the opaque warped grid (tau 1e6)
+/// seen obliquely is within SPLIT_MAX of the ray caster with them, and a
+/// whole pixel off without them (`ProjectedOptions::exact_ties`, off only to measure their
+/// cost in benches/ties.rs).
+#[test]
+fn outline_pixels_need_the_exact_tie_decisions() {
+    let mut scene = Scene::build(grid(4, 0.05), &SceneSpec::default()).unwrap();
+    scene.tf = tf((0.0, 1.0), 1e6);
+    let mut r = Renderer::new(scene.geometry());
+    let cam = camera(&scene.mesh, View::Fit(-30.0, 10.0, true), 96);
+    let mut render = |mode: Mode, model: FieldModel, ties: bool| {
+        let mut opts = options(mode, true, model);
+        opts.projected.compositor = zoovr::render::Compositor::Cpu;
+        opts.projected.exact_ties = ties;
+        r.render_with_camera(&scene.shading(), &opts, &cam, |_, _| {})
+            .unwrap()
+    };
+    let (tets, _) = render(Mode::Raycast, FieldModel::Tets, true);
+    let mut errors = Vec::new();
+    for ties in [true, false] {
+        let (img, stats) = render(Mode::Exact, FieldModel::Tets, ties);
+        let p = stats.projected().unwrap();
+        assert_eq!(p.tie_pixels > 0, ties, "tie pixels {}", p.tie_pixels);
+        let (d, _) = zoovr::image::compare_float(&img, &tets).unwrap();
+        errors.push(d.max_abs);
+    }
+    eprintln!(
+        "max error with ties {:.2e}, without {:.2e}",
+        errors[0], errors[1]
+    );
+    // Measured 7.3e-4 with them, 1.0 without.
+    assert!(errors[0] <= SPLIT_MAX, "{errors:?}");
+    assert!(errors[1] > 0.1, "{errors:?}");
+}
+
 #[test]
 fn extinction_up_to_1e6() {
     let gpu = gpu_available();

@@ -247,7 +247,7 @@ fn draw_part<M: ProjectedMode>(
         width: src.camera.width,
         height: src.camera.height,
     };
-    if mode.decides_ties() {
+    if mode.decides_ties() && src.exact_ties {
         decide_ties(&part_tris, part, &src.ties, &mut w.ties);
         out.tie_pixels += emit_tie_quads(mode, src, part, piece, &mapper, w, out);
     }
@@ -546,6 +546,7 @@ pub fn render_projected<M: ProjectedMode>(
         skip_invisible: opts.projected.skip_invisible,
         grid: PixelGrid::new(camera.width, camera.height),
         ties: TieRays::new(camera, scene.mesh.bounds()),
+        exact_ties: opts.projected.exact_ties,
         iso: mode.isosurfaces(),
         volume: mode.draws_volume(),
         gradients: mode.point_gradients(),
@@ -678,6 +679,7 @@ mod tests {
             skip_invisible: true,
             grid: PixelGrid::new(camera.width, camera.height),
             ties: TieRays::new(camera, scene.mesh.bounds()),
+            exact_ties: true,
             iso: None,
             volume: true,
             gradients: None,

@@ -119,6 +119,11 @@ pub struct ProjectedOptions {
     /// [`crate::numeric::tolerance::COLOR_REFINE_TOL`] by default): lower
     /// refines more region triangles, for less colour interpolation error.
     pub refine_tol: f64,
+    /// Decide the pixel centres next to each part's outline on the exact
+    /// geometry ([`super::ties`]; on by default). Off only to measure what
+    /// the decisions cost: centres within the snap of an outline are then
+    /// left to the rasteriser's rounding, which can miss or double them.
+    pub exact_ties: bool,
 }
 
 impl Default for ProjectedOptions {
@@ -131,6 +136,7 @@ impl Default for ProjectedOptions {
             watch: None,
             skip_invisible: true,
             refine_tol: crate::numeric::tolerance::COLOR_REFINE_TOL,
+            exact_ties: true,
         }
     }
 }

@@ -79,6 +79,8 @@ pub struct PieceSource<'a> {
     /// The frame's pixel rays for the exact decisions next to outlines
     /// ([`super::ties`]).
     pub ties: TieRays,
+    /// Whether the modes that decide ties do ([`super::ProjectedOptions::exact_ties`]).
+    pub exact_ties: bool,
     /// The isosurfaces drawn ([`super::iso`]): a piece whose scalar range
     /// holds one is drawn even where the volume is dark; cycle groups
     /// composite them.

@@ -253,27 +253,49 @@ pub fn decide_ties(
     };
     // Outline candidates: edges of drawn triangles not shared by two of
     // them, and every edge of an exact triangle that is not drawn.
-    let edges = &mut scratch.edges;
-    edges.clear();
     let key = |a: u32, b: u32| if a < b { (a, b) } else { (b, a) };
-    for (t, _) in part.drawn {
-        for k in 0..3 {
-            edges.push(key(t[k], t[(k + 1) % 3]));
-        }
-    }
-    edges.sort_unstable();
     let outline = &mut scratch.outline;
     outline.clear();
-    let mut k = 0;
-    while k < edges.len() {
-        let mut n = 1;
-        while k + n < edges.len() && edges[k + n] == edges[k] {
-            n += 1;
+    if part.proj.vertices.len() <= 64 {
+        // Small parts (almost all): each edge's count's parity in a bit
+        // matrix, no sort. A triangulation shares an edge between at most
+        // two triangles, so an odd count is a count of one.
+        let mut bits = [0u64; 64];
+        for (t, _) in part.drawn {
+            for k in 0..3 {
+                let (a, b) = key(t[k], t[(k + 1) % 3]);
+                bits[a as usize] ^= 1 << b;
+            }
         }
-        if n != 2 {
-            outline.push(edges[k]);
+        for (t, _) in part.drawn {
+            for k in 0..3 {
+                let (a, b) = key(t[k], t[(k + 1) % 3]);
+                if bits[a as usize] >> b & 1 == 1 {
+                    bits[a as usize] &= !(1 << b);
+                    outline.push((a, b));
+                }
+            }
         }
-        k += n;
+    } else {
+        let edges = &mut scratch.edges;
+        edges.clear();
+        for (t, _) in part.drawn {
+            for k in 0..3 {
+                edges.push(key(t[k], t[(k + 1) % 3]));
+            }
+        }
+        edges.sort_unstable();
+        let mut k = 0;
+        while k < edges.len() {
+            let mut n = 1;
+            while k + n < edges.len() && edges[k + n] == edges[k] {
+                n += 1;
+            }
+            if n != 2 {
+                outline.push(edges[k]);
+            }
+            k += n;
+        }
     }
     if part.drawn.len() != part.exact.len() {
         for t in part.exact {
@@ -335,23 +357,44 @@ fn near_centres(a: DVec2, b: DVec2, width: u32, height: u32, out: &mut Vec<(u32,
     };
     let lo = a_m.min(b_m) - band;
     let hi = a_m.max(b_m) + band;
-    let k0 = ((lo - 0.5).ceil().max(0.0)) as i64;
-    let k1 = ((hi - 0.5).floor().min(n_major as f64 - 1.0)) as i64;
+    let k0 = ceil_i(lo - 0.5).max(0);
+    let k1 = floor_i(hi - 0.5).min(n_major as i64 - 1);
     let reach = band * std::f64::consts::SQRT_2;
+    let inv = if len > 0.0 { 1.0 / (b_m - a_m) } else { 0.0 };
     for k in k0..=k1 {
         let m = k as f64 + 0.5;
-        let t = if len > 0.0 {
-            ((m - a_m) / (b_m - a_m)).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let n = a_n + (b_n - a_n) * t;
-        let l0 = ((n - reach - 0.5).ceil().max(0.0)) as i64;
-        let l1 = ((n + reach - 0.5).floor().min(n_minor as f64 - 1.0)) as i64;
-        for l in l0..=l1 {
+        let t = ((m - a_m) * inv).clamp(0.0, 1.0);
+        // The one centre row within `reach` (< 1/2) of the segment here,
+        // if any.
+        let r = a_n + (b_n - a_n) * t - 0.5;
+        let l = floor_i(r + 0.5);
+        if (r - l as f64).abs() <= reach && l >= 0 && l < n_minor as i64 {
             let (i, j) = if major_x { (k, l) } else { (l, k) };
             out.push((i as u32, j as u32));
         }
+    }
+}
+
+/// `x.floor()` as an integer (saturating), without the libm call the
+/// baseline x86-64 target makes of `floor`.
+#[inline]
+fn floor_i(x: f64) -> i64 {
+    let i = x as i64;
+    if (i as f64) > x {
+        i - 1
+    } else {
+        i
+    }
+}
+
+/// `x.ceil()` as an integer (saturating); see [`floor_i`].
+#[inline]
+fn ceil_i(x: f64) -> i64 {
+    let i = x as i64;
+    if (i as f64) < x {
+        i + 1
+    } else {
+        i
     }
 }
 
