@@ -193,10 +193,6 @@ fn usage_errors_exit_2() {
     for (args, want) in [
         (vec!["--modes", "exact,warp"], "unknown mode 'warp'"),
         (vec!["--modes", "iso"], "--iso"),
-        (
-            vec!["--modes", "exact", "--iso", "0.5"],
-            "exact mode cannot",
-        ),
         (vec!["--sizes", "0"], "positive"),
         (vec!["--repeats", "0"], "--repeats"),
         (
@@ -305,8 +301,8 @@ fn with_vtk_adds_vtk_rows() {
     }
 }
 
-/// With `--iso`, `all` means the modes that draw surfaces (iso in, exact
-/// out) and the references are the ray caster's surfaces (no `native`).
+/// With `--iso`, `all` means the modes that draw surfaces (every mode,
+/// iso too) and the references are the ray caster's surfaces (no `native`).
 #[test]
 fn isosurfaces_join_every_mode_that_draws_them() {
     let dir = tempfile::tempdir().unwrap();
@@ -330,7 +326,7 @@ fn isosurfaces_join_every_mode_that_draws_them() {
     let (head, rows) = csv_rows(&csv);
     let modes: Vec<&str> = rows.iter().map(|r| col(&head, r, "mode")).collect();
     assert!(
-        modes.contains(&"iso") && !modes.contains(&"exact"),
+        modes.contains(&"iso") && modes.contains(&"exact"),
         "{modes:?}"
     );
     // raycast: faces and tets only.

@@ -24,6 +24,8 @@ fn surfaces_render_alone_and_mixed() {
         ("preint2d", vec![]),
         ("raycast", vec!["--iso-only"]),
         ("exact", vec!["--iso-only"]),
+        ("exact", vec![]),
+        ("exact", vec!["--iso-mix", "blend", "--split", "all"]),
     ] {
         let out = dir.path().join(format!("{mode}.png"));
         let mut args = vec![
@@ -59,7 +61,6 @@ fn bad_isovalues_are_usage_errors() {
         (vec!["--iso", "0.5:tf:1.5"], "1.5"),
         (vec!["--iso", &many], "1025"),
         (vec!["--mode", "iso"], "--iso"),
-        (vec!["--mode", "exact", "--iso", "0.5"], "exact"),
         (
             vec!["--mode", "raycast", "--model", "native", "--iso", "0.5"],
             "native",

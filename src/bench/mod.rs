@@ -183,14 +183,13 @@ pub fn entries_for(modes: &[Mode], surfaces: bool) -> Vec<Entry> {
 }
 
 /// The modes `--modes all` means: every mode that can draw the scene
-/// (`iso` only with surfaces; `exact` only without, as it cannot mix them).
+/// (`iso` only with surfaces).
 pub fn all_modes(surfaces: bool) -> Vec<Mode> {
     Mode::ALL
         .iter()
         .copied()
         .filter(|m| match m {
             Mode::Iso => surfaces,
-            Mode::Exact => !surfaces,
             _ => true,
         })
         .collect()

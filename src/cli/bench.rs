@@ -209,13 +209,6 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         Some(m) => m.clone(),
         None => bench::all_modes(surfaces),
     };
-    if surfaces && modes.contains(&Mode::Exact) {
-        bail!(super::UsageError(
-            "--iso: the exact mode cannot draw isosurfaces (it slices pieces per vertex); \
-             leave it out of --modes"
-                .into()
-        ));
-    }
     if !surfaces && modes.contains(&Mode::Iso) {
         bail!(super::UsageError(
             "--modes iso draws isosurfaces: give them with --iso V,V,...".into()

@@ -96,8 +96,10 @@ pub struct ViewArgs {
     /// Isosurfaces, comma-separated: V[:COLOUR[:OPACITY[:BACKCOLOUR[:BACKOPACITY]]]].
     ///
     /// Drawn alone by --mode iso, mixed with the volume in the exact order
-    /// by exact-frag, preint3d, preint2d, preint2d-cyl and raycast (not
-    /// exact, which slices per vertex). COLOUR is #rrggbb or `tf` (the
+    /// by exact, exact-frag, preint3d, preint2d, preint2d-cyl and raycast
+    /// (exact slices the cells at each isovalue, as at the transfer
+    /// function's breakpoints, so its cost grows with the surfaces a cell
+    /// holds; the others find the crossings per fragment). COLOUR is #rrggbb or `tf` (the
     /// transfer function's colour at V, the default); OPACITY in [0, 1]
     /// (default 1, opaque). The front side is the one a ray meets while
     /// the field rises; the back side takes the front's style unless
@@ -230,13 +232,6 @@ impl ViewArgs {
     pub fn usage_error(&self) -> Option<String> {
         if self.mode == Mode::Iso && self.iso.is_none() {
             return Some("--mode iso draws isosurfaces only: give them with --iso V,V,...".into());
-        }
-        if self.mode == Mode::Exact && self.iso.is_some() && !self.iso_only {
-            return Some(
-                "--mode exact cannot draw isosurfaces (it slices pieces per vertex); use --mode \
-                 exact-frag, preint3d, preint2d, preint2d-cyl, iso or raycast with --iso"
-                    .into(),
-            );
         }
         if self.iso.is_some() && self.mode == Mode::Raycast {
             if self.model == Some(FieldModel::Native) {

@@ -8,7 +8,8 @@
 //! level is part of an original edge: the other kind of edge lies on the
 //! previous level), with the endpoints in a canonical order that depends only
 //! on their positions, so two cells sharing the edge get bit-identical points;
-//! its value is set to the level exactly. The caps are the boundary loops left
+//! its value is set to the level exactly (and a piece's point gradients,
+//! when it has them, are interpolated there like the scalar). The caps are the boundary loops left
 //! after cancelling opposite on-level edges of the kept polygons; they are
 //! convex and fan-triangulated. A piece that only touches the band is empty.
 
@@ -236,6 +237,9 @@ impl Clipper {
             Key::Orig(i) => {
                 out.points.push(src.points[i as usize]);
                 out.scalars.push(src.scalars[i as usize]);
+                if src.gradients.len() == n {
+                    out.gradients.push(src.gradients[i as usize]);
+                }
             }
             Key::Cut(i, j, lev) => {
                 let l = levels[lev as usize];
@@ -254,6 +258,10 @@ impl Clipper {
                 }
                 out.points.push(p);
                 out.scalars.push(s);
+                if src.gradients.len() == n {
+                    let (ga, gb) = (src.gradients[a as usize], src.gradients[b as usize]);
+                    out.gradients.push(ga + (gb - ga) * mu);
+                }
             }
         }
         match slot {

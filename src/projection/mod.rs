@@ -427,6 +427,16 @@ pub struct Projected {
     pub region_faces: Vec<[u32; 2]>,
     /// The camera mapping the values were computed for.
     pub view: ViewMap,
+    /// Edges (vertex pairs) inside the piece's outline across which the
+    /// mode's payload changes by more than interpolation (where a region
+    /// holding an isosurface meets one that does not): the pixel centres
+    /// next to them are decided on the exact geometry, as next to the
+    /// outline ([`crate::render::ties`]). Set by the mode, empty otherwise.
+    pub seams: Vec<(u32, u32)>,
+    /// For the values of tie decisions ([`crate::render::ties`], no
+    /// regions): the piece's boundary triangles (indices into
+    /// [`Polyhedron::triangles`]) where each vertex's ray enters and leaves.
+    pub tie_faces: Vec<[u32; 2]>,
     /// Scratch of [`Projected::cull_to_pixels`]: each vertex's
     /// [`coverage::Span`].
     spans: Vec<coverage::Span>,
@@ -441,6 +451,8 @@ impl Projected {
         self.triangle_region.clear();
         self.faces.clear();
         self.region_faces.clear();
+        self.seams.clear();
+        self.tie_faces.clear();
     }
 
     /// The front (`side` 0) or back (1) triangle of region `r`.

@@ -33,7 +33,8 @@ pub struct Polyhedron {
     pub triangles: Vec<[u32; 3]>,
     /// View-space gradient of the field per point, for smooth isosurface
     /// shading ([`crate::render::gradients`]); empty unless the piece's
-    /// source fills it (builders and clippers leave it empty).
+    /// source fills it (builders leave it empty; [`super::Clipper`]
+    /// interpolates it at the points it cuts, like the scalar).
     pub gradients: Vec<DVec3>,
 }
 

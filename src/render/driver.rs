@@ -284,6 +284,12 @@ fn emit_tie_quads<M: ProjectedMode>(
     values
         .vertices
         .extend(ties.decisions.iter().filter_map(|d| d.value));
+    values.tie_faces.extend(
+        ties.decisions
+            .iter()
+            .filter(|d| d.value.is_some())
+            .map(|d| d.faces),
+    );
     let mut used = std::mem::take(&mut w.used);
     used.clear();
     used.resize(values.vertices.len(), true);

@@ -88,8 +88,6 @@ pub enum RenderError {
     TableSize(#[from] modes::preint_tables::TableSizeError),
     #[error(transparent)]
     Iso(#[from] iso::IsoError),
-    #[error("--mode {0} cannot draw isosurfaces (it slices pieces per vertex); --mode exact-frag, preint3d, preint2d, preint2d-cyl, iso and raycast can")]
-    IsoUnsupported(&'static str),
     #[error("the ray caster draws isosurfaces on the faces and tets fields with the walk traversal (--model faces|tets, --traversal walk)")]
     IsoReference,
     #[error("--mode iso draws isosurfaces only: give them with --iso V,V,...")]
@@ -114,13 +112,31 @@ fn iso_mode(scene: &Scene, opts: &RenderOptions) -> Result<modes::iso::IsoMode, 
     let set = iso::IsoSet::new(&opts.iso, &scene.tf);
     let volume = match opts.mode {
         _ if opts.iso.alone => Volume::None,
-        Mode::Iso | Mode::Exact => Volume::None,
+        Mode::Iso | Mode::Exact => Volume::None, // Exact: --iso-only
         Mode::ExactFrag => Volume::Integral,
         m => Volume::Table(modes::preint::PreintMode::for_mode(m, opts)?),
     };
     let grads = (set.lighting == iso::Lighting::Smooth)
         .then(|| gradients::point_gradients(&scene.mesh, values));
     Ok(IsoMode::new(volume, set, grads))
+}
+
+/// The exact mode with the isosurfaces of `opts.iso` mixed in
+/// ([`modes::exact_iso`]).
+fn exact_iso_mode(
+    scene: &Scene,
+    opts: &RenderOptions,
+) -> Result<modes::exact_iso::ExactIsoMode, RenderError> {
+    let ScalarsRef::Point(values) = scene.scalars() else {
+        return Err(iso::IsoError::CellData.into());
+    };
+    let set = iso::IsoSet::new(&opts.iso, &scene.tf);
+    let grads = (set.lighting == iso::Lighting::Smooth)
+        .then(|| gradients::point_gradients(&scene.mesh, values));
+    let exact = modes::exact::ExactMode {
+        refine_tol: opts.projected.refine_tol,
+    };
+    Ok(modes::exact_iso::ExactIsoMode::new(exact, set, grads))
 }
 
 /// State reused across frames of one geometry: the geometry itself, the
@@ -231,7 +247,8 @@ impl Renderer {
         let scene = Scene::new(self.geometry.clone(), shading.clone());
         let (image, detail, setup_s) = match opts.mode {
             Mode::Exact if opts.iso.any() && !opts.iso.alone => {
-                return Err(RenderError::IsoUnsupported("exact"))
+                let mode = exact_iso_mode(&scene, opts)?;
+                self.projected(&mode, &scene, opts, camera, progress)?
             }
             Mode::Iso if !opts.iso.any() => return Err(RenderError::IsoMissing),
             Mode::Iso

@@ -244,6 +244,9 @@ impl PieceSource<'_> {
                 if *whole_of != Some((cell, tet)) {
                     let (p, s) = self.tet_view(cell, tet);
                     whole.set_tet(p, s);
+                    // The slab's cut points get them by interpolation
+                    // (smooth isosurface light on the slices).
+                    self.point_gradients(tet.into_iter(), whole);
                     *whole_of = Some((cell, tet));
                 }
                 if self.clip_band(cell, lo, hi, clipper, whole, poly)? {

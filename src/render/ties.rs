@@ -138,8 +138,9 @@ pub enum RayThrough {
     /// The ray misses the part.
     Misses,
     /// The ray crosses the part: the segment's values at pixel position
-    /// `c` (the region vertex the ray caster's numbers give).
-    Crosses(RegionVertex),
+    /// `c` (the region vertex the ray caster's numbers give), and the
+    /// part's boundary triangles where it enters and leaves.
+    Crosses(RegionVertex, [u32; 2]),
     /// The boundary did not give two crossings (a degenerate part): left
     /// to the rasteriser.
     Undecided,
@@ -156,9 +157,9 @@ pub fn ray_through(
     let (frame, dz) = rays.frame(c);
     proj.clear();
     proj.extend(part.points.iter().map(|&p| frame.project(flip(p))));
-    let mut hits = [(0.0, 0.0); 2];
+    let mut hits = [(0.0, 0.0, 0u32); 2];
     let mut n = 0;
-    for t in &part.triangles {
+    for (k, t) in part.triangles.iter().enumerate() {
         let [a, b, c] = t.map(|i| i as usize);
         let (pa, pb, pc) = (
             flip(part.points[a]),
@@ -175,20 +176,20 @@ pub fn ray_through(
                 return RayThrough::Undecided;
             }
             let s = x.interpolate([part.scalars[a], part.scalars[b], part.scalars[c]]);
-            hits[n] = (x.t, s);
+            hits[n] = (x.t, s, k as u32);
             n += 1;
         }
     }
     match n {
         0 => RayThrough::Misses,
         2 => {
-            let [(t0, s0), (t1, s1)] = hits;
-            let ((ti, si), (to, so)) = if t0 <= t1 {
-                ((t0, s0), (t1, s1))
+            let [(t0, s0, k0), (t1, s1, k1)] = hits;
+            let ((ti, si, ki), (to, so, ko)) = if t0 <= t1 {
+                ((t0, s0, k0), (t1, s1, k1))
             } else {
-                ((t1, s1), (t0, s0))
+                ((t1, s1, k1), (t0, s0, k0))
             };
-            RayThrough::Crosses(RegionVertex {
+            let v = RegionVertex {
                 px: c.x,
                 py: c.y,
                 z_front: ti * dz,
@@ -197,7 +198,8 @@ pub fn ray_through(
                 s_front: si,
                 s_back: so,
                 profile: false,
-            })
+            };
+            RayThrough::Crosses(v, [ki, ko])
         }
         _ => RayThrough::Undecided,
     }
@@ -210,6 +212,9 @@ pub fn ray_through(
 pub struct TieDecision {
     pub pixel: (u32, u32),
     pub value: Option<RegionVertex>,
+    /// With a value: the part's boundary triangles where the ray enters
+    /// and leaves it.
+    pub faces: [u32; 2],
 }
 
 /// Scratch of [`decide_ties`], reused from part to part.
@@ -218,6 +223,7 @@ pub struct TieScratch {
     edges: Vec<(u32, u32)>,
     outline: Vec<(u32, u32)>,
     centres: Vec<(u32, u32)>,
+    seam_centres: Vec<(u32, u32)>,
     proj: Vec<Proj>,
     pub decisions: Vec<TieDecision>,
     /// The values of the decisions that hold a segment, as a projection
@@ -312,24 +318,36 @@ pub fn decide_ties(
     for &(ia, ib) in outline.iter() {
         near_centres(pos(ia), pos(ib), part.width, part.height, centres);
     }
+    // Centres next to the mode's seams: decided exactly wherever the part
+    // holds them, since the two sides carry different values.
+    let seam_centres = &mut scratch.seam_centres;
+    seam_centres.clear();
+    for &(ia, ib) in &part.proj.seams {
+        near_centres(pos(ia), pos(ib), part.width, part.height, seam_centres);
+    }
+    centres.extend_from_slice(seam_centres);
     if centres.is_empty() {
         return;
     }
     centres.sort_unstable();
     centres.dedup();
+    seam_centres.sort_unstable();
     for &(i, j) in centres.iter() {
         let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
         let sub = SUBPIXEL as i64;
         let q = [i as i64 * sub + sub / 2, j as i64 * sub + sub / 2];
         let grid_in = part.drawn.iter().any(|(_, g)| covers_grid(*g, q));
-        let value = match (ray_through(poly, rays, c, &mut scratch.proj), grid_in) {
-            (RayThrough::Crosses(v), false) => Some(v),
-            (RayThrough::Misses, true) => None,
+        let seam = || seam_centres.binary_search(&(i, j)).is_ok();
+        let (value, faces) = match (ray_through(poly, rays, c, &mut scratch.proj), grid_in) {
+            (RayThrough::Crosses(v, f), false) => (Some(v), f),
+            (RayThrough::Crosses(v, f), true) if seam() => (Some(v), f),
+            (RayThrough::Misses, true) => (None, [0; 2]),
             _ => continue,
         };
         scratch.decisions.push(TieDecision {
             pixel: (i, j),
             value,
+            faces,
         });
     }
 }
@@ -434,7 +452,7 @@ mod tests {
 
     fn length(r: RayThrough) -> f64 {
         match r {
-            RayThrough::Crosses(v) => v.l,
+            RayThrough::Crosses(v, _) => v.l,
             RayThrough::Misses => 0.0,
             RayThrough::Undecided => f64::NAN,
         }
@@ -458,7 +476,7 @@ mod tests {
         let mut scratch = Vec::new();
         let r = ray_through(&p, &rays, DVec2::new(4.0, 4.0), &mut scratch);
         assert!((length(r) - 1.0).abs() < 1e-12, "{r:?}");
-        let RayThrough::Crosses(v) = r else {
+        let RayThrough::Crosses(v, _) = r else {
             unreachable!()
         };
         assert!((v.s_back - 3.0).abs() < 1e-9, "{v:?}");

@@ -576,7 +576,7 @@ impl IsoMode {
 }
 
 /// The smooth gradient at `x` on boundary triangle `t` of `part`.
-fn face_gradient(part: &Polyhedron, t: u32, x: DVec3) -> Option<DVec3> {
+pub(super) fn face_gradient(part: &Polyhedron, t: u32, x: DVec3) -> Option<DVec3> {
     let tri = part.triangles.get(t as usize)?;
     let p = tri.map(|i| part.points.get(i as usize).copied());
     let g = tri.map(|i| part.gradients.get(i as usize).copied());
@@ -591,7 +591,7 @@ fn face_gradient(part: &Polyhedron, t: u32, x: DVec3) -> Option<DVec3> {
 }
 
 /// A region vertex's entry (`side` 0) or exit point in view space.
-fn view_point(proj: &Projected, i: usize, side: usize) -> DVec3 {
+pub(super) fn view_point(proj: &Projected, i: usize, side: usize) -> DVec3 {
     let v = &proj.vertices[i];
     let z = if side == 0 { v.z_front } else { v.z_back };
     let u = proj.view.plane(DVec2::new(v.px, v.py));

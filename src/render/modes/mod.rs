@@ -26,6 +26,7 @@
 
 pub mod exact;
 pub mod exact_frag;
+pub mod exact_iso;
 pub mod integral;
 pub mod iso;
 pub mod preint;
@@ -179,7 +180,15 @@ impl std::str::FromStr for Mode {
 /// front of each).
 pub const SHADERS: &[(&str, &str)] = &[
     ("common.wgsl", crate::gpu::stage::COMMON_WGSL),
-    ("exact.wgsl", exact::EXACT_STAGE.wgsl),
+    ("exact.wgsl", include_str!("../../../shaders/exact.wgsl")),
+    (
+        "exact_iso.wgsl",
+        include_str!("../../../shaders/exact_iso.wgsl"),
+    ),
+    (
+        "exptable.wgsl",
+        include_str!("../../../shaders/exptable.wgsl"),
+    ),
     (
         "exact_frag.wgsl",
         include_str!("../../../shaders/exact_frag.wgsl"),

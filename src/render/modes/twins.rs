@@ -32,7 +32,8 @@ use std::any::type_name_of_val as path;
 use super::exact::exptable::{self, ExpTable};
 use super::integral::{self, TfBuffer};
 use super::{
-    exact, exact_frag, iso, preint, preint2d, preint2d_cyl, preint3d, segment, table_build,
+    exact, exact_frag, exact_iso, iso, preint, preint2d, preint2d_cyl, preint3d, segment,
+    table_build,
 };
 use crate::gpu::{common, layer};
 use crate::integrate::cylinder;
@@ -71,8 +72,9 @@ macro_rules! twins {
 pub fn stage_twins() -> Vec<StageTwins> {
     vec![
         twins!("common.wgsl": common::piece_depth, common::finite, common::count_of),
-        twins!("exact.wgsl":
-            exptable::log1p_, exptable::coord, ExpTable::alpha_of, exact::fs_main),
+        twins!("exact.wgsl": exact::fs_main),
+        twins!("exact_iso.wgsl": exact_iso::exact_iso_light, exact_iso::fs_main),
+        twins!("exptable.wgsl": exptable::log1p_, exptable::coord, ExpTable::alpha_of),
         twins!("exact_frag.wgsl": exact_frag::fs_main),
         twins!("integral.wgsl":
             TfBuffer::node_s, TfBuffer::node, TfBuffer::piece_index, TfBuffer::eval_piece,

@@ -164,7 +164,10 @@ pub struct ExactParams {
 pub static EXACT_STAGE: StageDesc = StageDesc {
     name: "exact.wgsl",
     fragment: "fs_main",
-    wgsl: include_str!("../../../../shaders/exact.wgsl"),
+    wgsl: concat!(
+        include_str!("../../../../shaders/exptable.wgsl"),
+        include_str!("../../../../shaders/exact.wgsl")
+    ),
     vertex: wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<ExactVertex>() as wgpu::BufferAddress,
         step_mode: wgpu::VertexStepMode::Vertex,
@@ -186,6 +189,17 @@ fn check_unit(length_unit: f32) -> Result<(), GpuError> {
 /// Binds the exact stage for a frame with length unit `length_unit` (the
 /// exponential table is uploaded once per device).
 pub fn bind_exact_stage(gpu: &Context, length_unit: f32) -> Result<Stage, GpuError> {
+    bind_table_stage(gpu, &EXACT_STAGE, length_unit, &[])
+}
+
+/// Binds `desc`, a stage on `shaders/exptable.wgsl` (bindings 0 and 1),
+/// with `extra` resources after those.
+pub fn bind_table_stage(
+    gpu: &Context,
+    desc: &'static StageDesc,
+    length_unit: f32,
+    extra: &[Resource],
+) -> Result<Stage, GpuError> {
     check_unit(length_unit)?;
     let table = gpu.resource("exact: exponential table", |g| {
         Table::upload(
@@ -204,13 +218,12 @@ pub fn bind_exact_stage(gpu: &Context, length_unit: f32) -> Result<Stage, GpuErr
         n: TABLE_N,
         _pad: [0; 3],
     };
-    gpu.bind_stage(
-        &EXACT_STAGE,
-        &[
-            Resource::Uniform(bytemuck::bytes_of(&params)),
-            Resource::Table(&table),
-        ],
-    )
+    let mut resources = vec![
+        Resource::Uniform(bytemuck::bytes_of(&params)),
+        Resource::Table(&table),
+    ];
+    resources.extend_from_slice(extra);
+    gpu.bind_stage(desc, &resources)
 }
 
 /// The exact stage's bindings on the CPU (the length unit of `Params` and
@@ -231,7 +244,11 @@ impl ExactTwin {
     }
 
     /// `l`, `tau` and glow as the shader interpolates and scales them.
-    fn values(&self, tri: [&ExactVertex; 3], bary: [f64; 3]) -> (f32, f32, [f32; 3]) {
+    pub(in crate::render::modes) fn values(
+        &self,
+        tri: [&ExactVertex; 3],
+        bary: [f64; 3],
+    ) -> (f32, f32, [f32; 3]) {
         let l = lerp(tri, bary, |v| v.thickness) / self.length_unit;
         let tau = lerp(tri, bary, |v| v.tau) * self.length_unit;
         let glow = [0, 1, 2].map(|k| lerp(tri, bary, |v| v.glow[k]));
@@ -291,7 +308,7 @@ impl Default for ExactMode {
 /// depth balance.
 #[derive(Default)]
 pub struct ExactPayload {
-    values: Vec<VertexValues>,
+    pub(in crate::render::modes) values: Vec<VertexValues>,
     balance: f64,
 }
 
