@@ -184,7 +184,7 @@ pub fn exact_iso_light(stage: &ExactIsoTwin, g: [f32; 3]) -> f32 {
         return 1.0;
     }
     let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-    if !(n > 0.0) || !finite(n) {
+    if n.is_nan() || n <= 0.0 || !finite(n) {
         return 1.0;
     }
     stage.light.ambient + stage.light.diffuse * (g[2].abs() / n).min(1.0)
@@ -435,11 +435,12 @@ impl ExactIsoMode {
         };
         if proj.regions.is_empty() {
             // Tie quads' segments: the triangles the exact crossings found.
-            for i in 0..proj.vertices.len() {
+            for (i, surface) in surfaces.iter_mut().enumerate() {
                 let Some(&[f, b]) = proj.tie_faces.get(i) else {
                     continue;
                 };
-                if !(proj.vertices[i].l > 0.0) {
+                let l = proj.vertices[i].l;
+                if l.is_nan() || l <= 0.0 {
                     continue;
                 }
                 let (side, face) = if on_level(f) {
@@ -450,7 +451,7 @@ impl ExactIsoMode {
                     continue;
                 };
                 let g = self.gradient(part, proj, i, side, Some(face), flat);
-                surfaces[i] = self.surface(k, side, g);
+                *surface = self.surface(k, side, g);
             }
             return;
         }
