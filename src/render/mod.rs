@@ -90,8 +90,6 @@ pub enum RenderError {
     Iso(#[from] iso::IsoError),
     #[error("--mode {0} cannot draw isosurfaces (it slices pieces per vertex); --mode exact-frag, preint3d, preint2d, preint2d-cyl, iso and raycast can")]
     IsoUnsupported(&'static str),
-    #[error("the ray caster draws isosurfaces on the faces and tets fields with the walk traversal (--model faces|tets, --traversal walk)")]
-    IsoReference,
     #[error("--mode iso draws isosurfaces only: give them with --iso V,V,...")]
     IsoMissing,
     #[error("the {mode} mode cannot draw {model:?} emission (it supports {supported}); modes that can: --mode {alternatives}")]
