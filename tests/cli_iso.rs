@@ -56,7 +56,10 @@ fn the_reference_draws_surfaces_with_native_and_brute() {
     for (name, extra) in [
         ("native", vec!["--model", "native"]),
         ("native-alone", vec!["--model", "native", "--iso-only"]),
-        ("native-blend", vec!["--model", "native", "--iso-mix", "blend"]),
+        (
+            "native-blend",
+            vec!["--model", "native", "--iso-mix", "blend"],
+        ),
         ("brute", vec!["--traversal", "brute"]),
         (
             "brute-tets",

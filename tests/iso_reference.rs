@@ -99,7 +99,11 @@ fn reference(
     };
     if model == FieldModel::Native {
         // Every interval through the iso-parametric field, none fell back.
-        assert!(rs.native.intervals > 0 && !rs.native.any_fallback(), "{:?}", rs.native);
+        assert!(
+            rs.native.intervals > 0 && !rs.native.any_fallback(),
+            "{:?}",
+            rs.native
+        );
     }
     img
 }
@@ -289,7 +293,11 @@ fn native_equals_faces_and_tets_on_an_affine_field() {
         DVec3::new(-0.2, 0.25, 0.9),
     );
     let grad = DVec3::new(1.0, -0.6, 0.45);
-    let scene = grid_scene(3, |p| shear * p + DVec3::new(0.1, -0.2, 0.3), |p| grad.dot(p));
+    let scene = grid_scene(
+        3,
+        |p| shear * p + DVec3::new(0.1, -0.2, 0.3),
+        |p| grad.dot(p),
+    );
     let (lo, hi) = scene.range;
     let at = |x: f64| lo + (hi - lo) * x;
     let ten: Vec<String> = (1..=10)

@@ -100,17 +100,20 @@ fn level_crossings(
     Some(())
 }
 
+/// The ends of an interval's monotone pieces: depth and scalar.
+type Nodes = Vec<(f64, f64)>;
+
 /// The surfaces the native field of one cell crosses along `[t_a, t_b]`
 /// (the ends' scalars replaced by `s_a` where given and `s_b`), in depth
 /// order, with the monotone pieces' nodes; `None` when the map cannot be
 /// inverted.
-pub fn interval_crossings(
+fn interval_crossings(
     field: &mut IsoRay,
     set: &IsoSet,
     (t_a, s_a): (f64, Option<f64>),
     (t_b, s_b): (f64, f64),
     stats: &mut NativeStats,
-) -> Option<(Vec<IsoHit>, Vec<(f64, f64)>)> {
+) -> Option<(Vec<IsoHit>, Nodes)> {
     let nodes = monotone_nodes(field, t_a, t_b, stats)?;
     let mut classed = nodes.clone();
     if let Some(s) = s_a {
