@@ -400,3 +400,106 @@ fn brute_equals_walk_with_isosurfaces() {
     // and the same gradients, composited in the same order.
     eprintln!("brute vs walk: max {worst:.2e}");
 }
+
+/// A surface on a layer of faces: `s = x + (x - 1/2) y z` (trilinear) is
+/// exactly `1/2` on the plane `x = 1/2`, a layer of the 4-grid's faces, and
+/// nowhere else. Translucent and alone, it is drawn once on every ray that
+/// meets it (not twice by the two cells sharing the face, nor never): the
+/// native reference's pixels are exactly the surface's colour and opacity
+/// there, nothing elsewhere, in both projections.
+#[test]
+fn native_surface_on_a_layer_of_faces_is_drawn_once() {
+    let scene = grid_scene(4, |p| p, |p| p.x + (p.x - 0.5) * p.y * p.z);
+    let mut r = Renderer::new(scene.geometry());
+    let set = iso("0.5:#ff0000:0.5", Lighting::None, true, IsoMix::Exact);
+    let mut worst = 0.0f64;
+    for ortho in [true, false] {
+        let img = reference(
+            &mut r,
+            &scene,
+            &set,
+            ortho,
+            FieldModel::Native,
+            Traversal::Walk,
+        );
+        let cam = Camera::fit(scene.mesh.bounds(), &camera_params(ortho));
+        let mut checked = 0;
+        for j in 0..SIZE {
+            for i in 0..SIZE {
+                let ray = cam.pixel_ray(i, j);
+                let t = (0.5 - ray.origin.x) / ray.dir.x;
+                let x = ray.origin + ray.dir * t;
+                let inside = x.y.min(1.0 - x.y).min(x.z).min(1.0 - x.z);
+                if inside.abs() < 1e-2 {
+                    continue;
+                }
+                let want = if inside > 0.0 {
+                    checked += 1;
+                    [0.5, 0.0, 0.0, 0.5]
+                } else {
+                    [0.0; 4]
+                };
+                let got = img.pixels[(j * SIZE + i) as usize];
+                for c in 0..4 {
+                    worst = worst.max((got[c] as f64 - want[c]).abs());
+                }
+            }
+        }
+        assert!(checked > 500, "{checked}");
+    }
+    // Measured 0.
+    eprintln!("surface on faces: max {worst:.2e}");
+    assert!(worst <= 1e-7, "{worst:.3e}");
+}
+
+/// An isovalue at the field's minimum is never crossed: with the native
+/// model (on a mesh of every cell kind: native cells and walk segments)
+/// the image is the volume's alone, bit for bit.
+#[test]
+fn native_isovalue_at_the_minimum_leaves_the_volume_unchanged() {
+    let mesh = io::read(&mesh_file("zoo_3x3x3.vtu"), &ReadOptions::default()).unwrap();
+    let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+    let lo = scene.field.as_ref().unwrap().range.0;
+    let mut r = Renderer::new(scene.geometry());
+    let none = IsoOptions::default();
+    for ortho in [true, false] {
+        let plain = reference(
+            &mut r,
+            &scene,
+            &none,
+            ortho,
+            FieldModel::Native,
+            Traversal::Walk,
+        );
+        for lighting in [Lighting::Smooth, Lighting::Flat] {
+            let set = iso(&format!("{lo}:#ff0000"), lighting, false, IsoMix::Exact);
+            let got = reference(
+                &mut r,
+                &scene,
+                &set,
+                ortho,
+                FieldModel::Native,
+                Traversal::Walk,
+            );
+            assert!(covered(&plain) > 500);
+            assert_eq!(max_diff(&plain, &got), 0.0, "{lighting:?} ortho={ortho}");
+        }
+    }
+    // And a surface inside the range is drawn on that mesh.
+    let (a, b) = scene.range;
+    let set = iso(
+        &format!("{}:#ff0000", 0.5 * (a + b)),
+        Lighting::Smooth,
+        true,
+        IsoMix::Exact,
+    );
+    let img = reference(
+        &mut r,
+        &scene,
+        &set,
+        false,
+        FieldModel::Native,
+        Traversal::Walk,
+    );
+    assert!(covered(&img) > 200, "{}", covered(&img));
+}
