@@ -136,6 +136,7 @@ impl IsoReference<'_, '_> {
             points: self.points,
         };
         let mut acc = RayAccumulator::default();
+        let mut next = 0;
         for iv in &ivs {
             let c = iv.cell as usize;
             let flat = self.flat.get(c).copied().unwrap_or_default();
@@ -155,8 +156,19 @@ impl IsoReference<'_, '_> {
                     s.s_in += (t_near - s.t_in) / (s.t_out - s.t_in) * (s.s_out - s.s_in);
                     s.t_in = t_near;
                 }
-                let g = match raws.iter().find(|r| r.cell == iv.cell && r.t_in == iv.t_a) {
-                    Some(raw) => self.walk_gradients(&s, raw),
+                // Its walk segment: the raws are in depth order too, so
+                // the search goes on from the last one found.
+                let same = |r: &RawSegment| r.cell == iv.cell && r.t_in == iv.t_a;
+                let found = raws[next..]
+                    .iter()
+                    .position(same)
+                    .map(|k| next + k)
+                    .or_else(|| raws.iter().position(same));
+                let g = match found {
+                    Some(k) => {
+                        next = k + 1;
+                        self.walk_gradients(&s, &raws[k])
+                    }
                     None => [flat; 2],
                 };
                 self.segment(material, &s, g)
