@@ -155,7 +155,7 @@ impl Entry {
 
 /// The entries of `modes` (in the order given): the settings each mode
 /// trades time for error with. `surfaces`: the scene has `--iso` surfaces
-/// (the ray caster's `native` field has no isosurface crossings).
+/// (the ray caster's `native` rows are then not run).
 pub fn entries_for(modes: &[Mode], surfaces: bool) -> Vec<Entry> {
     let mut out = Vec::new();
     for &mode in modes {

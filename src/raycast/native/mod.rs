@@ -31,6 +31,10 @@
 //!    depth). Material is only evaluated at interior nodes, never exactly on
 //!    a breakpoint.
 //!
+//! **Isosurfaces** ([`iso`]): the crossings of each isovalue are found as
+//! the breakpoints are, on the same monotone pieces, and the volume is
+//! integrated between them.
+//!
 //! If the map cannot be inverted inside an interval (degenerate cell,
 //! Newton failure) the interval falls back to the linear integral between
 //! the exact boundary scalars at its ends ([`interval_value`]), counted in
