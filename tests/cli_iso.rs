@@ -48,6 +48,46 @@ fn surfaces_render_alone_and_mixed() {
     }
 }
 
+/// The reference draws surfaces with every field model and traversal: the
+/// native field and the brute force, mixed with the volume and alone, in
+/// both lights and both mixes.
+#[test]
+fn the_reference_draws_surfaces_with_native_and_brute() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = mesh_file("curvilinear_4x4x4.vtu");
+    for (name, extra) in [
+        ("native", vec!["--model", "native"]),
+        ("native-alone", vec!["--model", "native", "--iso-only"]),
+        (
+            "native-blend",
+            vec!["--model", "native", "--iso-mix", "blend"],
+        ),
+        ("brute", vec!["--traversal", "brute"]),
+        (
+            "brute-tets",
+            vec!["--traversal", "brute", "--model", "tets", "--iso-only"],
+        ),
+    ] {
+        for shading in ["smooth", "flat"] {
+            let out = dir.path().join(format!("{name}-{shading}.png"));
+            let mut args = vec![
+                "--mode",
+                "raycast",
+                "--iso",
+                "0.4:#ff0000,0.6:#ff8000:0.5",
+                "--size",
+                "48x48",
+                "--shading",
+                shading,
+            ];
+            args.extend(&extra);
+            let o = render(&file, &out, &args);
+            assert!(o.status.success(), "{name}: {}", stderr(&o));
+            assert!(lit_pixels(&out) > 100, "{name} {shading}: no surface");
+        }
+    }
+}
+
 #[test]
 fn bad_isovalues_are_usage_errors() {
     let dir = tempfile::tempdir().unwrap();
@@ -61,8 +101,18 @@ fn bad_isovalues_are_usage_errors() {
         (vec!["--iso", "0.5:tf:1.5"], "1.5"),
         (vec!["--iso", &many], "1025"),
         (vec!["--mode", "iso"], "--iso"),
+        // Brute force has no native model, with or without surfaces.
         (
-            vec!["--mode", "raycast", "--model", "native", "--iso", "0.5"],
+            vec![
+                "--mode",
+                "raycast",
+                "--model",
+                "native",
+                "--traversal",
+                "brute",
+                "--iso",
+                "0.5",
+            ],
             "native",
         ),
     ] {

@@ -367,6 +367,16 @@ fn mixed_cells_voxel_quadratic_and_filtered_cell_data() {
         (0..24).map(|_| "0.5").collect::<Vec<_>>().join(" "),
     );
     let m = parse(&text);
+    // The dataset's TIME is the step's time; CYCLE is dropped with a note.
+    assert_eq!(m.source.time_value, Some(2.5));
+    assert!(
+        m.source
+            .notes
+            .iter()
+            .any(|n| n.contains("CYCLE") && !n.contains("TIME")),
+        "{:?}",
+        m.source.notes
+    );
     assert_eq!(m.cells.len(), 3);
     assert_eq!(m.source.ignored_cells, 2);
     assert_eq!(
@@ -391,7 +401,7 @@ fn mixed_cells_voxel_quadratic_and_filtered_cell_data() {
     assert_eq!(m.active_point_scalars.as_deref(), Some("two"));
     assert_eq!(arr(&m.point_data, "two").components, 2);
     assert_eq!(arr(&m.point_data, "rgb").components, 3);
-    assert!(m.source.notes.iter().any(|n| n.contains("TIME")));
+    assert!(m.source.notes.iter().any(|n| n.contains("CYCLE")));
 }
 
 #[test]

@@ -620,6 +620,57 @@ fn pvd_and_series_resolve_sort_and_refuse() {
     assert!(e.contains("s.pvd") && e.contains("itself"), "{e}");
 }
 
+/// A `.pvtu` step's time is its pieces' `TimeValue`; pieces that disagree
+/// leave it unset with a note.
+#[test]
+fn pvtu_time_value_from_its_pieces() {
+    let d = tmp();
+    let timed = |t: f64| {
+        POLY.replace(
+            "<UnstructuredGrid><Piece",
+            &format!(
+                "<UnstructuredGrid><FieldData><DataArray type=\"Float64\" Name=\"TimeValue\" \
+                 NumberOfTuples=\"1\" format=\"ascii\">{t}</DataArray></FieldData><Piece"
+            ),
+        )
+    };
+    write(d.path(), "a.vtu", &timed(1.5));
+    write(d.path(), "b.vtu", &timed(1.5));
+    write(d.path(), "c.vtu", &timed(2.0));
+    let pvtu = |name: &str, pieces: &[&str]| {
+        let body: String = pieces
+            .iter()
+            .map(|p| format!("<Piece Source=\"{p}\"/>"))
+            .collect();
+        write(
+            d.path(),
+            name,
+            &format!(
+                "<VTKFile type=\"PUnstructuredGrid\"><PUnstructuredGrid>{body}</PUnstructuredGrid></VTKFile>"
+            ),
+        )
+    };
+    let same = io::read(
+        &pvtu("s.pvtu", &["a.vtu", "b.vtu"]),
+        &ReadOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(same.source.time_value, Some(1.5));
+    let differ = io::read(
+        &pvtu("d.pvtu", &["a.vtu", "c.vtu"]),
+        &ReadOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(differ.source.time_value, None);
+    assert!(
+        differ.source.notes.iter().any(|n| n.contains("TimeValue")),
+        "{:?}",
+        differ.source.notes
+    );
+    let single = io::read(&d.path().join("c.vtu"), &ReadOptions::default()).unwrap();
+    assert_eq!(single.source.time_value, Some(2.0));
+}
+
 #[test]
 fn pvtu_missing_and_self_pieces() {
     let d = tmp();

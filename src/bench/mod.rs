@@ -16,7 +16,7 @@
 //!    The probes also warm the caches a first render builds (the sorter's
 //!    geometry, the GPU device).
 //! 3. **Run.** For each size and view: the references first (the ray
-//!    caster on `faces`, and on `native` when the scene has no surfaces),
+//!    caster on the mode's field and on `native`, surfaces included),
 //!    then each entry: `warmup` untimed renders and `repeats` timed ones;
 //!    a row keeps the (lower) median run's stage times and the spread of the
 //!    totals, the triangles and pieces, the process's peak resident memory
@@ -154,9 +154,8 @@ impl Entry {
 }
 
 /// The entries of `modes` (in the order given): the settings each mode
-/// trades time for error with. `surfaces`: the scene has `--iso` surfaces
-/// (the ray caster's `native` field has no isosurface crossings).
-pub fn entries_for(modes: &[Mode], surfaces: bool) -> Vec<Entry> {
+/// trades time for error with.
+pub fn entries_for(modes: &[Mode]) -> Vec<Entry> {
     let mut out = Vec::new();
     for &mode in modes {
         let settings: Vec<Setting> = match mode {
@@ -169,13 +168,10 @@ pub fn entries_for(modes: &[Mode], surfaces: bool) -> Vec<Entry> {
             }
             Mode::Preint2d => [128, 256, 512].into_iter().map(Setting::Table).collect(),
             Mode::ExactFrag | Mode::Iso => vec![Setting::Default],
-            Mode::Raycast => {
-                let mut m = vec![FieldModel::Faces, FieldModel::Tets];
-                if !surfaces {
-                    m.push(FieldModel::Native);
-                }
-                m.into_iter().map(Setting::Model).collect()
-            }
+            Mode::Raycast => [FieldModel::Faces, FieldModel::Tets, FieldModel::Native]
+                .into_iter()
+                .map(Setting::Model)
+                .collect(),
         };
         out.extend(settings.into_iter().map(|setting| Entry { mode, setting }));
     }
@@ -244,10 +240,6 @@ impl BenchConfig {
             elevation: (b.elevation + view.elevation).clamp(-89.0, 89.0),
             ..*b
         }
-    }
-
-    fn native_reference(&self) -> bool {
-        !self.base.iso.any()
     }
 }
 
@@ -368,7 +360,8 @@ pub fn run(
     let estimate_s = estimate(renderer, shading, config)?;
     let mut frames = Vec::new();
     let runs_per_entry = config.warmup + config.repeats;
-    let refs_per_frame = 1 + config.native_reference() as usize;
+    // The mode's field and `native`.
+    let refs_per_frame = 2;
     let total = config.sizes.len()
         * config.views.len()
         * (config.entries.len() * runs_per_entry + refs_per_frame);
@@ -399,11 +392,7 @@ pub fn run(
             let mut frame_rows = Vec::new();
             for entry in order {
                 if entry.mode != Mode::Raycast {
-                    for m in same_models
-                        .iter()
-                        .copied()
-                        .chain(config.native_reference().then_some(FieldModel::Native))
-                    {
+                    for m in same_models.iter().copied().chain(Some(FieldModel::Native)) {
                         if !refs.iter().any(|(r, _)| *r == m) {
                             progress(&what(&format!("reference {}", m.name())), done, total);
                             done += 1;
@@ -450,7 +439,7 @@ pub fn run(
             }
             // Any reference no entry needed before (a bench of the ray
             // caster alone still reports its model error).
-            if config.native_reference() && !refs.iter().any(|(r, _)| *r == FieldModel::Native) {
+            if !refs.iter().any(|(r, _)| *r == FieldModel::Native) {
                 let m = FieldModel::Native;
                 progress(&what(&format!("reference {}", m.name())), done, total);
                 done += 1;
@@ -603,11 +592,7 @@ fn estimate(
     let mut total = 0.0;
     let mut longest = (0.0, String::new());
     let mut parts: Vec<(String, Mode, f64, f64)> = Vec::new();
-    let mut refs = vec![FieldModel::Faces];
-    if config.native_reference() {
-        refs.push(FieldModel::Native);
-    }
-    for m in refs {
+    for m in [FieldModel::Faces, FieldModel::Native] {
         let mut o = base.clone();
         o.mode = Mode::Raycast;
         o.reference.model = m;

@@ -240,7 +240,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let pending = gpu.then(|| zoovr::gpu::Context::spawn(&base.gpu));
     let (geometry, shading, load_s) = load(args)?;
     let config = BenchConfig {
-        entries: bench::entries_for(&modes, surfaces),
+        entries: bench::entries_for(&modes),
         sizes: args.sizes.0.clone(),
         views: bench::views(args.views.max(1)),
         base,

@@ -61,7 +61,8 @@ pub struct ViewArgs {
     pub mode: Mode,
     /// Field model of the ray caster: faces (default), tets or native. The
     /// exact mode integrates `faces` for whole cells and `tets` with
-    /// `--split all`.
+    /// `--split all`. All three draw --iso surfaces (native: where the
+    /// iso-parametric field reaches the value along each ray).
     #[arg(long)]
     pub model: Option<FieldModel>,
     /// How the ray caster finds the cells along each ray: walk (default) or
@@ -76,8 +77,8 @@ pub struct ViewArgs {
     /// same image (to rounding); brute force is slower and is the
     /// reference where adjacency cannot be trusted: non-conforming faces
     /// that only partly overlap (faults in corner-point grids, hanging
-    /// nodes), overlapping or duplicated cells, duplicated points. Not
-    /// available with `--model native`.
+    /// nodes), overlapping or duplicated cells, duplicated points. Both
+    /// draw --iso surfaces. `brute` is not available with `--model native`.
     #[arg(long)]
     pub traversal: Option<Traversal>,
     /// Pre-integrated table modes (preint3d, preint2d, preint2d-cyl):
@@ -97,9 +98,10 @@ pub struct ViewArgs {
     ///
     /// Drawn alone by --mode iso, mixed with the volume in the exact order
     /// by exact, exact-frag, preint3d, preint2d, preint2d-cyl and raycast
-    /// (exact slices the cells at each isovalue, as at the transfer
-    /// function's breakpoints, so its cost grows with the surfaces a cell
-    /// holds; the others find the crossings per fragment). COLOUR is #rrggbb or `tf` (the
+    /// (any --model and --traversal; exact slices the cells at each
+    /// isovalue, as at the transfer function's breakpoints, so its cost
+    /// grows with the surfaces a cell holds; the others find the crossings
+    /// per fragment). COLOUR is #rrggbb or `tf` (the
     /// transfer function's colour at V, the default); OPACITY in [0, 1]
     /// (default 1, opaque). The front side is the one a ray meets while
     /// the field rises; the back side takes the front's style unless
@@ -232,18 +234,6 @@ impl ViewArgs {
     pub fn usage_error(&self) -> Option<String> {
         if self.mode == Mode::Iso && self.iso.is_none() {
             return Some("--mode iso draws isosurfaces only: give them with --iso V,V,...".into());
-        }
-        if self.iso.is_some() && self.mode == Mode::Raycast {
-            if self.model == Some(FieldModel::Native) {
-                return Some(
-                    "--iso with --mode raycast needs --model faces or tets (isosurface \
-                     crossings of the native field are not implemented)"
-                        .into(),
-                );
-            }
-            if self.traversal == Some(Traversal::Brute) {
-                return Some("--iso with --mode raycast needs --traversal walk".into());
-            }
         }
         if self.traversal == Some(Traversal::Brute) && self.model == Some(FieldModel::Native) {
             return Some(

@@ -14,7 +14,7 @@
 //! Files found by a folder or a pattern are put in natural order (runs of
 //! digits compare as numbers, so `step_2` comes before `step_10`) and their
 //! time is their index in that order (`zoovr animate` then takes the time
-//! a file records itself, VTK XML's `TimeValue`, where it has one). An empty folder or a pattern that
+//! a file records itself, `TimeValue` or legacy `TIME`, where it has one). An empty folder or a pattern that
 //! matches nothing is an error naming it.
 
 use std::cmp::Ordering;

@@ -172,8 +172,10 @@ pub struct SourceInfo {
     pub ignored_cells: usize,
     /// Human-readable notes about repairs the reader made.
     pub notes: Vec<String>,
-    /// The time value the file itself records (VTK XML: the first value of
-    /// the `TimeValue` array of the dataset's `<FieldData>`), if any.
+    /// The time value the file itself records, if any: VTK XML, the first
+    /// value of the `TimeValue` array of the dataset's `<FieldData>` (a
+    /// `.pvtu`: its pieces'); legacy VTK, of the dataset `FIELD` array
+    /// `TIME` or `TimeValue`.
     pub time_value: Option<f64>,
 }
 

@@ -72,6 +72,14 @@
 //! where two pieces meet at an edge or vertex, whose depths round
 //! differently through different triangles, are not).
 //!
+//! **Isosurfaces** ([`super::iso::BruteIsoReference`]): each composited
+//! part ([`Part`]: a whole segment, or a sub-interval of an overlap) is
+//! split at the surfaces it crosses by [`crate::render::iso::IsoSet::composite`],
+//! the scalar being linear along it as on the walk's segments; the
+//! gradient is its piece's (flat) or the points' gradients interpolated at
+//! the crossings with the triangles' barycentric weights, linear between
+//! (smooth, [`Brute::trace_with`]).
+//!
 //! The `native` model is not offered ([`RaycastError::BruteModel`]): its
 //! pieces are bounded by bilinear patches, not triangles.
 
@@ -84,7 +92,7 @@ use super::geometry::{Proj, RayFrame};
 use super::{stop_depth, Segment};
 use super::{validate, FieldModel, RayTracer, RaycastError, RaycastOptions, Scalars, Scene};
 use crate::camera::Ray;
-use crate::integrate::{RayAccumulator, RayMaterial};
+use crate::integrate::{RayAccumulator, RayMaterial, SegmentValue};
 use crate::mesh::tetra::{tetrahedralize, tetrahedralize_cell};
 use crate::mesh::CellKind;
 use crate::numeric::predicates::{orient3d, Side};
@@ -126,10 +134,10 @@ pub struct BruteScratch {
     /// Edge values of the current cell by local node pair (NaN: not yet).
     edges: Vec<f64>,
     local: Vec<usize>,
-    /// Crossings of the current piece: depth, sign, scalar.
-    crossings: Vec<(f64, i8, f64)>,
-    /// Segments of the ray with their piece.
-    segs: Vec<(Segment, u32)>,
+    /// Crossings of the current piece: depth, sign, scalar, gradient.
+    crossings: Vec<(f64, i8, f64, DVec3)>,
+    /// Segments of the ray with their piece and end gradients.
+    segs: Vec<PieceSegment>,
     cuts: Vec<f64>,
     active: Vec<usize>,
 }
@@ -137,7 +145,7 @@ pub struct BruteScratch {
 /// A scene prepared for brute-force ray casting with the `faces` or `tets`
 /// model.
 pub struct Brute<'a> {
-    scene: Scene<'a>,
+    pub(super) scene: Scene<'a>,
     model: FieldModel,
     /// `tets`: the non-flat consistent tets, cell `c`'s at
     /// `tets[tet_offsets[c]..tet_offsets[c + 1]]`.
@@ -154,6 +162,23 @@ pub struct Brute<'a> {
     pad: f64,
     flat: usize,
     counts: [AtomicU64; 3],
+}
+
+/// A segment of the ray with its piece and the points' gradients
+/// interpolated at its ends (zero unless asked for: [`Brute::trace_with`]).
+type PieceSegment = (Segment, u32, [DVec3; 2]);
+
+/// The part of a piece's segment composited at once (the whole segment, or
+/// a sub-interval of an overlap): length, scalars and gradients at its ends
+/// (linear between), the piece (a cell for `faces`, an index of
+/// [`Brute::piece_nodes`] for `tets`) and its mesh cell.
+#[derive(Clone, Copy, Debug)]
+pub struct Part {
+    pub piece: u32,
+    pub cell: u32,
+    pub l: f64,
+    pub s: [f64; 2],
+    pub g: [DVec3; 2],
 }
 
 /// The largest `f32` not above `x` (boxes are rounded outwards).
@@ -326,6 +351,17 @@ impl<'a> Brute<'a> {
         b
     }
 
+    /// The point ids of piece `piece` (a cell for `faces`, a tet for `tets`).
+    pub fn piece_nodes(&self, piece: u32) -> Option<&[u32]> {
+        match &self.tets {
+            Some((tets, _)) => tets.get(piece as usize).map(|t| &t[..]),
+            None => {
+                let cells = &self.scene.mesh.cells;
+                ((piece as usize) < cells.len()).then(|| cells.nodes(piece as usize))
+            }
+        }
+    }
+
     /// The counts summed over every ray traced so far.
     pub fn stats(&self) -> BruteStats {
         let c = |k: usize| self.counts[k].load(Ordering::Relaxed);
@@ -362,7 +398,8 @@ impl<'a> Brute<'a> {
         let inv = DVec3::ONE / frame.d;
         self.bvh.query(frame.o, frame.d, t_near, &mut stack, |k| {
             if self.item_hit(k, frame.o, inv, t_near) {
-                self.cell_segments(&frame, self.ids[k as usize], t_near, scratch, &mut segs);
+                let c = self.ids[k as usize];
+                self.cell_segments(&frame, c, t_near, None, scratch, &mut segs);
             }
         });
         segs.sort_unstable_by(|a, b| a.0.t_in.total_cmp(&b.0.t_in).then(a.1.cmp(&b.1)));
@@ -371,14 +408,16 @@ impl<'a> Brute<'a> {
     }
 
     /// Appends the segments of cell `c`'s pieces along the ray (see the
-    /// module docs: non-zero winding, clipped at `t_near`).
+    /// module docs: non-zero winding, clipped at `t_near`), with the
+    /// points' gradients `grads` interpolated at their ends where given.
     fn cell_segments(
         &self,
         frame: &RayFrame,
         c: u32,
         t_near: f64,
+        grads: Option<&[DVec3]>,
         scratch: &mut BruteScratch,
-        out: &mut Vec<(Segment, u32)>,
+        out: &mut Vec<PieceSegment>,
     ) {
         let cells = &self.scene.mesh.cells;
         let ci = c as usize;
@@ -407,6 +446,7 @@ impl<'a> Brute<'a> {
             nodes,
             scalars: self.scene.scalars,
             cell: c,
+            grads,
         };
         let crossings = &mut scratch.crossings;
         match &self.tets {
@@ -479,6 +519,23 @@ impl<'a> Brute<'a> {
         opts: &RaycastOptions,
         scratch: &mut BruteScratch,
     ) -> RayAccumulator {
+        self.trace_with(ray, t_near, opts, scratch, None, |p| {
+            material.segment(p.l, p.s[0], p.s[1])
+        })
+    }
+
+    /// [`Brute::trace`] with each [`Part`]'s value given by `value` (the
+    /// material's integral, or that with isosurfaces), the points'
+    /// gradients `grads` interpolated at the segments' ends where given.
+    pub fn trace_with(
+        &self,
+        ray: &Ray,
+        t_near: f64,
+        opts: &RaycastOptions,
+        scratch: &mut BruteScratch,
+        grads: Option<&[DVec3]>,
+        value: impl Fn(&Part) -> SegmentValue,
+    ) -> RayAccumulator {
         let frame = RayFrame::new(ray, self.center, self.radius);
         let stop = stop_depth(opts);
         let mut pending = std::mem::take(&mut scratch.segs);
@@ -491,7 +548,7 @@ impl<'a> Brute<'a> {
             .query_ordered(frame.o, frame.d, t_near, &mut queue, |t_leaf, items| {
                 let limit = t_leaf - self.pad;
                 self.flush(
-                    material,
+                    &value,
                     &mut pending,
                     limit,
                     stop,
@@ -509,6 +566,7 @@ impl<'a> Brute<'a> {
                             &frame,
                             self.ids[k as usize],
                             t_near,
+                            grads,
                             scratch,
                             &mut pending,
                         );
@@ -519,7 +577,7 @@ impl<'a> Brute<'a> {
         if acc.depth < stop {
             let end = f64::INFINITY;
             self.flush(
-                material,
+                &value,
                 &mut pending,
                 end,
                 stop,
@@ -543,10 +601,10 @@ impl<'a> Brute<'a> {
     /// `counts[1]` and `counts[2]` count the segments integrated and those
     /// overlapping the ones before them.
     #[allow(clippy::too_many_arguments)]
-    fn flush<M: RayMaterial>(
+    fn flush(
         &self,
-        material: &M,
-        pending: &mut Vec<(Segment, u32)>,
+        value: &impl Fn(&Part) -> SegmentValue,
+        pending: &mut Vec<PieceSegment>,
         limit: f64,
         stop: f64,
         acc: &mut RayAccumulator,
@@ -576,10 +634,16 @@ impl<'a> Brute<'a> {
                 break;
             }
             if j == i + 1 {
-                let s = &pending[i].0;
-                acc.add(&material.segment(s.t_out - s.t_in, s.s_in, s.s_out));
+                let (s, piece, g) = &pending[i];
+                acc.add(&value(&Part {
+                    piece: *piece,
+                    cell: s.cell,
+                    l: s.t_out - s.t_in,
+                    s: [s.s_in, s.s_out],
+                    g: *g,
+                }));
             } else {
-                composite_overlap(material, &pending[i..j], stop, acc, scratch);
+                composite_overlap(value, &pending[i..j], stop, acc, scratch);
             }
             counts[1] += (j - i) as u64;
             counts[2] += overlapping;
@@ -615,6 +679,8 @@ struct CellRay<'r> {
     nodes: &'r [u32],
     scalars: Scalars<'r>,
     cell: u32,
+    /// The points' gradients, interpolated at the crossings where given.
+    grads: Option<&'r [DVec3]>,
 }
 
 impl CellRay<'_> {
@@ -635,9 +701,9 @@ impl CellRay<'_> {
     }
 
     /// The crossing of triangle `t` (local nodes, in the piece's winding):
-    /// depth, sign along the winding normal, scalar.
+    /// depth, sign along the winding normal, scalar, gradient.
     #[inline]
-    fn crossing(&mut self, t: [usize; 3]) -> Option<(f64, i8, f64)> {
+    fn crossing(&mut self, t: [usize; 3]) -> Option<(f64, i8, f64, DVec3)> {
         // The crossing test's own sign condition first (most triangles
         // fail it), then the test itself in the canonical order.
         let e = [
@@ -662,7 +728,12 @@ impl CellRay<'_> {
             Scalars::Cell(v) => v[self.cell as usize],
             Scalars::Constant(s) => s,
         };
-        Some((x.t, x.sign * parity, s))
+        let g = self.grads.map_or(DVec3::ZERO, |g| {
+            let [a, b, c] = x.order;
+            let at = |i: usize| g.get(nodes[k[i]] as usize).copied().unwrap_or_default();
+            at(a) * x.w[a] + at(b) * x.w[b] + at(c) * x.w[c]
+        });
+        Some((x.t, x.sign * parity, s, g))
     }
 }
 
@@ -670,23 +741,23 @@ impl CellRay<'_> {
 /// their winding number is non-zero, clipped at `t_near`, and appends them
 /// with the piece's index (see the module docs).
 fn pair_crossings(
-    crossings: &mut [(f64, i8, f64)],
+    crossings: &mut [(f64, i8, f64, DVec3)],
     cell: u32,
     piece: u32,
     t_near: f64,
-    out: &mut Vec<(Segment, u32)>,
+    out: &mut Vec<PieceSegment>,
 ) {
     if crossings.len() < 2 {
         return;
     }
     crossings.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let mut winding = 0i32;
-    let mut open = (0.0, 0.0);
-    for &(t, sign, s) in crossings.iter() {
+    let mut open = (0.0, 0.0, DVec3::ZERO);
+    for &(t, sign, s, g) in crossings.iter() {
         let before = winding;
         winding += sign as i32;
         if before == 0 && winding != 0 {
-            open = (t, s);
+            open = (t, s, g);
         } else if before != 0 && winding == 0 {
             let mut seg = Segment {
                 cell,
@@ -698,12 +769,14 @@ fn pair_crossings(
             if seg.t_out <= t_near || seg.t_out <= seg.t_in {
                 continue;
             }
+            let mut g_in = open.2;
             if seg.t_in < t_near {
                 let x = (t_near - seg.t_in) / (seg.t_out - seg.t_in);
                 seg.s_in += x * (seg.s_out - seg.s_in);
                 seg.t_in = t_near;
+                g_in = g_in.lerp(g, x);
             }
-            out.push((seg, piece));
+            out.push((seg, piece, [g_in, g]));
         }
     }
 }
@@ -723,16 +796,16 @@ fn scalar_at(s: &Segment, t: f64) -> f64 {
 /// Composites a run of segments that overlap in depth (sorted by entry
 /// depth, then piece): split at every segment boundary; within each
 /// sub-interval the covering segments in their order.
-fn composite_overlap<M: RayMaterial>(
-    material: &M,
-    run: &[(Segment, u32)],
+fn composite_overlap(
+    value: &impl Fn(&Part) -> SegmentValue,
+    run: &[PieceSegment],
     stop: f64,
     acc: &mut RayAccumulator,
     scratch: &mut BruteScratch,
 ) {
     let cuts = &mut scratch.cuts;
     cuts.clear();
-    for (s, _) in run {
+    for (s, _, _) in run {
         cuts.push(s.t_in);
         cuts.push(s.t_out);
     }
@@ -751,8 +824,16 @@ fn composite_overlap<M: RayMaterial>(
             next += 1;
         }
         for &k in active.iter() {
-            let s = &run[k].0;
-            acc.add(&material.segment(b - a, scalar_at(s, a), scalar_at(s, b)));
+            let (s, piece, g) = &run[k];
+            let span = s.t_out - s.t_in;
+            let at = |t: f64| g[0].lerp(g[1], ((t - s.t_in) / span).clamp(0.0, 1.0));
+            acc.add(&value(&Part {
+                piece: *piece,
+                cell: s.cell,
+                l: b - a,
+                s: [scalar_at(s, a), scalar_at(s, b)],
+                g: [at(a), at(b)],
+            }));
             if acc.depth >= stop {
                 return;
             }

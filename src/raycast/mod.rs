@@ -397,6 +397,19 @@ impl<'a> Raycaster<'a> {
         scratch: &mut Scratch,
         stats: &mut native::NativeStats,
     ) -> Option<Vec<native::Interval>> {
+        self.native_intervals_with(ray, t_near, scratch, stats, None)
+    }
+
+    /// [`Raycaster::native_intervals`], also collecting into `raws` the
+    /// walk segments of the cells without a native field (in walk order).
+    pub(crate) fn native_intervals_with(
+        &self,
+        ray: &Ray,
+        t_near: f64,
+        scratch: &mut Scratch,
+        stats: &mut native::NativeStats,
+        mut raws: Option<&mut Vec<RawSegment>>,
+    ) -> Option<Vec<native::Interval>> {
         let vals = native::point_values(&self.scene)?;
         let cells = &self.scene.mesh.cells;
         let topo = self.scene.topology;
@@ -412,6 +425,9 @@ impl<'a> Raycaster<'a> {
                     queue.push(raw.cell);
                 }
             } else if raw.t_out > t_near {
+                if let Some(r) = raws.as_deref_mut() {
+                    r.push(*raw);
+                }
                 let s = self.to_segment(raw);
                 out.push(native::Interval {
                     cell: s.cell,

@@ -365,8 +365,15 @@ impl IsoSet {
         self.surface_weighted(k, rising, g, d, 1.0)
     }
 
-    /// [`Self::surface`] with its opacity times `w`.
-    fn surface_weighted(&self, k: usize, rising: bool, g: DVec3, d: DVec3, w: f64) -> SegmentValue {
+    /// [`Self::surface`] with its opacity times `w` (RKE's blend).
+    pub fn surface_weighted(
+        &self,
+        k: usize,
+        rising: bool,
+        g: DVec3,
+        d: DVec3,
+        w: f64,
+    ) -> SegmentValue {
         let c = self.sides[k][if rising { 0 } else { 1 }];
         let i = self.light(g, d);
         let a = (c[3] * w).clamp(0.0, 1.0);

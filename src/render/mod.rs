@@ -88,8 +88,6 @@ pub enum RenderError {
     TableSize(#[from] modes::preint_tables::TableSizeError),
     #[error(transparent)]
     Iso(#[from] iso::IsoError),
-    #[error("the ray caster draws isosurfaces on the faces and tets fields with the walk traversal (--model faces|tets, --traversal walk)")]
-    IsoReference,
     #[error("--mode iso draws isosurfaces only: give them with --iso V,V,...")]
     IsoMissing,
     #[error("the {mode} mode cannot draw {model:?} emission (it supports {supported}); modes that can: --mode {alternatives}")]

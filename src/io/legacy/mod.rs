@@ -13,8 +13,10 @@
 //!   `VERTICES`/`LINES`/`POLYGONS`/`TRIANGLE_STRIPS` (2D at most: counted as
 //!   ignored);
 //! - data: `POINT_DATA n` / `CELL_DATA n` followed by attributes
-//!   ([`attributes`]); a `FIELD` block outside them is dataset field data
-//!   (e.g. `TIME`), read and dropped;
+//!   ([`attributes`]); a `FIELD` block outside them is dataset field data:
+//!   the first value of its `TIME` (VTK's writers) or `TimeValue` array is
+//!   the step's time ([`SourceInfo::time_value`], what `animate` labels the
+//!   frame with), the other arrays are read and dropped;
 //! - `METADATA` blocks anywhere (skipped up to their closing blank line).
 //!
 //! Blank lines are whitespace like any other. At the end the pieces are
@@ -172,6 +174,7 @@ struct Reader {
     cell_data: Vec<DataArray>,
     active_point: Option<String>,
     active_cell: Option<String>,
+    time_value: Option<f64>,
     notes: Vec<String>,
 }
 
@@ -184,7 +187,21 @@ impl Reader {
             match kw.as_str() {
                 "METADATA" => cur.skip_metadata(),
                 "FIELD" if self.section.is_none() => {
-                    let arrays = attributes::read_field(cur, None)?;
+                    let mut arrays = attributes::read_field(cur, None)?;
+                    if let Some(k) = arrays
+                        .iter()
+                        .position(|a| a.name == "TIME" || a.name == "TimeValue")
+                    {
+                        let a = arrays.remove(k);
+                        let t = (a.tuples() > 0).then(|| a.component(0, 0));
+                        match t {
+                            Some(t) if t.is_finite() => self.time_value = Some(t),
+                            _ => self.notes.push(format!(
+                                "dataset field '{}' holds no finite time value: not used",
+                                a.name
+                            )),
+                        }
+                    }
                     let names: Vec<&str> = arrays.iter().map(|a| a.name.as_str()).collect();
                     if !names.is_empty() {
                         self.notes
@@ -411,6 +428,7 @@ impl Reader {
         mesh.active_cell_scalars = self.active_cell;
         mesh.source = SourceInfo {
             notes: self.notes,
+            time_value: self.time_value,
             ..mesh.source
         };
         Ok(mesh)

@@ -1,7 +1,9 @@
 //! `.pvtu`: a `PUnstructuredGrid` whose `<Piece Source="...">` elements name
 //! `.vtu` files (relative to the `.pvtu`'s folder). The pieces are read in
 //! parallel and merged (point ids offset per piece). The `PPointData` /
-//! `PCellData` `Scalars` attribute marks the active scalars.
+//! `PCellData` `Scalars` attribute marks the active scalars. The step's time
+//! is the pieces' `TimeValue` (ParaView writes it into every piece); pieces
+//! that disagree leave it unset, with a note.
 //!
 //! Refused with a clean error naming the `.pvtu` and the piece: a missing or
 //! unreadable piece, a piece that is the `.pvtu` itself, and a piece that is
@@ -88,7 +90,16 @@ pub fn read(path: &Path, grid: &Element, depth: usize) -> Result<Mesh, IoError> 
                 .map_err(|e| IoError::parse(path, at(), format!("piece failed: {e}")))
         })
         .collect::<Result<Vec<Mesh>, IoError>>()?;
+    let times: Vec<Option<f64>> = meshes.iter().map(|m| m.source.time_value).collect();
     let mut mesh = super::merge_checked(path, grid, meshes)?;
+    let first = times.iter().flatten().next().copied();
+    if times.iter().flatten().all(|t| Some(*t) == first) {
+        mesh.source.time_value = first;
+    } else {
+        mesh.source
+            .notes
+            .push("the pieces' TimeValues differ: no time value".into());
+    }
     let active = |el: Option<&Element>| el.and_then(|e| e.attr("Scalars")).map(str::to_string);
     if let Some(s) =
         active(grid.child("PPointData")).filter(|s| mesh.point_data.iter().any(|a| &a.name == s))

@@ -31,6 +31,10 @@
 //!    depth). Material is only evaluated at interior nodes, never exactly on
 //!    a breakpoint.
 //!
+//! **Isosurfaces** ([`iso`]): the crossings of each isovalue are found as
+//! the breakpoints are, on the same monotone pieces, and the volume is
+//! integrated between them.
+//!
 //! If the map cannot be inverted inside an interval (degenerate cell,
 //! Newton failure) the interval falls back to the linear integral between
 //! the exact boundary scalars at its ends ([`interval_value`]), counted in
@@ -41,6 +45,7 @@ use std::sync::OnceLock;
 use glam::{DMat3, DVec3};
 
 mod boundary;
+pub mod iso;
 
 pub use boundary::{axes_of, cell_intervals, ray_bilinear, ray_triangle, Interval};
 
@@ -529,15 +534,25 @@ pub fn breakpoint_crossings(
     stats: &mut NativeStats,
 ) -> Option<Vec<f64>> {
     let nodes = monotone_nodes(field, t_in, t_out, stats)?;
+    node_crossings(field, &nodes, breakpoints)
+}
+
+/// [`breakpoint_crossings`] on the monotone pieces `nodes` (from
+/// [`monotone_nodes`]): each breakpoint strictly inside a piece's scalar
+/// range is bracketed there and found by bisection ([`piece_root`]).
+fn node_crossings(
+    field: &mut IsoRay,
+    nodes: &[(f64, f64)],
+    breakpoints: &[f64],
+) -> Option<Vec<f64>> {
     let mut cuts = Vec::new();
-    for k in 0..nodes.len() - 1 {
-        let ((ta, sa), (tb, sb)) = (nodes[k], nodes[k + 1]);
-        let (lo, hi) = (sa.min(sb), sa.max(sb));
+    for w in nodes.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let (lo, hi) = (a.1.min(b.1), a.1.max(b.1));
         let mut here = Vec::new();
-        for &b in breakpoints {
-            if b > lo && b < hi {
-                let t = bisect(ta, tb, sa - b, |t| field.eval(t).map(|v| v.0 - b))?;
-                here.push(t);
+        for &v in breakpoints {
+            if v > lo && v < hi {
+                here.push(piece_root(field, a, b, v)?);
             }
         }
         here.sort_by(f64::total_cmp);
@@ -545,6 +560,19 @@ pub fn breakpoint_crossings(
     }
     cuts.sort_by(f64::total_cmp);
     Some(cuts)
+}
+
+/// The depth where `s(t) = v` on the monotone piece from node `a` to node
+/// `b` (`v` between their values): an end that has the value exactly, else
+/// bisection of `s(t) - v`.
+fn piece_root(field: &mut IsoRay, a: (f64, f64), b: (f64, f64), v: f64) -> Option<f64> {
+    if a.1 == v {
+        return Some(a.0);
+    }
+    if b.1 == v {
+        return Some(b.0);
+    }
+    bisect(a.0, b.0, a.1 - v, |t| field.eval(t).map(|e| e.0 - v))
 }
 
 /// Integrates `[t_in, t_out]` through the iso-parametric field; `None` when
@@ -566,6 +594,17 @@ pub fn integrate<M: RayMaterial>(
     )?);
     cuts.push(t_out);
     cuts.sort_by(f64::total_cmp);
+    integrate_cuts(field, material, &cuts)
+}
+
+/// Integrates between consecutive depths of the sorted `cuts` (each part
+/// smooth: inside one piece of the transfer function) and composites the
+/// parts front to back.
+fn integrate_cuts<M: RayMaterial>(
+    field: &mut IsoRay,
+    material: &M,
+    cuts: &[f64],
+) -> Option<SegmentValue> {
     let mut acc = SegmentValue::default();
     for w in cuts.windows(2) {
         if w[1] > w[0] {

@@ -9,8 +9,7 @@ use std::time::Instant;
 use crate::camera::Camera;
 use crate::image::Image;
 use crate::raycast::brute::Brute;
-use crate::raycast::iso::{Empty, IsoReference};
-use crate::raycast::FieldModel;
+use crate::raycast::iso::{BruteIsoReference, Empty, IsoReference};
 use crate::raycast::{self, RayTracer, RaycastOptions, Raycaster, Traversal};
 use crate::render::gradients::point_gradients;
 use crate::render::iso::{IsoError, IsoSet, Lighting};
@@ -98,8 +97,9 @@ pub(crate) fn render(
 }
 
 /// The reference with the isosurfaces of `opts.iso`, over the volume
-/// (`volume`) or alone (the reference of `--mode iso`): the walk
-/// traversal, `faces` or `tets` field ([`crate::raycast::iso`]).
+/// (`volume`) or alone (the reference of `--mode iso`): the walk (any
+/// field model) or the brute-force traversal (`faces`, `tets`), see
+/// [`crate::raycast::iso`].
 pub fn render_iso(
     scene: &Scene,
     opts: &RenderOptions,
@@ -111,9 +111,6 @@ pub fn render_iso(
     let ScalarsRef::Point(values) = scene.scalars() else {
         return Err(IsoError::CellData.into());
     };
-    if opts.reference.model == FieldModel::Native || opts.reference.traversal != Traversal::Walk {
-        return Err(RenderError::IsoReference);
-    }
     let rs = raycast::Scene {
         mesh: &scene.mesh,
         topology: &scene.topology,
@@ -131,21 +128,43 @@ pub fn render_iso(
     };
     let set = IsoSet::new(&opts.iso, &scene.tf);
     let grads = (set.lighting == Lighting::Smooth).then(|| point_gradients(&scene.mesh, values));
-    let rc = Raycaster::new(rs, opts.reference.model)?;
-    let iso = IsoReference::new(&rc, &set, camera.forward, grads.as_deref(), values);
-    let setup_s = t0.elapsed().as_secs_f64();
-    let (img, terminated_rays) = if volume {
-        iso.render_counting(&scene.tf, camera, &ro, progress)
-    } else {
-        iso.render_counting(&Empty, camera, &ro, progress)
+    let mut native = Default::default();
+    let mut brute = Default::default();
+    let (setup_s, (img, terminated_rays)) = match opts.reference.traversal {
+        Traversal::Walk => {
+            let rc = Raycaster::new(rs, opts.reference.model)?;
+            let iso = IsoReference::new(&rc, &set, camera.forward, grads.as_deref(), values);
+            let setup_s = t0.elapsed().as_secs_f64();
+            let before = rc.native_stats();
+            let out = if volume {
+                iso.render_counting(&scene.tf, camera, &ro, progress)
+            } else {
+                iso.render_counting(&Empty, camera, &ro, progress)
+            };
+            native = rc.native_stats().since(&before);
+            (setup_s, out)
+        }
+        Traversal::Brute => {
+            let b = Brute::new(rs, opts.reference.model)?;
+            let iso = BruteIsoReference::new(&b, &set, camera.forward, grads.as_deref(), values);
+            let setup_s = t0.elapsed().as_secs_f64();
+            let before = b.stats();
+            let out = if volume {
+                iso.render_counting(&scene.tf, camera, &ro, progress)
+            } else {
+                iso.render_counting(&Empty, camera, &ro, progress)
+            };
+            brute = b.stats().since(&before);
+            (setup_s, out)
+        }
     };
     let stats = RaycastStats {
         model: opts.reference.model,
         traversal: opts.reference.traversal,
         termination_transmittance: ro.early_termination,
         terminated_rays,
-        native: Default::default(),
-        brute: Default::default(),
+        native,
+        brute,
     };
     Ok((img, stats, setup_s))
 }
