@@ -38,15 +38,18 @@ mod tests {
     #[test]
     #[cfg(target_os = "linux")]
     fn peak_follows_a_large_allocation() {
+        // The peak is the process's: the other tests of the binary run
+        // in parallel and allocate too (tens of MiB), so the allocation
+        // here is large against that, and the margins wide.
         reset_peak();
         let before = peak_mb().unwrap();
-        let big = vec![1u8; 64 << 20];
+        let big = vec![1u8; 512 << 20];
         std::hint::black_box(&big);
         let after = peak_mb().unwrap();
-        assert!(after >= before + 60.0, "{before} -> {after}");
+        assert!(after >= before + 500.0, "{before} -> {after}");
         drop(big);
         reset_peak();
         let reset = peak_mb().unwrap();
-        assert!(reset < after - 60.0, "reset: {after} -> {reset}");
+        assert!(reset < after - 256.0, "reset: {after} -> {reset}");
     }
 }

@@ -65,7 +65,7 @@ use crate::visibility::{Piece, Sorter, SplitPolicy};
 pub use super::projected_mode::ProjectedMode;
 
 use super::group::composite_group;
-use super::pieces::{PartScratch, PieceError, PieceSource};
+use super::pieces::{value_range, PartScratch, PieceError, PieceSource};
 use super::scene::{ScalarsRef, Scene};
 use super::stats::ProjectedStats;
 use super::ties::{decide_ties, PartTriangles, TieRays, TieScratch};
@@ -145,6 +145,9 @@ struct Worker<P, V> {
     /// of the centres next to the outline ([`super::ties`]).
     drawn: Vec<([u32; 3], [[i64; 2]; 3])>,
     ties: TieScratch,
+    /// The transfer function's largest rate anywhere (a bound on every
+    /// part's, [`PieceSource::max_rate`]).
+    rate_bound: f64,
     _vertex: std::marker::PhantomData<V>,
 }
 
@@ -167,6 +170,10 @@ impl<P: Default, V> Worker<P, V> {
             grid: Vec::new(),
             drawn: Vec::new(),
             ties: TieScratch::default(),
+            rate_bound: {
+                let (lo, hi) = src.tf.scalar_range();
+                src.max_rate(lo, hi)
+            },
             _vertex: std::marker::PhantomData,
         }
     }
@@ -246,6 +253,11 @@ fn draw_part<M: ProjectedMode>(
         exact: &proj.triangles,
         width: src.camera.width,
         height: src.camera.height,
+        rate_bound: w.rate_bound,
+        rate: &|| {
+            let (lo, hi) = value_range(part.scalars.iter().copied());
+            src.max_rate(lo, hi)
+        },
     };
     if mode.decides_ties() && src.exact_ties {
         decide_ties(&part_tris, part, &src.ties, &mut w.ties);

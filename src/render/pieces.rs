@@ -395,6 +395,30 @@ impl PieceSource<'_> {
         }
     }
 
+    /// The largest extinction or emission rate (per unit length) the
+    /// transfer function takes on `[lo, hi]` (at its ends and on both sides
+    /// of every node inside: the function is piecewise linear), `f64::MAX`
+    /// when not finite: a bound on how fast a segment's optical depth and
+    /// colour grow with its length ([`super::ties`] weighs slivers by it).
+    pub fn max_rate(&self, lo: f64, hi: f64) -> f64 {
+        let rate = |s: f64| {
+            let m = self.tf.material(s);
+            m.source.iter().fold(m.tau, |a, &c| a.max(c.abs()))
+        };
+        let mut r = rate(lo).max(rate(hi));
+        for &b in self.tf.breakpoints_slice() {
+            if b >= lo && b <= hi {
+                let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
+                r = r.max(rate(b)).max(rate(left));
+            }
+        }
+        if r.is_finite() {
+            r
+        } else {
+            f64::MAX
+        }
+    }
+
     /// Whether nothing of a piece with scalars in `[lo, hi]` is drawn: it
     /// holds no isosurface, and the volume is not drawn or the material is
     /// dark over the whole interval: zero

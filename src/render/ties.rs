@@ -38,6 +38,19 @@
 //! does not (a blocker, drawn at [`crate::gpu::common::BLOCKER_Z`], which counting draws do
 //! not count). Each piece colours a pixel once (its depth key), so the
 //! quad decides the pixel and the triangles drawn after it leave it alone.
+//!
+//! Two more kinds of centre are decided exactly, and get the exact
+//! segment's quad wherever the part holds them (not only where the two
+//! tests disagree):
+//! - next to a mode's **seams** ([`Projected::seams`]): edges inside the
+//!   outline across which the payload jumps (an isosurface region of the
+//!   exact mode beside a region without it), where a centre must go to
+//!   the same side in every part that shares the edge;
+//! - inside **slivers**, drawn triangles narrower than [`SLIVER_TIE_PX`]:
+//!   the snap of their corners shifts the interpolated values by their
+//!   screen gradient times the snap, which across a sliver is a large part
+//!   of the values' change (a region of a face seen nearly edge-on; an
+//!   optically thick tet seen almost along a face).
 
 use glam::{DVec2, DVec3};
 
@@ -50,6 +63,25 @@ use crate::raycast::geometry::{Proj, RayFrame};
 /// exactly: the largest move of a snapped corner is `sqrt(2)/512` = 2.8e-3
 /// px; 1/256 leaves a margin.
 pub const TIE_BAND_PX: f64 = 1.0 / 256.0;
+
+/// Triangles narrower than this (pixels: twice the area over the longest
+/// edge) have the centres they may hold decided exactly too, with the
+/// segment's exact values: the snap of a corner (up to `sqrt(2)/512` px)
+/// shifts an interpolated value by its screen gradient times that, which
+/// across a sliver of width `w` is `0.0028 / w` of the value's change over
+/// the sliver (0.6 % at half a pixel; a sliver region of a face seen nearly
+/// edge-on can be far thinner). Only slivers where that can matter are
+/// decided ([`SLIVER_DEPTH_TOL`]): a dense mesh has narrow triangles holding
+/// centres by the hundred thousand, nearly all optically thin.
+pub const SLIVER_TIE_PX: f64 = 1.0 / 2.0;
+
+/// The largest move of a snapped corner, pixels (`sqrt(2)/512`).
+const SNAP_PX: f64 = std::f64::consts::SQRT_2 / 512.0;
+
+/// A sliver's centres are decided exactly where the snap could change the
+/// optical depth (or emitted colour) by more than this: a quarter of an
+/// 8-bit step.
+pub const SLIVER_DEPTH_TOL: f64 = 1e-3;
 
 /// Whether the snapped triangle `g` (grid units) covers the centre `q`
 /// (grid units): the rasteriser's test ([`crate::gpu::cpu`]).
@@ -223,7 +255,8 @@ pub struct TieScratch {
     edges: Vec<(u32, u32)>,
     outline: Vec<(u32, u32)>,
     centres: Vec<(u32, u32)>,
-    seam_centres: Vec<(u32, u32)>,
+    forced: Vec<(u32, u32)>,
+    near: Vec<(u32, u32)>,
     proj: Vec<Proj>,
     pub decisions: Vec<TieDecision>,
     /// The values of the decisions that hold a segment, as a projection
@@ -242,6 +275,14 @@ pub struct PartTriangles<'a> {
     pub exact: &'a [[u32; 3]],
     pub width: u32,
     pub height: u32,
+    /// The largest extinction or emission rate on the part's scalar range
+    /// ([`crate::render::pieces::PieceSource::max_rate`]): what a sliver's
+    /// thickness error is weighed by.
+    /// Called only when the part has a sliver that [`Self::rate_bound`]
+    /// does not rule out.
+    pub rate: &'a dyn Fn() -> f64,
+    /// A bound on `rate` for every part.
+    pub rate_bound: f64,
 }
 
 /// Decides the centres near the part's outline (see the module docs) into
@@ -320,24 +361,82 @@ pub fn decide_ties(
     }
     // Centres next to the mode's seams: decided exactly wherever the part
     // holds them, since the two sides carry different values.
-    let seam_centres = &mut scratch.seam_centres;
-    seam_centres.clear();
+    let forced = &mut scratch.forced;
+    forced.clear();
     for &(ia, ib) in &part.proj.seams {
-        near_centres(pos(ia), pos(ib), part.width, part.height, seam_centres);
+        near_centres(pos(ia), pos(ib), part.width, part.height, forced);
     }
-    centres.extend_from_slice(seam_centres);
+    // Centres inside (or next to) sliver triangles: across a triangle
+    // narrower than SLIVER_TIE_PX the values change fast, and the snap of
+    // its corners shifts them by up to its gradient times 1/256 pixel; the
+    // exact segment is taken there instead.
+    let mut rate = None;
+    for (t, _) in part.drawn {
+        let p = t.map(&pos);
+        // Cheap tests first: narrow (twice the area against the longest
+        // edge, squared), then what the snap can do to the optical depth
+        // or colour there (the rate times the thickness's change across
+        // the sliver times the snap over the width), with the bound on the
+        // rate, then the part's own rate.
+        let area2 = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+        let d2 = [0, 1, 2].map(|k| (p[(k + 1) % 3] - p[k]).length_squared());
+        let k = if d2[0] >= d2[1] && d2[0] >= d2[2] {
+            0
+        } else if d2[1] >= d2[2] {
+            1
+        } else {
+            2
+        };
+        if !(d2[k] > 0.0 && area2 * area2 < SLIVER_TIE_PX * SLIVER_TIE_PX * d2[k]) {
+            continue;
+        }
+        let l = t.map(|i| part.proj.vertices[i as usize].l);
+        let dl = l[0].max(l[1]).max(l[2]) - l[0].min(l[1]).min(l[2]);
+        let long = d2[k].sqrt();
+        let w = area2.abs() / long;
+        // False for NaN too.
+        let matters = |r: f64| r * dl * SNAP_PX > SLIVER_DEPTH_TOL * w;
+        if !matters(part.rate_bound) || !matters(*rate.get_or_insert_with(|| (part.rate)())) {
+            continue;
+        }
+        let (a, b) = (p[k], p[(k + 1) % 3]);
+        let near = &mut scratch.near;
+        near.clear();
+        centres_within(
+            a,
+            b,
+            area2.abs() / long + TIE_BAND_PX,
+            part.width,
+            part.height,
+            near,
+        );
+        // Only the centres inside the triangle or within the snap band of
+        // it (distance to each edge's line, on the inner side or less than
+        // the band outside).
+        let s = area2.signum();
+        forced.extend(near.iter().copied().filter(|&(i, j)| {
+            let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+            (0..3).all(|k| {
+                let (u, v) = (p[k], p[(k + 1) % 3]);
+                let e = v - u;
+                let len = e.length();
+                len > 0.0 && s * e.perp_dot(c - u) >= -TIE_BAND_PX * len
+            })
+        }));
+    }
+    centres.extend_from_slice(forced);
     if centres.is_empty() {
         return;
     }
     centres.sort_unstable();
     centres.dedup();
-    seam_centres.sort_unstable();
+    forced.sort_unstable();
     for &(i, j) in centres.iter() {
         let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
         let sub = SUBPIXEL as i64;
         let q = [i as i64 * sub + sub / 2, j as i64 * sub + sub / 2];
         let grid_in = part.drawn.iter().any(|(_, g)| covers_grid(*g, q));
-        let seam = || seam_centres.binary_search(&(i, j)).is_ok();
+        let seam = || forced.binary_search(&(i, j)).is_ok();
         let (value, faces) = match (ray_through(poly, rays, c, &mut scratch.proj), grid_in) {
             (RayThrough::Crosses(v, f), false) => (Some(v), f),
             (RayThrough::Crosses(v, f), true) if seam() => (Some(v), f),
@@ -355,7 +454,20 @@ pub fn decide_ties(
 /// Appends the image's pixel centres within [`TIE_BAND_PX`] of segment `a b`
 /// (a superset: the band is walked along the segment's major axis).
 fn near_centres(a: DVec2, b: DVec2, width: u32, height: u32, out: &mut Vec<(u32, u32)>) {
-    let band = TIE_BAND_PX;
+    centres_within(a, b, TIE_BAND_PX, width, height, out);
+}
+
+/// Appends the image's pixel centres within `band` pixels of segment `a b`
+/// (a superset, as [`near_centres`]).
+#[inline(always)]
+fn centres_within(
+    a: DVec2,
+    b: DVec2,
+    band: f64,
+    width: u32,
+    height: u32,
+    out: &mut Vec<(u32, u32)>,
+) {
     let d = b - a;
     if !(a.is_finite() && b.is_finite()) {
         return;
@@ -385,10 +497,19 @@ fn near_centres(a: DVec2, b: DVec2, width: u32, height: u32, out: &mut Vec<(u32,
         // The one centre row within `reach` (< 1/2) of the segment here,
         // if any.
         let r = a_n + (b_n - a_n) * t - 0.5;
-        let l = floor_i(r + 0.5);
-        if (r - l as f64).abs() <= reach && l >= 0 && l < n_minor as i64 {
-            let (i, j) = if major_x { (k, l) } else { (l, k) };
-            out.push((i as u32, j as u32));
+        if reach < 0.5 {
+            let l = floor_i(r + 0.5);
+            if (r - l as f64).abs() <= reach && l >= 0 && l < n_minor as i64 {
+                let (i, j) = if major_x { (k, l) } else { (l, k) };
+                out.push((i as u32, j as u32));
+            }
+        } else {
+            let l0 = ceil_i(r - reach).max(0);
+            let l1 = floor_i(r + reach).min(n_minor as i64 - 1);
+            for l in l0..=l1 {
+                let (i, j) = if major_x { (k, l) } else { (l, k) };
+                out.push((i as u32, j as u32));
+            }
         }
     }
 }
