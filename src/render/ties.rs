@@ -371,7 +371,7 @@ pub fn decide_ties(
     // its corners shifts them by up to its gradient times 1/256 pixel; the
     // exact segment is taken there instead.
     let mut rate = None;
-    for (t, _) in part.drawn {
+    for (t, g) in part.drawn {
         let p = t.map(&pos);
         // Cheap tests first: narrow (twice the area against the longest
         // edge, squared), then what the snap can do to the optical depth
@@ -410,18 +410,13 @@ pub fn decide_ties(
             part.height,
             near,
         );
-        // Only the centres inside the triangle or within the snap band of
-        // it (distance to each edge's line, on the inner side or less than
-        // the band outside).
-        let s = area2.signum();
+        // Only the centres the snapped sliver covers (the rasteriser's
+        // test): a triangle that covers none is left out by coverage
+        // culling, and with it must go no decision (culling changes no
+        // pixel).
+        let sub = SUBPIXEL as i64;
         forced.extend(near.iter().copied().filter(|&(i, j)| {
-            let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
-            (0..3).all(|k| {
-                let (u, v) = (p[k], p[(k + 1) % 3]);
-                let e = v - u;
-                let len = e.length();
-                len > 0.0 && s * e.perp_dot(c - u) >= -TIE_BAND_PX * len
-            })
+            covers_grid(*g, [i as i64 * sub + sub / 2, j as i64 * sub + sub / 2])
         }));
     }
     centres.extend_from_slice(forced);
