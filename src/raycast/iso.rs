@@ -42,6 +42,29 @@ pub struct IsoReference<'a, 'm> {
     points: Option<&'a [DVec3]>,
 }
 
+/// Flat light: the least-squares gradient of each of `n` cells or pieces
+/// (their nodes by `nodes`), or nothing when the light is not flat.
+fn flat_gradients<'n>(
+    set: &IsoSet,
+    n: usize,
+    nodes: impl Fn(usize) -> &'n [u32],
+    pts: &[DVec3],
+    scalars: &[f64],
+) -> Vec<DVec3> {
+    if set.lighting != Lighting::Flat {
+        return Vec::new();
+    }
+    (0..n)
+        .map(|c| {
+            fit_gradient(
+                nodes(c)
+                    .iter()
+                    .filter_map(|&n| Some((*pts.get(n as usize)?, *scalars.get(n as usize)?))),
+            )
+        })
+        .collect()
+}
+
 impl<'a, 'm> IsoReference<'a, 'm> {
     /// Isosurfaces `set` on the walk of `rc`, lit along `forward`;
     /// `points` are the points' gradients (smooth light).
@@ -54,19 +77,7 @@ impl<'a, 'm> IsoReference<'a, 'm> {
     ) -> IsoReference<'a, 'm> {
         let cells = &rc.walker.cells;
         let pts = rc.walker.points;
-        let flat =
-            if set.lighting == Lighting::Flat {
-                (0..cells.len())
-                    .map(|c| {
-                        let nodes = cells.nodes(c);
-                        fit_gradient(nodes.iter().filter_map(|&n| {
-                            Some((*pts.get(n as usize)?, *scalars.get(n as usize)?))
-                        }))
-                    })
-                    .collect()
-            } else {
-                Vec::new()
-            };
+        let flat = flat_gradients(set, cells.len(), |c| cells.nodes(c), pts, scalars);
         IsoReference {
             rc,
             set,
@@ -249,19 +260,13 @@ impl<'a, 'm> BruteIsoReference<'a, 'm> {
             FieldModel::Tets => brute.piece_count(),
             _ => brute.scene.mesh.cells.len(),
         };
-        let flat =
-            if set.lighting == Lighting::Flat {
-                (0..pieces as u32)
-                    .map(|p| {
-                        let nodes = brute.piece_nodes(p).unwrap_or(&[]);
-                        fit_gradient(nodes.iter().filter_map(|&n| {
-                            Some((*pts.get(n as usize)?, *scalars.get(n as usize)?))
-                        }))
-                    })
-                    .collect()
-            } else {
-                Vec::new()
-            };
+        let flat = flat_gradients(
+            set,
+            pieces,
+            |p| brute.piece_nodes(p as u32).unwrap_or(&[]),
+            pts,
+            scalars,
+        );
         BruteIsoReference {
             brute,
             set,

@@ -253,6 +253,10 @@ pub struct ExactIsoPayload {
     tris: Vec<(u32, u32)>,
     /// Scratch: a surface region's edges.
     edges: Vec<(u32, u32)>,
+    /// Scratch: the side and triangle of each region holding the surface.
+    sides: Vec<Option<(usize, u32)>>,
+    /// Scratch: the vertices given a copy in the region being done.
+    made: Vec<usize>,
 }
 
 /// The exact mode with isosurfaces on the projected-cell driver.
@@ -456,7 +460,8 @@ impl ExactIsoMode {
             return;
         }
         // The side of each region whose triangle lies on the level.
-        let mut sides = Vec::with_capacity(proj.regions.len());
+        let sides = &mut payload.sides;
+        sides.clear();
         for r in 0..proj.regions.len() {
             let faces = proj.region_faces.get(r).copied();
             sides.push(faces.and_then(|[f, b]| {
@@ -497,7 +502,8 @@ impl ExactIsoMode {
                 start = end;
                 continue;
             };
-            let mut made = Vec::new();
+            let made = &mut payload.made;
+            made.clear();
             for &(_, t) in &tris[start..end] {
                 for c in 0..3 {
                     let v = proj.triangles[t as usize][c] as usize;
@@ -514,7 +520,7 @@ impl ExactIsoMode {
                     proj.triangles[t as usize][c] = copy[v];
                 }
             }
-            for v in made {
+            for &v in made.iter() {
                 copy[v] = u32::MAX;
             }
             // The region's boundary: its edges used once.
