@@ -8,29 +8,28 @@
 //! compared with:
 //! - the CPU twin of the rasteriser (`gpu::cpu`), which must give the
 //!   GPU's counts exactly (same snapped positions, same top-left rule);
-//! - the number of pieces the reference ray meets: with `--split all` and a
-//!   transfer function without breakpoints every piece is one tet of the
-//!   consistent tetrahedralisation, and the ray caster's `tets` walk
-//!   returns one segment per tet the (tie-broken) ray passes through.
+//! - the number of pieces the reference ray crosses for a positive length,
+//!   from the ray caster's brute force (`raycast::brute`: every tet tested
+//!   on its own, no adjacency): with `--split all` and a transfer function
+//!   without breakpoints every piece is one tet of the consistent
+//!   tetrahedralisation. **Zero mismatches**, in every view.
 //!
-//! Both break ties the same way: the rasteriser by the top-left rule, the
-//! ray caster by moving its ray right, then down, on the image
-//! (`raycast::geometry::tie_basis`), which is the same rule. So on meshes
-//! whose vertices project exactly onto pixel centres (every edge through
-//! centres, faces seen edge-on, all corners on the sub-pixel grid already)
-//! the piece counts equal the ray's tet counts at every centre: zero
-//! mismatches.
+//! Why zero, by construction: a centre far from a piece's projected
+//! outline is inside the snapped piece exactly when it is inside the exact
+//! one; a centre near it (within the snap of 1/256 px) is decided by
+//! `render::ties` with the ray caster's own predicate on the ray caster's
+//! own numbers (the same world-space ray, far point, perturbation and
+//! points), so a centre on a projected edge, a vertex, or a face seen
+//! edge-on goes to the side the ray caster gives it, and a ray that meets
+//! a piece for no length (through a vertex or along an edge) takes no
+//! segment there, as in the brute force.
 //!
-//! In general views the rasteriser draws the corners snapped to its grid of
-//! 1/256 px (each moves by at most 1/512 px in x and y, so an edge by at
-//! most [`SNAP_BAND_PX`]); the ray caster meets the exact tets. A centre
-//! closer than that to a projected edge could fall on the other side of the
-//! snapped edge (measured 0 to 87 such centres per view before
-//! `render::ties`, which decides them with the ray caster's exact rule).
-//! Every mismatch
-//! must lie within [`SNAP_BAND_PX`] of a projected tet edge. Fold counts
-//! include the blocker quads of `render::ties` (a centre a piece's snapped
-//! triangle covers but its exact outline does not).
+//! The adjacency walk (`raycast::walk`, the default traversal) chains each
+//! tet's entry depth to the previous tet's exit, so where the ray passes
+//! through a vertex it reports tets crossed for no length, or for a
+//! rounding error's length, that the brute force (and the renderer) leave
+//! out. Every other segment is the brute force's: checked here, segments
+//! longer than [`NOISE_LEN`] counted per pixel.
 
 mod render_util;
 use render_util::gpu_available;
@@ -43,6 +42,7 @@ use zoovr::image::Image;
 use zoovr::io::{self, ReadOptions};
 use zoovr::mesh::tetra::tetrahedralize_cell;
 use zoovr::mesh::Mesh;
+use zoovr::raycast::brute::Brute;
 use zoovr::raycast::{self, FieldModel, Raycaster};
 use zoovr::render::{
     Compositor, ProjectedOptions, RenderOptions, Renderer, ScalarsRef, Scene, SceneSpec, Shading,
@@ -50,11 +50,10 @@ use zoovr::render::{
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
-/// Centres this close to a projected edge may be on the other side of the
-/// GPU's snapped edge than of the exact one: a snapped corner moves by at
-/// most half a grid step of 1/256 px in x and in y, so every point of an
-/// edge between snapped corners by at most `sqrt(2) / 512` px.
-const SNAP_BAND_PX: f64 = std::f64::consts::SQRT_2 / 512.0;
+/// Segments of the walk and the brute force at most this long relative to
+/// the mesh's size are rounding (a ray through a vertex); longer ones are
+/// the same in both.
+const NOISE_LEN: f64 = 1e-12;
 
 /// Constant extinction and colour: no breakpoint (every tet is one piece)
 /// and no piece skipped for zero extinction.
@@ -91,27 +90,32 @@ fn counts(
         .0
 }
 
-/// The reference ray caster of `scene` (the `tets` walk), built once per
-/// scene for all its views.
-fn reference(scene: &Scene) -> Raycaster<'_> {
+fn ray_scene(scene: &Scene) -> raycast::Scene<'_> {
     let scalars = match scene.scalars() {
         ScalarsRef::Point(v) => raycast::Scalars::Point(v),
         ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
         ScalarsRef::Constant(c) => raycast::Scalars::Constant(c),
     };
-    Raycaster::new(
-        raycast::Scene {
-            mesh: &scene.mesh,
-            topology: &scene.topology,
-            scalars,
-        },
-        FieldModel::Tets,
-    )
-    .unwrap()
+    raycast::Scene {
+        mesh: &scene.mesh,
+        topology: &scene.topology,
+        scalars,
+    }
 }
 
-/// Tets met by each pixel's reference ray ([`reference`]).
-fn reference_counts(rc: &Raycaster, camera: &Camera) -> Vec<usize> {
+/// The reference: the ray caster's brute force over the `tets`, built once
+/// per scene for all its views.
+fn reference(scene: &Scene) -> Brute<'_> {
+    Brute::new(ray_scene(scene), FieldModel::Tets).unwrap()
+}
+
+/// The `tets` walk of `scene`.
+fn walk(scene: &Scene) -> Raycaster<'_> {
+    Raycaster::new(ray_scene(scene), FieldModel::Tets).unwrap()
+}
+
+/// Tets each pixel's reference ray crosses for a positive length.
+fn reference_counts(rc: &Brute, camera: &Camera) -> Vec<usize> {
     let t_near = if camera.ortho { 0.0 } else { camera.near };
     let mut out = Vec::new();
     for j in 0..camera.height {
@@ -120,6 +124,32 @@ fn reference_counts(rc: &Raycaster, camera: &Camera) -> Vec<usize> {
         }
     }
     out
+}
+
+/// The walk gives the brute force's segments but for rounding-length ones
+/// (see the module docs): the counts of segments longer than
+/// [`NOISE_LEN`] times the mesh's diagonal agree at every pixel.
+fn check_walk(scene: &Scene, brute: &Brute, camera: &Camera, tag: &str) {
+    let b = scene.mesh.bounds();
+    let diag = glam::DVec3::new(b[1] - b[0], b[3] - b[2], b[5] - b[4]).length();
+    let t_near = if camera.ortho { 0.0 } else { camera.near };
+    let long = |s: &raycast::Segment| s.t_out - s.t_in > NOISE_LEN * diag;
+    let walk = walk(scene);
+    for j in 0..camera.height {
+        for i in 0..camera.width {
+            let ray = camera.pixel_ray(i, j);
+            let w = walk.segments(&ray, t_near);
+            let r = brute.segments(&ray, t_near);
+            let (nw, nr) = (
+                w.iter().filter(|s| long(s)).count(),
+                r.iter().filter(|s| long(s)).count(),
+            );
+            assert_eq!(
+                nw, nr,
+                "{tag}: pixel ({i}, {j}): walk {w:?}, brute force {r:?}"
+            );
+        }
+    }
 }
 
 /// The tet edges of `mesh` projected into the image of `camera` (both ends
@@ -165,35 +195,21 @@ fn distance_to_edges(edges: &[(glam::DVec2, glam::DVec2)], i: u32, j: u32) -> f6
     best
 }
 
-/// Every centre whose piece count differs from the ray's tet count lies
-/// within `band` px of a projected edge; returns how many differ.
-fn check_mismatches(
-    scene: &Scene,
-    camera: &Camera,
-    pieces: &[usize],
-    want: &[usize],
-    band: f64,
-    tag: &str,
-) -> usize {
-    let mut ties = 0;
-    let mut edges = None;
-    for k in 0..want.len() {
-        if want[k] == pieces[k] {
-            continue;
-        }
+/// Every centre's piece count is the ray's tet count; the first that is
+/// not is reported with its distance to the nearest projected tet edge.
+fn check_counts(scene: &Scene, camera: &Camera, pieces: &[usize], want: &[usize], tag: &str) {
+    let bad: Vec<usize> = (0..want.len()).filter(|&k| want[k] != pieces[k]).collect();
+    if let Some(&k) = bad.first() {
         let (i, j) = (k as u32 % camera.width, k as u32 / camera.width);
-        let edges = edges.get_or_insert_with(|| projected_edges(&scene.mesh, camera));
-        let d = distance_to_edges(edges, i, j);
-        assert!(
-            d <= band,
-            "{tag}: pixel ({i}, {j}) drawn by {} pieces, the ray meets {} tets, \
-             {d:.2e} px from the nearest projected edge",
+        let d = distance_to_edges(&projected_edges(&scene.mesh, camera), i, j);
+        panic!(
+            "{tag}: {} mismatches; first: pixel ({i}, {j}) drawn by {} pieces, the ray \
+             crosses {} tets, {d:.2e} px from the nearest projected edge",
+            bad.len(),
             pieces[k],
             want[k]
         );
-        ties += 1;
     }
-    ties
 }
 
 fn red(img: &Image) -> Vec<usize> {
@@ -284,9 +300,10 @@ fn on_grid_meshes_are_covered_exactly_once() {
         let mut renderer = Renderer::new(scene.geometry());
         let tag = format!("on-grid shear {shear}");
         let (pieces, folds) = check_twin(&mut renderer, &scene.shading(), &camera, gpu, &tag);
-        let want = reference_counts(&reference(&scene), &camera);
-        // No band: a single mismatch fails.
-        check_mismatches(&scene, &camera, &pieces, &want, -1.0, &tag);
+        let brute = reference(&scene);
+        let want = reference_counts(&brute, &camera);
+        check_counts(&scene, &camera, &pieces, &want, &tag);
+        check_walk(&scene, &brute, &camera, &tag);
         assert!(want.iter().any(|&c| c > 0), "{tag}: nothing covered");
         let edges = projected_edges(&scene.mesh, &camera);
         let on_edges = (0..want.len())
@@ -295,14 +312,14 @@ fn on_grid_meshes_are_covered_exactly_once() {
                 distance_to_edges(&edges, i, j) == 0.0
             })
             .count();
-        eprintln!("{tag}: {on_edges} centres on projected edges, all decided alike");
-        assert_eq!(folds, 0, "{tag}: folds on an on-grid mesh");
+        // Folds here are blockers: centres on a vertex the rasteriser
+        // gives to a tet that the ray meets there for no length.
+        eprintln!("{tag}: {on_edges} centres on projected edges, all decided alike, {folds} folds");
     }
 }
 
-/// Real meshes in seeded random views: the GPU counts equal the twin's, and
-/// every centre whose piece count differs from the ray's tet count lies in
-/// the snap band of a projected edge.
+/// Real meshes in seeded random views: the GPU counts equal the twin's and
+/// the ray's tet counts at every centre.
 #[test]
 fn datasets_are_covered_exactly_once_in_random_views() {
     let gpu = gpu_available();
@@ -344,8 +361,9 @@ fn datasets_are_covered_exactly_once_in_random_views() {
             let tag = format!("{} view {view} {params:?}", path.display());
             let (pieces, folds) = check_twin(&mut renderer, &scene.shading(), &camera, gpu, &tag);
             let want = reference_counts(&rc, &camera);
-            let snapped = check_mismatches(&scene, &camera, &pieces, &want, SNAP_BAND_PX, &tag);
-            eprintln!("{tag}: {snapped} snap-band pixels, {folds} fold pixels");
+            check_counts(&scene, &camera, &pieces, &want, &tag);
+            check_walk(&scene, &rc, &camera, &tag);
+            eprintln!("{tag}: all right, {folds} fold pixels");
         }
     }
 }

@@ -240,6 +240,9 @@ impl Clipper {
                 if src.gradients.len() == n {
                     out.gradients.push(src.gradients[i as usize]);
                 }
+                if src.world.len() == n {
+                    out.world.push(src.world[i as usize]);
+                }
             }
             Key::Cut(i, j, lev) => {
                 let l = levels[lev as usize];
@@ -261,6 +264,10 @@ impl Clipper {
                 if src.gradients.len() == n {
                     let (ga, gb) = (src.gradients[a as usize], src.gradients[b as usize]);
                     out.gradients.push(ga + (gb - ga) * mu);
+                }
+                if src.world.len() == n {
+                    let (wa, wb) = (src.world[a as usize], src.world[b as usize]);
+                    out.world.push(wa + (wb - wa) * mu);
                 }
             }
         }
@@ -304,11 +311,18 @@ mod tests {
             .expect("hull")
             .faces;
         let scalars = pts.iter().map(|p| p.x + 0.3 * p.y * p.z).collect();
+        // World positions: the view ones moved, so that the clip's
+        // interpolation of them is checked too.
+        let world = pts
+            .iter()
+            .map(|p| *p + DVec3::new(10.0, -3.0, 0.5))
+            .collect();
         let mut poly = Polyhedron {
             points: pts,
             scalars,
             triangles: tris,
             gradients: Vec::new(),
+            world,
         };
         poly.orient_outward();
         poly

@@ -36,6 +36,15 @@ pub struct Polyhedron {
     /// source fills it (builders leave it empty; [`super::Clipper`]
     /// interpolates it at the points it cuts, like the scalar).
     pub gradients: Vec<DVec3>,
+    /// World-space position per point, when the piece's source has them
+    /// (empty otherwise): the exact pixel-centre decisions of
+    /// [`crate::render::ties`] are taken on these, the very numbers the
+    /// reference ray caster decides on, so that both give a centre on a
+    /// shared edge or an edge-on face to the same side. [`Self::set_cell`]
+    /// fills them; [`super::Clipper`] interpolates them at the points it
+    /// cuts, with the same canonical edge order and weight as the view
+    /// position.
+    pub world: Vec<DVec3>,
 }
 
 impl Polyhedron {
@@ -45,12 +54,22 @@ impl Polyhedron {
         self.scalars.clear();
         self.triangles.clear();
         self.gradients.clear();
+        self.world.clear();
     }
 
     /// A tetrahedron from view-space corners (either orientation).
     pub fn from_tet(points: [DVec3; 4], scalars: [f64; 4]) -> Polyhedron {
         let mut p = Polyhedron::default();
         p.set_tet(points, scalars);
+        p
+    }
+
+    /// A tetrahedron from world-space corners, seen by `camera` (either
+    /// orientation): view positions by [`Camera::to_view`], and
+    /// [`Self::world`] kept.
+    pub fn from_world_tet(world: [DVec3; 4], scalars: [f64; 4], camera: &Camera) -> Polyhedron {
+        let mut p = Polyhedron::from_tet(world.map(|w| camera.to_view(w)), scalars);
+        p.world.extend_from_slice(&world);
         p
     }
 
@@ -97,6 +116,7 @@ impl Polyhedron {
                 .get(n as usize)
                 .ok_or(ProjectionError::IndexOutOfRange(n))?;
             self.points.push(camera.to_view(*w));
+            self.world.push(*w);
             self.scalars.push(scalar(n));
         }
         let mut bad = None;

@@ -280,8 +280,7 @@ impl<'a> Brute<'a> {
             lo = DVec3::ZERO;
             hi = DVec3::ZERO;
         }
-        let center = (lo + hi) * 0.5;
-        let radius = (hi - lo).length() * 0.5;
+        let (center, radius) = super::geometry::bounding_sphere(lo, hi);
         let mut ids = Vec::with_capacity(cells.len());
         let mut boxes = Vec::with_capacity(cells.len());
         let mut dboxes = Vec::with_capacity(cells.len());

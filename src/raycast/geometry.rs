@@ -71,6 +71,18 @@ pub fn tie_basis(ray: &Ray) -> (DVec3, DVec3) {
     (u, d.cross(u))
 }
 
+/// The sphere `(center, radius)` around the box `lo..hi` that every
+/// [`RayFrame`] of the reference ray caster is built with (its far point
+/// lies beyond it). One function, so that everything deciding on pixel
+/// rays (the walk, the brute-force traversal, the projected modes' exact
+/// pixel-centre decisions) frames the same line, bit for bit.
+pub fn bounding_sphere(lo: DVec3, hi: DVec3) -> (DVec3, f64) {
+    if !(lo.is_finite() && hi.is_finite()) || lo.cmpgt(hi).any() {
+        return (DVec3::ZERO, 0.0);
+    }
+    ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+}
+
 /// One ray with its frame and symbolic perturbation.
 #[derive(Clone, Copy, Debug)]
 pub struct RayFrame {

@@ -113,8 +113,7 @@ impl<'a> WalkMesh<'a> {
             lo = DVec3::ZERO;
             hi = DVec3::ZERO;
         }
-        let center = (lo + hi) * 0.5;
-        let radius = (hi - lo).length() * 0.5;
+        let (center, radius) = super::geometry::bounding_sphere(lo, hi);
         let mut boundary = Vec::new();
         let mut orient_cache: Vec<(u32, i8)> = Vec::new();
         for f in 0..topo.face_count() {

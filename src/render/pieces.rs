@@ -138,6 +138,7 @@ impl PieceSource<'_> {
             Piece::Tet { tet, .. } => {
                 let (p, s) = self.tet_view(cell, tet);
                 poly.set_tet(p, s);
+                poly.world.extend_from_slice(&self.tet_world(tet));
                 Ok(())
             }
             Piece::Slab { tet, lo, hi, .. } => {
@@ -145,6 +146,7 @@ impl PieceSource<'_> {
                 let mut clipper = Clipper::default();
                 let (p, s) = self.tet_view(cell, tet);
                 whole.set_tet(p, s);
+                whole.world.extend_from_slice(&self.tet_world(tet));
                 if !self.clip_band(cell, lo, hi, &mut clipper, &whole, poly)? {
                     poly.clear();
                 }
@@ -193,6 +195,7 @@ impl PieceSource<'_> {
                 // A tet holding a breakpoint comes as its slabs
                 // (`Piece::Slab`): the TF is linear on this one.
                 poly.set_tet(p, s);
+                poly.world.extend_from_slice(&self.tet_world(tet));
                 self.point_gradients(tet.into_iter(), poly);
                 draw(poly)?;
             }
@@ -244,6 +247,7 @@ impl PieceSource<'_> {
                 if *whole_of != Some((cell, tet)) {
                     let (p, s) = self.tet_view(cell, tet);
                     whole.set_tet(p, s);
+                    whole.world.extend_from_slice(&self.tet_world(tet));
                     // The slab's cut points get them by interpolation
                     // (smooth isosurface light on the slices).
                     self.point_gradients(tet.into_iter(), whole);
@@ -349,10 +353,16 @@ impl PieceSource<'_> {
         let (p, s) = self.tet_view(cell, tet);
         poly.clear();
         poly.points = f.positions(&p);
+        poly.world = f.positions(&self.tet_world(tet));
         poly.scalars = f.values(&s);
         poly.triangles.extend_from_slice(&f.triangles);
         poly.orient_outward();
         Ok(())
+    }
+
+    /// World-space corners of a tet ([`Polyhedron::world`]).
+    fn tet_world(&self, tet: [u32; 4]) -> [DVec3; 4] {
+        tet.map(|n| self.mesh.points[n as usize])
     }
 
     /// View-space corners and scalars of a tet of cell `cell`.

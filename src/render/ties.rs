@@ -15,9 +15,10 @@
 //! decided twice:
 //!
 //! - **exactly, in 3D, by the ray caster's rule**
-//!   ([`crate::raycast::geometry`]): the pixel ray, a line through two
-//!   `f64` points in camera-relative coordinates, crosses the convex part
-//!   when it crosses two of its boundary triangles. Each crossing is
+//!   ([`crate::raycast::geometry`]): the pixel ray, the ray caster's line
+//!   through two `f64` points in world space ([`TieRays`]), crosses the
+//!   convex part when it crosses two of its boundary triangles, taken on
+//!   the part's world-space points ([`Polyhedron::world`]). Each crossing is
 //!   decided by the exact signs of the Plücker products of the line with
 //!   the triangles' edges, with the same symbolic perturbation of the ray
 //!   (right, then down on the image: the top-left rule) and every edge
@@ -54,10 +55,10 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::camera::{Camera, Ray};
+use crate::camera::Camera;
 use crate::gpu::SUBPIXEL;
-use crate::projection::{Polyhedron, Projected, RegionVertex, ViewMap};
-use crate::raycast::geometry::{Proj, RayFrame};
+use crate::projection::{Polyhedron, Projected, RegionVertex};
+use crate::raycast::geometry::{bounding_sphere, Proj, RayFrame};
 
 /// Centres within this distance (pixels) of an outline edge are decided
 /// exactly: the largest move of a snapped corner is `sqrt(2)/512` = 2.8e-3
@@ -104,70 +105,55 @@ pub fn covers_grid(g: [[i64; 2]; 3], q: [i64; 2]) -> bool {
     true
 }
 
-/// The pixel rays of one frame in the parts' coordinates, for the exact
-/// decisions.
+/// The pixel rays of one frame, for the exact decisions: the reference
+/// ray caster's rays, bit for bit.
 ///
-/// Parts are in view space (x right, y up, z depth, [`Camera::to_view`]).
-/// The rays are taken in the same space with y negated (exactly), so that
-/// the ray caster's perturbation basis ([`crate::raycast::geometry::tie_basis`]:
-/// `u` the image's right, `v = d x u`) points right and down on the image,
-/// as it does for the ray caster's world-space rays.
-#[derive(Clone, Copy, Debug)]
+/// Each is [`Camera::ray_at`] of the pixel position, framed
+/// ([`RayFrame::new`]) with the bounding sphere the ray caster's walk uses
+/// ([`crate::raycast::geometry::bounding_sphere`] of the mesh bounds), and
+/// tested against the parts' world-space points ([`Polyhedron::world`]),
+/// which are the mesh's points bit for bit where a part's corner is a mesh
+/// point. So the exact predicates get the ray caster's very inputs and give
+/// its answers, also where a centre lies on a projected edge or an edge-on
+/// face only up to rounding: a decision on view-space positions, rounded
+/// differently, could give such a centre to the other side.
+#[derive(Clone, Debug)]
 pub struct TieRays {
-    view: ViewMap,
-    /// Bounding sphere of every part (the mesh, in the flipped view space):
-    /// the same for every part, so every part sees the same line.
+    camera: Camera,
+    /// The ray caster's bounding sphere of the mesh: the same for every
+    /// part, so every part sees the same line.
     center: DVec3,
     radius: f64,
 }
 
 impl TieRays {
-    /// The rays of `camera` for parts within the mesh bounds `bounds`.
+    /// The rays of `camera` for parts within the mesh bounds `bounds`
+    /// ([`crate::mesh::Mesh::bounds`]).
     pub fn new(camera: &Camera, bounds: [f64; 6]) -> TieRays {
         let lo = DVec3::new(bounds[0], bounds[2], bounds[4]);
         let hi = DVec3::new(bounds[1], bounds[3], bounds[5]);
-        let (center, radius) = if lo.is_finite() && hi.is_finite() {
-            let c = camera.to_view((lo + hi) * 0.5);
-            // A margin over the half diagonal for the rounding of view
-            // coordinates and near-plane clipping.
-            (flip(c), (hi - lo).length() * 0.5 * 1.01 + 1.0)
-        } else {
-            (DVec3::ZERO, 1.0)
-        };
+        let (center, radius) = bounding_sphere(lo, hi);
         TieRays {
-            view: ViewMap::of(camera),
+            camera: *camera,
             center,
             radius,
         }
     }
 
-    /// The ray through pixel position `c` and the `z` component of its
-    /// unit direction (depth per unit of length).
+    /// The ray through pixel position `c` and its depth per unit of
+    /// length.
     fn frame(&self, c: DVec2) -> (RayFrame, f64) {
-        let u = self.view.plane(c);
-        let (origin, dir) = if self.view.ortho {
-            (DVec3::new(u.x, -u.y, 0.0), DVec3::Z)
-        } else {
-            (DVec3::ZERO, DVec3::new(u.x, -u.y, 1.0).normalize())
-        };
-        let ray = Ray {
-            origin,
-            dir,
-            right: DVec3::X,
-        };
-        (RayFrame::new(&ray, self.center, self.radius), dir.z)
+        let ray = self.camera.ray_at(c.x, c.y);
+        let dz = ray.dir.dot(self.camera.forward);
+        (RayFrame::new(&ray, self.center, self.radius), dz)
     }
-}
-
-#[inline]
-fn flip(p: DVec3) -> DVec3 {
-    DVec3::new(p.x, -p.y, p.z)
 }
 
 /// What the exact test says of one ray and one part.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RayThrough {
-    /// The ray misses the part.
+    /// The ray misses the part, or meets it for no length (in a point or
+    /// along an edge).
     Misses,
     /// The ray crosses the part: the segment's values at pixel position
     /// `c` (the region vertex the ray caster's numbers give), and the
@@ -186,18 +172,19 @@ pub fn ray_through(
     c: DVec2,
     proj: &mut Vec<Proj>,
 ) -> RayThrough {
+    if part.world.len() != part.points.len() {
+        // No world positions: nothing to decide on (every part source of
+        // the driver gives them).
+        return RayThrough::Undecided;
+    }
     let (frame, dz) = rays.frame(c);
     proj.clear();
-    proj.extend(part.points.iter().map(|&p| frame.project(flip(p))));
+    proj.extend(part.world.iter().map(|&p| frame.project(p)));
     let mut hits = [(0.0, 0.0, 0u32); 2];
     let mut n = 0;
     for (k, t) in part.triangles.iter().enumerate() {
         let [a, b, c] = t.map(|i| i as usize);
-        let (pa, pb, pc) = (
-            flip(part.points[a]),
-            flip(part.points[b]),
-            flip(part.points[c]),
-        );
+        let (pa, pb, pc) = (part.world[a], part.world[b], part.world[c]);
         let e = [
             frame.edge_by_position(pa, &proj[a], pb, &proj[b]),
             frame.edge_by_position(pb, &proj[b], pc, &proj[c]),
@@ -214,6 +201,13 @@ pub fn ray_through(
     }
     match n {
         0 => RayThrough::Misses,
+        // The line meets the part in a point or along an edge only (the
+        // perturbed line crosses it for no length): no segment, as in the
+        // ray caster's brute force, which keeps segments of positive
+        // length only. The same crossings give the same depths in the
+        // walk and the brute force, so all three agree on which segments
+        // have a length.
+        2 if hits[0].0 == hits[1].0 => RayThrough::Misses,
         2 => {
             let [(t0, s0, k0), (t1, s1, k1)] = hits;
             let ((ti, si, ki), (to, so, ko)) = if t0 <= t1 {
@@ -432,6 +426,14 @@ pub fn decide_ties(
         let q = [i as i64 * sub + sub / 2, j as i64 * sub + sub / 2];
         let grid_in = part.drawn.iter().any(|(_, g)| covers_grid(*g, q));
         let seam = || forced.binary_search(&(i, j)).is_ok();
+        if std::env::var("TIE_PIX").ok().as_deref() == Some(&format!("{i},{j}")) {
+            eprintln!(
+                "TIE {i},{j}: {:?} grid_in {grid_in} npts {} ntris {}",
+                ray_through(poly, rays, c, &mut scratch.proj),
+                poly.points.len(),
+                poly.triangles.len()
+            );
+        }
         let (value, faces) = match (ray_through(poly, rays, c, &mut scratch.proj), grid_in) {
             (RayThrough::Crosses(v, f), false) => (Some(v), f),
             (RayThrough::Crosses(v, f), true) if seam() => (Some(v), f),
@@ -536,10 +538,11 @@ fn ceil_i(x: f64) -> i64 {
 mod tests {
     use super::*;
     use crate::camera::CameraParams;
+    use crate::projection::ViewMap;
 
-    /// An orthographic 16 x 16 camera and its rays, and the view-space
-    /// point at pixel position `(px, py)` and depth `z`.
-    fn setup(ortho: bool) -> (TieRays, impl Fn(f64, f64, f64) -> DVec3) {
+    /// A 16 x 16 camera, its rays, and the world-space point at pixel
+    /// position `(px, py)` and depth `z`.
+    fn setup(ortho: bool) -> (TieRays, Camera, impl Fn(f64, f64, f64) -> DVec3) {
         let camera = Camera::fit(
             [-1.0, 1.0, -1.0, 1.0, -1.0, 1.0],
             &CameraParams {
@@ -551,19 +554,21 @@ mod tests {
         );
         let view = ViewMap::of(&camera);
         let rays = TieRays::new(&camera, [-1.0, 1.0, -1.0, 1.0, -1.0, 1.0]);
+        let c = camera;
         let at = move |px: f64, py: f64, z: f64| {
             let u = view.plane(DVec2::new(px, py));
-            if view.ortho {
+            let v = if view.ortho {
                 DVec3::new(u.x, u.y, z)
             } else {
                 DVec3::new(u.x * z, u.y * z, z)
-            }
+            };
+            c.position + c.right * v.x + c.up * v.y + c.forward * v.z
         };
-        (rays, at)
+        (rays, camera, at)
     }
 
-    fn tet(p: [DVec3; 4]) -> Polyhedron {
-        Polyhedron::from_tet(p, [0.0, 1.0, 2.0, 3.0])
+    fn tet(camera: &Camera, p: [DVec3; 4]) -> Polyhedron {
+        Polyhedron::from_world_tet(p, [0.0, 1.0, 2.0, 3.0], camera)
     }
 
     fn length(r: RayThrough) -> f64 {
@@ -578,17 +583,19 @@ mod tests {
     /// length and scalars; one beside it misses.
     #[test]
     fn inside_and_outside() {
-        let (rays, at) = setup(true);
-        let camera_depth = at(0.0, 0.0, 0.0).z;
-        let z0 = camera_depth + 4.0;
+        let (rays, camera, at) = setup(true);
+        let z0 = 4.0;
         // A tet whose face at depth z0 covers pixels (2..10, 2..10) and
         // whose apex is behind (4, 4).
-        let p = tet([
-            at(2.0, 2.0, z0),
-            at(10.0, 2.0, z0),
-            at(2.0, 10.0, z0),
-            at(4.0, 4.0, z0 + 1.0),
-        ]);
+        let p = tet(
+            &camera,
+            [
+                at(2.0, 2.0, z0),
+                at(10.0, 2.0, z0),
+                at(2.0, 10.0, z0),
+                at(4.0, 4.0, z0 + 1.0),
+            ],
+        );
         let mut scratch = Vec::new();
         let r = ray_through(&p, &rays, DVec2::new(4.0, 4.0), &mut scratch);
         assert!((length(r) - 1.0).abs() < 1e-12, "{r:?}");
@@ -608,8 +615,8 @@ mod tests {
     #[test]
     fn a_centre_on_shared_edges_is_given_to_one_part() {
         for ortho in [true, false] {
-            let (rays, at) = setup(ortho);
-            let z0 = at(0.0, 0.0, 0.0).z + 5.0;
+            let (rays, camera, at) = setup(ortho);
+            let z0 = 5.0;
             // Four triangular prisms around the centre (8.5, 8.5), each cut
             // into 3 tets with the consistent smallest-vertex rule; the
             // prisms' corners sit on pixel centres, so their side faces are
@@ -621,9 +628,9 @@ mod tests {
                 let (a, b) = (ring[k], ring[(k + 1) % 4]);
                 let bottom = [c, a, b].map(|q| at(q.0, q.1, z0));
                 let top = [c, a, b].map(|q| at(q.0, q.1, z0 + 1.0));
-                parts.push(tet([bottom[0], bottom[1], bottom[2], top[0]]));
-                parts.push(tet([bottom[1], bottom[2], top[0], top[1]]));
-                parts.push(tet([bottom[2], top[0], top[1], top[2]]));
+                parts.push(tet(&camera, [bottom[0], bottom[1], bottom[2], top[0]]));
+                parts.push(tet(&camera, [bottom[1], bottom[2], top[0], top[1]]));
+                parts.push(tet(&camera, [bottom[2], top[0], top[1], top[2]]));
             }
             let mut scratch = Vec::new();
             for j in 0..16 {
@@ -638,11 +645,10 @@ mod tests {
                     }
                     // The ray's length per unit of depth (1 orthographic).
                     let want = if inside {
-                        let d = at(q.x, q.y, 1.0);
                         if ortho {
                             1.0
                         } else {
-                            d.length()
+                            (at(q.x, q.y, 1.0) - camera.position).length()
                         }
                     } else {
                         0.0
@@ -654,7 +660,7 @@ mod tests {
                     // Inside, on the shared edges and faces, the layers
                     // still add up exactly.
                     let outline = [4.5, 12.5].contains(&q.x) || [4.5, 12.5].contains(&q.y);
-                    let d = at(q.x, q.y, 1.0).length();
+                    let d = (at(q.x, q.y, 1.0) - camera.position).length();
                     let ok = (sum - want).abs() < 1e-9
                         || (!ortho && outline && (0.0..=d + 1e-9).contains(&sum));
                     assert!(ok, "{ortho} {i} {j} {sum} {want}");
