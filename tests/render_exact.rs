@@ -46,10 +46,6 @@ const MODEL_DIFF: (f64, f64) = (0.1, 4e-2);
 /// the exact mode integrates both where the ray caster's walk follows one
 /// layer) and 24,569 nonplanar faces. Measured 0.136 (both comparisons).
 const CAN_CRUSH: (f64, f64) = (0.15, 4e-3);
-/// Still above 2/255 with the same field (split vs tets), cause not yet
-/// established: PentaHexa 1.11e-2 (perspective), AngularSector 8.6e-3
-/// (orthographic, kinked TF).
-const OPEN_GAP: (f64, f64) = (1.2e-2, RMS);
 
 /// A TF over `range` whose extinction has kinks at 30 %, 50 % and 70 % of
 /// the range and whose colour varies.
@@ -269,10 +265,11 @@ fn shared_datasets() {
         let Some(path) = shared_file(rel) else {
             continue;
         };
+        // PentaHexa and AngularSector were up to 1.11e-2 before the pixel
+        // centres next to outlines and inside slivers were decided on the
+        // ray caster's own numbers (src/render/ties.rs); now within 2.9e-3.
         let whole = if rel.starts_with("can_crush") {
             CAN_CRUSH
-        } else if rel.starts_with("prisms_zoo") || rel.starts_with("angular_sector") {
-            OPEN_GAP
         } else {
             (MAX, RMS)
         };

@@ -29,8 +29,14 @@ use zoovr::tf::{EmissionModel, TransferFunction};
 /// other scene within 5.75e-3; pixel centres next to outlines are decided
 /// by the ray caster's exact rule (src/render/ties.rs).
 const SPLIT_MAX: f64 = 1e-2;
-/// The tau_1e3 scene's snap shift (see where it is used).
-const SNAP_SHIFT_MAX: f64 = 4e-2;
+/// The tau_1e3 scene (optically thick cells seen nearly edge-on) in the
+/// exact-frag mode: measured 3.2e-2, both views, split and whole. The
+/// exact mode was at 3.5e-2 here from the snap of sliver corners, and is
+/// at 3.4e-3 since `render::ties` decides sliver centres exactly; the
+/// exact-frag mode takes the same decisions and stays at 3.2e-2, so its
+/// cause is elsewhere (its `f32` closed-form integral at optical depths
+/// of hundreds is the suspect) and not yet established.
+const FRAG_TAU_1E3_MAX: f64 = 4e-2;
 const P999: f64 = 1e-2;
 const RMS: f64 = 2e-3;
 /// exact-frag whole cells against `faces`: cells with nonplanar faces are
@@ -150,18 +156,6 @@ fn run(case: Case, gpu: bool) {
         }
         let b = if case.gap.is_some() {
             loose
-        } else if case.name == "tau_1e3" {
-            // Optically thick cells seen nearly edge-on: inside sliver
-            // regions narrower than a pixel, the corners' snap to the
-            // rasteriser's 1/256-px grid shifts the interpolated thickness
-            // (measured 3.5e-2 exact, 3.2e-2 exact-frag; outline centres
-            // are decided exactly by src/render/ties.rs, interior sliver
-            // centres not yet).
-            Bounds {
-                max_abs: SNAP_SHIFT_MAX,
-                p999: P999,
-                rms: RMS,
-            }
         } else {
             Bounds {
                 max_abs: SPLIT_MAX,
@@ -219,10 +213,17 @@ fn run(case: Case, gpu: bool) {
         // except in cells with nonplanar faces, which the order draws as
         // tets (model difference measured up to 4.86e-2 on the warped
         // grids, the same as the exact mode's there).
-        // Those cells up to OUTLIER_MAX; tau_1e3 at its split bound (the
-        // snap shift inside slivers, measured 3.2e-2).
-        let frag_whole = if case.gap.is_some() || case.name == "tau_1e3" {
+        // Those cells up to OUTLIER_MAX; tau_1e3 at FRAG_TAU_1E3_MAX.
+        let frag_tau = Bounds {
+            max_abs: FRAG_TAU_1E3_MAX,
+            p999: P999,
+            rms: RMS,
+        };
+        let frag_split = if case.name == "tau_1e3" { frag_tau } else { b };
+        let frag_whole = if case.gap.is_some() {
             b
+        } else if case.name == "tau_1e3" {
+            frag_tau
         } else {
             Bounds {
                 max_abs: OUTLIER_MAX,
@@ -241,7 +242,7 @@ fn run(case: Case, gpu: bool) {
                 &format!("stress_{}_{vi}_frag_{split_all}", case.name),
                 &got,
                 reference,
-                if split_all { &b } else { &frag_whole },
+                if split_all { &frag_split } else { &frag_whole },
             )
             .unwrap_or_else(|e| panic!("{e}"));
             eprintln!(
