@@ -12,13 +12,13 @@
 //! without the shared data.
 
 mod render_util;
-use render_util::{gpu_available, options};
+use render_util::{gpu_available, max_outside, options, split_cells, split_mask};
 
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use zoovr::camera::CameraParams;
+use zoovr::camera::{Camera, CameraParams};
 use zoovr::image::{check_images_with, Bounds, Image};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
@@ -67,6 +67,19 @@ fn kinked_tf(range: (f64, f64), unit: f64) -> TransferFunction {
     TransferFunction::from_channels(&tau, &col, None, EmissionModel::Glow).unwrap()
 }
 
+/// The view every comparison here is made in.
+fn view(ortho: bool) -> CameraParams {
+    CameraParams {
+        width: 256,
+        height: 256,
+        azimuth: 20.0,
+        elevation: 35.0,
+        zoom: 1.25,
+        ortho,
+        ..Default::default()
+    }
+}
+
 /// Renders `scene` with `renderer` (made from its geometry, so a GPU
 /// device is opened once per scene).
 fn render(
@@ -78,15 +91,7 @@ fn render(
     ortho: bool,
 ) -> Image {
     let opts = RenderOptions {
-        camera: CameraParams {
-            width: 256,
-            height: 256,
-            azimuth: 20.0,
-            elevation: 35.0,
-            zoom: 1.25,
-            ortho,
-            ..Default::default()
-        },
+        camera: view(ortho),
         ..options(mode, split_all, model)
     };
     let (img, _) = renderer.render(&scene.shading(), &opts, |_, _| {}).unwrap();
@@ -168,7 +173,23 @@ fn check_mode(
                 FieldModel::Faces
             };
             let faces = reference(&key, &scene, reference_model, ortho);
-            let (m, r) = if slices && kinked && !single_cell {
+            let model_diff = slices && kinked && !single_cell;
+            if model_diff {
+                // The model difference only where the rays meet a split
+                // cell: elsewhere the whole-cell bound holds.
+                let split = split_cells(&renderer, scene.mesh.cells.len());
+                let camera = Camera::fit(scene.mesh.bounds(), &view(ortho));
+                let mask = split_mask(&scene, &camera, &split);
+                let (d, at) = max_outside(&exact, faces.as_ref(), &mask);
+                let n = mask.iter().filter(|&&m| m).count();
+                eprintln!("{tag} whole vs faces outside the {n} pixels of split cells: max {d:.2e} at {at:?}");
+                assert!(
+                    d <= whole_bounds.0,
+                    "{tag}: whole vs faces outside split cells: {d:.3e} at {at:?} (bound {:.1e})",
+                    whole_bounds.0
+                );
+            }
+            let (m, r) = if model_diff {
                 (
                     MODEL_DIFF.0.max(whole_bounds.0),
                     MODEL_DIFF.1.max(whole_bounds.1),

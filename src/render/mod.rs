@@ -203,6 +203,13 @@ impl Renderer {
             .get_or_insert_with(|| Sorter::new(g.mesh.clone(), g.topology.clone()))
     }
 
+    /// The visibility order the last projected-cell render drew (kept for
+    /// the next render of the same view), e.g. to see which cells it drew
+    /// as tets ([`crate::visibility::Piece`]).
+    pub fn last_order(&self) -> Option<&std::sync::Arc<crate::visibility::Order>> {
+        self.orders.last()
+    }
+
     /// Renders one image of `shading` with the camera of `opts.camera`
     /// (fitted to the mesh bounds, docs/conventions.md Conventions).
     pub fn render(

@@ -55,6 +55,11 @@ impl OrderCache {
         self.last = None;
     }
 
+    /// The last order made or reused, if any.
+    pub fn last(&self) -> Option<&Arc<Order>> {
+        self.last.as_ref().map(|(_, o)| o)
+    }
+
     /// The order of `sorter` for `camera` and `policy`: the last one when
     /// its key is equal (`true`), else a new sort (`false`), kept for next
     /// time.

@@ -35,3 +35,77 @@ pub fn options(mode: Mode, split_all: bool, model: FieldModel) -> RenderOptions 
         ..Default::default()
     }
 }
+
+/// Which cells the last projected-cell render of `renderer` drew as tets
+/// (split for a breakpoint, a problem face, a cycle or `--split all`), of
+/// `cells` cells.
+pub fn split_cells(renderer: &zoovr::render::Renderer, cells: usize) -> Vec<bool> {
+    use zoovr::visibility::Piece;
+    let order = renderer.last_order().expect("a projected render before");
+    let mut split = vec![false; cells];
+    for p in &order.pieces {
+        match *p {
+            Piece::Cell(_) => {}
+            Piece::Tet { cell, .. } | Piece::Slab { cell, .. } | Piece::Frag { cell, .. } => {
+                split[cell as usize] = true
+            }
+        }
+    }
+    split
+}
+
+/// The pixels of `camera` whose ray (the ray caster's `faces` walk) meets
+/// a cell marked in `split`: where a whole-cell render integrates the
+/// `tets` field instead of `faces` (a model difference).
+pub fn split_mask(
+    scene: &zoovr::render::Scene,
+    camera: &zoovr::camera::Camera,
+    split: &[bool],
+) -> Vec<bool> {
+    use zoovr::raycast::{self, Raycaster};
+    use zoovr::render::ScalarsRef;
+    let scalars = match scene.scalars() {
+        ScalarsRef::Point(v) => raycast::Scalars::Point(v),
+        ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
+        ScalarsRef::Constant(c) => raycast::Scalars::Constant(c),
+    };
+    let rc = Raycaster::new(
+        raycast::Scene {
+            mesh: &scene.mesh,
+            topology: &scene.topology,
+            scalars,
+        },
+        FieldModel::Faces,
+    )
+    .unwrap();
+    let t_near = if camera.ortho { 0.0 } else { camera.near };
+    let mut mask = Vec::with_capacity((camera.width * camera.height) as usize);
+    for j in 0..camera.height {
+        for i in 0..camera.width {
+            let segs = rc.segments(&camera.pixel_ray(i, j), t_near);
+            mask.push(segs.iter().any(|s| split[s.cell as usize]));
+        }
+    }
+    mask
+}
+
+/// The largest display difference (PNG values, every channel) between two
+/// images over the pixels not in `mask`, and the pixel where it is.
+pub fn max_outside(
+    actual: &zoovr::image::Image,
+    expected: &zoovr::image::Image,
+    mask: &[bool],
+) -> (f64, (u32, u32)) {
+    let (_, diff) = zoovr::image::compare_display(actual, expected, [0.0; 3]).unwrap();
+    let mut worst = (0.0, (0, 0));
+    for (k, p) in diff.pixels.iter().enumerate() {
+        if mask[k] {
+            continue;
+        }
+        let d = p.iter().take(3).fold(0.0f64, |m, &v| m.max(v as f64));
+        if d > worst.0 {
+            worst = (d, (k as u32 % diff.width, k as u32 / diff.width));
+        }
+    }
+    worst
+}
