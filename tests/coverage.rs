@@ -367,3 +367,71 @@ fn datasets_are_covered_exactly_once_in_random_views() {
         }
     }
 }
+
+/// Colour refinement (`--refine-tol`) splits region triangles inside a
+/// part at edge midpoints, conforming (`projection::refine`: the split is
+/// decided per edge, so both triangles on an edge take the same midpoint,
+/// no T-junction; a silhouette edge, zero thickness along it, is not
+/// split, and the exact decisions of `render::ties` hold the outline's
+/// centres anyway). So refinement changes no centre's coverage: the piece
+/// counts are the same at the default tolerance and at a fine one, which
+/// refines several times more triangles.
+#[test]
+fn refinement_changes_no_coverage() {
+    let mut files = vec![mesh_file("zoo_3x3x3.vtu"), mesh_file("ring_hole.vtu")];
+    for rel in [
+        "prisms_zoo/PentaHexa.vtk",
+        "angular_sector/AngularSector.vtk",
+        "bluntfin/bluntfin_converted.vts",
+    ] {
+        files.extend(shared_file(rel));
+    }
+    for path in files {
+        let mesh = io::read(&path, &ReadOptions::default()).unwrap();
+        let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        let mut renderer = Renderer::new(scene.geometry());
+        for (view, ortho) in [(0, false), (1, true)] {
+            let params = CameraParams {
+                width: 72,
+                height: 64,
+                azimuth: 30.0 + 50.0 * view as f64,
+                elevation: 25.0 - 40.0 * view as f64,
+                zoom: 1.3,
+                ortho,
+                ..Default::default()
+            };
+            let camera = Camera::fit(scene.mesh.bounds(), &params);
+            let mut refined = Vec::new();
+            let tag = format!("{} view {view}", path.display());
+            let mut first = None;
+            for tol in [zoovr::numeric::tolerance::COLOR_REFINE_TOL, 1e-3] {
+                let opts = RenderOptions {
+                    projected: ProjectedOptions {
+                        split_all: true,
+                        draw: DrawKind::CountPieces,
+                        compositor: Compositor::Cpu,
+                        refine_tol: tol,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                };
+                let (img, stats) = renderer
+                    .render_with_camera(&scene.shading(), &opts, &camera, |_, _| {})
+                    .unwrap();
+                refined.push(stats.projected().unwrap().refined_triangles);
+                let counts = red(&img);
+                let first = first.get_or_insert_with(|| counts.clone());
+                let bad = (0..counts.len()).find(|&p| counts[p] != first[p]);
+                assert!(
+                    bad.is_none(),
+                    "{tag}: piece count at pixel {:?} is {} unrefined, {} at tolerance {tol}",
+                    bad.map(|p| (p as u32 % camera.width, p as u32 / camera.width)),
+                    bad.map_or(0, |p| first[p]),
+                    bad.map_or(0, |p| counts[p]),
+                );
+            }
+            eprintln!("{tag}: refined triangles {refined:?}, counts unchanged");
+            assert!(refined[1] > refined[0], "{tag}: {refined:?}");
+        }
+    }
+}
