@@ -72,9 +72,11 @@ pub struct ViewArgs {
     /// `brute` ignores adjacency: it tests every cell whose bounding box the
     /// ray meets (a bounding volume hierarchy), whole (`--model faces`) or
     /// as its consistent tets (`--model tets`), with the walk's exact
-    /// crossing test, and composites all their segments in depth order;
-    /// where pieces overlap, their extinctions add. On a conforming mesh both give the
-    /// same image (to rounding); brute force is slower and is the
+    /// crossing test, and composites all their segments of positive
+    /// length in depth order; where pieces overlap, their extinctions add.
+    /// On a conforming mesh both give the same image (to rounding: the walk
+    /// may also report pieces a ray meets in a vertex or along an edge,
+    /// for no length); brute force is slower and is the
     /// reference where adjacency cannot be trusted: non-conforming faces
     /// that only partly overlap (faults in corner-point grids, hanging
     /// nodes), overlapping or duplicated cells, duplicated points. Both
