@@ -18,22 +18,10 @@ use zoovr::render::{
 };
 use zoovr::testdata::{mesh_file, shared_file};
 
-/// Bound over every pixel (PNG values): 2/255. The seeded cases reach
-/// 6.6e-3 (CylinderLinear); tetraMesh's 8.9e-3 went with the exact
-/// decisions on the ray caster's own numbers (`src/render/ties.rs`).
+/// Bound over every pixel (PNG values): 2/255, every case. The seeded
+/// cases reach 6.6e-3 (CylinderLinear); tetraMesh's 8.9e-3 went with the
+/// exact decisions on the ray caster's own numbers (`src/render/ties.rs`).
 const MAX: f64 = 2.0 / 255.0;
-/// PentaHexa: its prisms share an axis through the mesh's centre, which
-/// projects onto the image's centre column in every view from above or
-/// below the equator (a line of projected vertices through pixel centres
-/// when the width is odd). Pixels on that column reach 2.37e-2 (case 13,
-/// perspective; 2.7e-2 at 157x145 orthographic, azimuth 149.04, elevation
-/// 27.39, zoom 1.15, pixel (78, 30)): the region triangle that holds the
-/// centre has an edge on the axis's image, and its corners' thickness
-/// (0.70 and 0.71, in the payload's units) is not the exact thickness at
-/// the centre between them (0.63): a vertex of the arrangement on that
-/// line is missing from the part's regions. Open; the exact-frag mode gets
-/// the pixel right (its sliver decision takes the exact segment there).
-const PENTA_HEXA_AXIS: f64 = 2.5e-2;
 
 fn crop(img: &Image, i: u32, j: u32, r: u32) -> Image {
     let (i0, j0) = (i.saturating_sub(r), j.saturating_sub(r));
@@ -119,11 +107,13 @@ fn random_views_match_the_reference_on_every_pixel() {
         assert_eq!(img.count_non_finite(), 0, "{tag}: non-finite pixels");
         let (d, _) = compare_display(&img, &want, [0.0; 3]).unwrap();
         eprintln!("{tag}: max {:.2e} rms {:.2e}", d.max_abs, d.rms);
-        let bound = if name == "PentaHexa.vtk" {
-            PENTA_HEXA_AXIS
-        } else {
-            MAX
-        };
+        // PentaHexa reached 2.37e-2 (case 13) on the image's centre column:
+        // a face seen nearly edge-on whose thickness rises from 0 to 0.4
+        // across 0.02 px, refined into slivers that collapsed on the
+        // rasteriser's grid, so the centre took the neighbouring
+        // triangle's values. Slivers are now found among the exact
+        // triangles (src/render/ties.rs).
+        let bound = MAX;
         if d.max_abs > bound {
             let (i, j) = d.worst;
             let watch = RenderOptions {

@@ -47,11 +47,13 @@
 //!   outline across which the payload jumps (an isosurface region of the
 //!   exact mode beside a region without it), where a centre must go to
 //!   the same side in every part that shares the edge;
-//! - inside **slivers**, drawn triangles narrower than [`SLIVER_TIE_PX`]:
+//! - inside **slivers**, exact triangles narrower than [`SLIVER_TIE_PX`]:
 //!   the snap of their corners shifts the interpolated values by their
 //!   screen gradient times the snap, which across a sliver is a large part
 //!   of the values' change (a region of a face seen nearly edge-on; an
-//!   optically thick tet seen almost along a face).
+//!   optically thick tet seen almost along a face); a sliver whose corners
+//!   collapse on the grid is not drawn at all, and its centres would take
+//!   the values of the triangle beside it.
 
 use glam::{DVec2, DVec3};
 
@@ -365,7 +367,12 @@ pub fn decide_ties(
     // its corners shifts them by up to its gradient times 1/256 pixel; the
     // exact segment is taken there instead.
     let mut rate = None;
-    for (t, g) in part.drawn {
+    // Every exact triangle, also those whose snapped corners collapse (a
+    // sliver a few thousandths of a pixel wide on the steep side of a face
+    // seen nearly edge-on, dropped as flat on the grid, whose centres the
+    // neighbouring triangle then takes with its own, far different,
+    // values).
+    for t in part.exact {
         let p = t.map(&pos);
         // Cheap tests first: narrow (twice the area against the longest
         // edge, squared), then what the snap can do to the optical depth
@@ -404,14 +411,16 @@ pub fn decide_ties(
             part.height,
             near,
         );
-        // Only the centres the snapped sliver covers (the rasteriser's
-        // test): a triangle that covers none is left out by coverage
-        // culling, and with it must go no decision (culling changes no
-        // pixel).
-        let sub = SUBPIXEL as i64;
-        forced.extend(near.iter().copied().filter(|&(i, j)| {
-            covers_grid(*g, [i as i64 * sub + sub / 2, j as i64 * sub + sub / 2])
-        }));
+        // Only the centres in the exact sliver grown by the band (which
+        // holds every centre its snapped triangle can cover): coverage
+        // culling keeps every triangle within COVERAGE_MARGIN_PX (1/64 px)
+        // of a centre, so it drops no sliver that has such a centre, and
+        // changes no decision.
+        forced.extend(
+            near.iter()
+                .copied()
+                .filter(|&(i, j)| in_grown_triangle(p, DVec2::new(i as f64 + 0.5, j as f64 + 0.5))),
+        );
     }
     centres.extend_from_slice(forced);
     if centres.is_empty() {
@@ -446,6 +455,26 @@ pub fn decide_ties(
             faces,
         });
     }
+}
+
+/// Whether `c` is inside triangle `p` (either winding) or within
+/// [`TIE_BAND_PX`] of one of its edges.
+fn in_grown_triangle(p: [DVec2; 3], c: DVec2) -> bool {
+    let e = [0, 1, 2].map(|k| (p[(k + 1) % 3] - p[k]).perp_dot(c - p[k]));
+    if (e[0] >= 0.0 && e[1] >= 0.0 && e[2] >= 0.0) || (e[0] <= 0.0 && e[1] <= 0.0 && e[2] <= 0.0) {
+        return true;
+    }
+    (0..3).any(|k| {
+        let (a, b) = (p[k], p[(k + 1) % 3]);
+        let d = b - a;
+        let l2 = d.length_squared();
+        let t = if l2 > 0.0 {
+            ((c - a).dot(d) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (a + d * t - c).length_squared() <= TIE_BAND_PX * TIE_BAND_PX
+    })
 }
 
 /// Appends the image's pixel centres within [`TIE_BAND_PX`] of segment `a b`
