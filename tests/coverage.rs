@@ -198,7 +198,21 @@ fn distance_to_edges(edges: &[(glam::DVec2, glam::DVec2)], i: u32, j: u32) -> f6
 /// Every centre's piece count is the ray's tet count; the first that is
 /// not is reported with its distance to the nearest projected tet edge.
 fn check_counts(scene: &Scene, camera: &Camera, pieces: &[usize], want: &[usize], tag: &str) {
-    let bad: Vec<usize> = (0..want.len()).filter(|&k| want[k] != pieces[k]).collect();
+    check_counts_outside(scene, camera, pieces, want, &vec![false; want.len()], tag);
+}
+
+/// [`check_counts`] at the centres not in `skip`.
+fn check_counts_outside(
+    scene: &Scene,
+    camera: &Camera,
+    pieces: &[usize],
+    want: &[usize],
+    skip: &[bool],
+    tag: &str,
+) {
+    let bad: Vec<usize> = (0..want.len())
+        .filter(|&k| !skip[k] && want[k] != pieces[k])
+        .collect();
     if let Some(&k) = bad.first() {
         let (i, j) = (k as u32 % camera.width, k as u32 / camera.width);
         let d = distance_to_edges(&projected_edges(&scene.mesh, camera), i, j);
@@ -322,7 +336,6 @@ fn on_grid_meshes_are_covered_exactly_once() {
 /// the ray's tet counts at every centre.
 #[test]
 fn datasets_are_covered_exactly_once_in_random_views() {
-    let gpu = gpu_available();
     let mut files = vec![mesh_file("zoo_3x3x3.vtu"), mesh_file("ring_hole.vtu")];
     for rel in [
         "tets_small/CylinderLinear.vtk",
@@ -334,7 +347,40 @@ fn datasets_are_covered_exactly_once_in_random_views() {
     ] {
         files.extend(shared_file(rel));
     }
-    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    random_views(files, 0x9e37_79b9_7f4a_7c15);
+}
+
+/// The rest of the shared collection, eight random views each (skipped
+/// without it).
+#[test]
+fn every_shared_dataset_is_covered_exactly_once_in_random_views() {
+    let mut files = Vec::new();
+    for rel in [
+        "bluntfin/bluntfin_converted.vts",
+        "can_crush/can.vtu",
+        "disk_out_ref/disk_out_ref_converted.vtu",
+        "fea_bracket_qtet/kiefer_bracket.vtu",
+        "fire_room/fire_ug.vtu",
+        "notch/notch_disp.vtu",
+        "office_kitchen/office.binary.vtk",
+        "office_kitchen/kitchen.vtk",
+        "prisms_zoo/hexa.vtk",
+        "su2_sphere_hybrid/sphere_hybrid_converted.vtu",
+        "synthetic/hex_shell_zlib.vtu",
+    ] {
+        files.extend(shared_file(rel));
+    }
+    random_views(files, 0x2545_f491_4f6c_dd1d);
+}
+
+/// Eight seeded random views of each file: the GPU counts equal the
+/// twin's, the twin's equal the brute force's at every centre, and the
+/// walk's segments longer than rounding are the brute force's (except on
+/// can_crush, whose overlapping pieces the walk legitimately sees once:
+/// README, "The ray caster").
+fn random_views(files: Vec<std::path::PathBuf>, seed: u64) {
+    let gpu = gpu_available();
+    let mut seed = seed;
     let mut next = move || {
         seed ^= seed << 13;
         seed ^= seed >> 7;
@@ -347,6 +393,7 @@ fn datasets_are_covered_exactly_once_in_random_views() {
         scene.tf = flat_tf(scene.range);
         let mut renderer = Renderer::new(scene.geometry());
         let rc = reference(&scene);
+        let overlapping = path.ends_with("can.vtu");
         for view in 0..8 {
             let params = CameraParams {
                 width: 48 + (next() * 48.0) as u32,
@@ -361,11 +408,47 @@ fn datasets_are_covered_exactly_once_in_random_views() {
             let tag = format!("{} view {view} {params:?}", path.display());
             let (pieces, folds) = check_twin(&mut renderer, &scene.shading(), &camera, gpu, &tag);
             let want = reference_counts(&rc, &camera);
-            check_counts(&scene, &camera, &pieces, &want, &tag);
-            check_walk(&scene, &rc, &camera, &tag);
-            eprintln!("{tag}: all right, {folds} fold pixels");
+            // Unresolved visibility cycles (can_crush's overlapping
+            // pieces) are composited per pixel into one layer, drawn as one
+            // piece: their pixels are left out, and counted.
+            let groups = group_mask(&renderer, &rc, &scene, &camera);
+            check_counts_outside(&scene, &camera, &pieces, &want, &groups, &tag);
+            let in_groups = groups.iter().filter(|&&g| g).count();
+            assert!(overlapping || in_groups == 0, "{tag}: cycle groups");
+            if !overlapping {
+                check_walk(&scene, &rc, &camera, &tag);
+            }
+            eprintln!("{tag}: all right, {folds} fold pixels, {in_groups} pixels of cycle groups");
         }
     }
+}
+
+/// The centres whose reference ray crosses a cell that has a piece in a
+/// cycle group of the last render's order.
+fn group_mask(renderer: &Renderer, rc: &Brute, scene: &Scene, camera: &Camera) -> Vec<bool> {
+    use zoovr::visibility::Piece;
+    let order = renderer.last_order().expect("a projected render");
+    let mut cells = vec![false; scene.mesh.cells.len()];
+    for g in &order.groups {
+        for p in &order.pieces[g.clone()] {
+            let c = match *p {
+                Piece::Cell(c) => c,
+                Piece::Tet { cell, .. } | Piece::Slab { cell, .. } | Piece::Frag { cell, .. } => {
+                    cell
+                }
+            };
+            cells[c as usize] = true;
+        }
+    }
+    let t_near = if camera.ortho { 0.0 } else { camera.near };
+    let mut mask = Vec::new();
+    for j in 0..camera.height {
+        for i in 0..camera.width {
+            let segs = rc.segments(&camera.pixel_ray(i, j), t_near);
+            mask.push(segs.iter().any(|s| cells[s.cell as usize]));
+        }
+    }
+    mask
 }
 
 /// Colour refinement (`--refine-tol`) splits region triangles inside a
