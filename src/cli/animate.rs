@@ -31,9 +31,12 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 
 use zoovr::camera::Camera;
+use zoovr::gpu::PendingContext;
 use zoovr::io::{self, ReadOptions, TimeStep};
 use zoovr::mesh::Mesh;
-use zoovr::render::{Geometry, ModeStats, RenderStats, Renderer, Shading, StepChange};
+use zoovr::render::{
+    Geometry, ModeStats, RenderOptions, RenderStats, Renderer, SceneSpec, Shading, StepChange,
+};
 
 use super::args::{parse_finite, parse_frames, parse_positive};
 use super::assemble::{self, AssembleArgs};
@@ -327,17 +330,28 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         });
     }
     if let (Some(series), Some(file)) = (&args.series, &args.range_only) {
-        let steps = io::sequence::list_steps(series)?;
-        let ropts = args.view.scene.read_options();
-        let range = colour_range(args, &steps, &ropts)?;
-        let text = serde_json::to_string(&serde_json::json!({ "range": range }))?;
-        std::fs::write(file, text + "\n")
-            .with_context(|| format!("{}: cannot write the range", file.display()))?;
-        return Ok(());
+        return write_range(args, series, file);
     }
     let (Some(series), Some(out)) = (&args.series, &args.output) else {
         return Err(UsageError("give SERIES and -o DIR (or --assemble DIR)".into()).into());
     };
+    render_series(args, series, out)
+}
+
+/// `--range-only FILE`: the colour range of the whole series, as JSON.
+fn write_range(args: &AnimateArgs, series: &Path, file: &Path) -> Result<()> {
+    let steps = io::sequence::list_steps(series)?;
+    let ropts = args.view.scene.read_options();
+    let range = colour_range(args, &steps, &ropts)?;
+    let text = serde_json::to_string(&serde_json::json!({ "range": range }))?;
+    std::fs::write(file, text + "\n")
+        .with_context(|| format!("{}: cannot write the range", file.display()))?;
+    Ok(())
+}
+
+/// Renders the planned frames of `series` into `out` (module docs, steps 1
+/// to 4), then assembles them (step 5).
+fn render_series(args: &AnimateArgs, series: &Path, out: &Path) -> Result<()> {
     super::interrupt::install();
     let steps = io::sequence::list_steps(series)?;
     // A collection's times win; steps found by a folder or a pattern take
@@ -354,7 +368,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("{}: cannot make the output folder", out.display()))?;
     let ropts = args.view.scene.read_options();
-    let mut opts = args.view.render_options();
+    let opts = args.view.render_options();
     let pending = opts
         .mode
         .info()
@@ -377,6 +391,21 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     }
     let bar = frame_bar(frames.len());
     let mut reports = Vec::new();
+    let mut drawer = Drawer {
+        args,
+        spec: &spec,
+        steps: &steps,
+        ropts: &ropts,
+        out,
+        collection,
+        first_step: frames.first().map_or(0, |f| f.step),
+        opts,
+        renderer: None,
+        pending,
+        current: None,
+        first_field: None,
+        camera_bounds: None,
+    };
     let result = std::thread::scope(|scope| -> Result<()> {
         let (tx, rx) = mpsc::sync_channel::<(usize, Result<Mesh>)>(1);
         let (steps_ref, ropts_ref, needed_ref) = (&steps, &ropts, &needed);
@@ -389,121 +418,24 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
                 }
             }
         });
-        let mut renderer: Option<Renderer> = None;
-        let mut pending = pending;
-        let mut current: Option<(usize, Shading, f64)> = None;
-        let mut first_field = None;
-        let mut camera_bounds: Option<[f64; 6]> = None;
         for f in &frames {
             if super::interrupt::requested() {
                 break;
             }
             let t0 = Instant::now();
-            let step = &steps[f.step];
-            let change = match &current {
-                Some((k, _, _)) if *k == f.step => {
-                    if opts.camera.azimuth == f.azimuth {
-                        "none"
-                    } else {
-                        "camera"
-                    }
-                }
-                _ => {
-                    let (k, mesh) = rx
-                        .recv()
-                        .map_err(|_| anyhow!("the loader thread stopped"))?;
-                    debug_assert_eq!(k, f.step);
-                    let mesh = mesh?;
-                    let time = match mesh.source.time_value {
-                        Some(t) if !collection => t,
-                        _ => step.time,
-                    };
-                    let at = || format!("{}", step.path.display());
-                    if args.no_reuse {
-                        renderer = None;
-                    }
-                    let change = match renderer.as_mut() {
-                        None if args.no_reuse && current.is_some() => {
-                            let g = Geometry::build(mesh, spec.show_hidden).with_context(at)?;
-                            renderer = Some(Renderer::new(g));
-                            StepChange::Cells
-                        }
-                        None => {
-                            let g = Geometry::build(mesh, spec.show_hidden).with_context(at)?;
-                            let mut r = Renderer::new(g);
-                            if let Some(p) = pending.take() {
-                                r.set_pending_gpu(p);
-                            }
-                            renderer = Some(r);
-                            StepChange::None
-                        }
-                        Some(r) => {
-                            let (g, change) = r
-                                .geometry()
-                                .next_step(mesh, spec.show_hidden)
-                                .with_context(at)?;
-                            r.set_geometry(g, change);
-                            if change == StepChange::Cells && !args.no_reuse {
-                                eprintln!(
-                                    "zoovr: note: {}: its cells differ from the step before; \
-                                     rendered with a new topology (nothing reused)",
-                                    step.path.display()
-                                );
-                            }
-                            change
-                        }
-                    };
-                    let r = renderer.as_ref().ok_or_else(|| anyhow!("no renderer"))?;
-                    let shading = Shading::build(r.geometry(), &spec).with_context(at)?;
-                    if current.is_none() && f.step == frames[0].step {
-                        first_field = field_key(&shading);
-                    } else {
-                        check_field(&first_field, &shading, step)?;
-                    }
-                    current = Some((f.step, shading, time));
-                    change.name()
-                }
+            let on_screen = matches!(&drawer.current, Some((k, _, _)) if *k == f.step);
+            let change = if !on_screen {
+                let (k, mesh) = rx
+                    .recv()
+                    .map_err(|_| anyhow!("the loader thread stopped"))?;
+                debug_assert_eq!(k, f.step);
+                drawer.load(k, mesh?)?
+            } else if drawer.opts.camera.azimuth == f.azimuth {
+                "none"
+            } else {
+                "camera"
             };
-            let renderer = renderer.as_mut().ok_or_else(|| anyhow!("no renderer"))?;
-            let Some((_, shading, time)) = &current else {
-                bail!("no shading");
-            };
-            let bounds = match camera_bounds {
-                Some(b) => b,
-                None => {
-                    let b = step0_bounds(&steps, f.step, renderer, &ropts, spec.show_hidden)?;
-                    camera_bounds = Some(b);
-                    b
-                }
-            };
-            let load_s = t0.elapsed().as_secs_f64();
-            opts.camera.azimuth = f.azimuth;
-            let camera = Camera::fit(bounds, &opts.camera);
-            let (image, stats) = renderer
-                .render_with_camera(shading, &opts, &camera, |_, _| {})
-                .with_context(|| format!("{}", step.path.display()))?;
-            let t_write = Instant::now();
-            let path = out.join(frame_name(f.index));
-            super::legend::write_frame(&image, &path, &args.view, shading, Some(*time))?;
-            let write_s = t_write.elapsed().as_secs_f64();
-            let sort_s = match &stats.detail {
-                ModeStats::Projected(p) => p.sort_s,
-                _ => 0.0,
-            };
-            let report = FrameReport {
-                frame: f.index,
-                step: f.step,
-                time: *time,
-                file: step.path.display().to_string(),
-                change,
-                range: shading.range,
-                load_s,
-                sort_s,
-                draw_s: (stats.total_s - sort_s).max(0.0),
-                write_s,
-                total_s: t0.elapsed().as_secs_f64(),
-                render: stats,
-            };
+            let report = drawer.draw(f, change, t0)?;
             bar.set_message(format!(
                 "load {:.0} ms, sort {:.0} ms, draw {:.0} ms",
                 report.load_s * 1e3,
@@ -517,6 +449,154 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         Ok(())
     });
     bar.finish_and_clear();
+    finish(args, out, &frames, &reports, result)
+}
+
+/// What the frame loop keeps from frame to frame: the one renderer (made
+/// at the first step, then told what each step changed), the GPU device
+/// opening meanwhile, the step on screen with its shading and time, and
+/// the camera's bounds (step 0's).
+struct Drawer<'a> {
+    args: &'a AnimateArgs,
+    spec: &'a SceneSpec,
+    steps: &'a [TimeStep],
+    ropts: &'a ReadOptions,
+    out: &'a Path,
+    /// Whether the series is a collection, whose times win over the files'.
+    collection: bool,
+    /// The step of the first frame, whose field every step must render.
+    first_step: usize,
+    opts: RenderOptions,
+    renderer: Option<Renderer>,
+    pending: Option<PendingContext>,
+    current: Option<(usize, Shading, f64)>,
+    first_field: Option<(String, zoovr::field::Association)>,
+    camera_bounds: Option<[f64; 6]>,
+}
+
+impl Drawer<'_> {
+    /// Puts step `k` (its mesh read) on screen: builds the renderer at the
+    /// first step, else tells it what changed, and the step's shading;
+    /// returns the change's name.
+    fn load(&mut self, k: usize, mesh: Mesh) -> Result<&'static str> {
+        let step = &self.steps[k];
+        let time = match mesh.source.time_value {
+            Some(t) if !self.collection => t,
+            _ => step.time,
+        };
+        let at = || format!("{}", step.path.display());
+        let (no_reuse, hidden) = (self.args.no_reuse, self.spec.show_hidden);
+        if no_reuse {
+            self.renderer = None;
+        }
+        let change = match self.renderer.as_mut() {
+            None if no_reuse && self.current.is_some() => {
+                let g = Geometry::build(mesh, hidden).with_context(at)?;
+                self.renderer = Some(Renderer::new(g));
+                StepChange::Cells
+            }
+            None => {
+                let g = Geometry::build(mesh, hidden).with_context(at)?;
+                let mut r = Renderer::new(g);
+                if let Some(p) = self.pending.take() {
+                    r.set_pending_gpu(p);
+                }
+                self.renderer = Some(r);
+                StepChange::None
+            }
+            Some(r) => {
+                let (g, change) = r.geometry().next_step(mesh, hidden).with_context(at)?;
+                r.set_geometry(g, change);
+                if change == StepChange::Cells && !no_reuse {
+                    eprintln!(
+                        "zoovr: note: {}: its cells differ from the step before; \
+                         rendered with a new topology (nothing reused)",
+                        step.path.display()
+                    );
+                }
+                change
+            }
+        };
+        let r = self
+            .renderer
+            .as_ref()
+            .ok_or_else(|| anyhow!("no renderer"))?;
+        let shading = Shading::build(r.geometry(), self.spec).with_context(at)?;
+        if self.current.is_none() && k == self.first_step {
+            self.first_field = field_key(&shading);
+        } else {
+            check_field(&self.first_field, &shading, step)?;
+        }
+        self.current = Some((k, shading, time));
+        Ok(change.name())
+    }
+
+    /// Renders frame `f` of the step on screen and writes it; `t0` is when
+    /// the frame began, `change` what its step changed.
+    fn draw(&mut self, f: &FramePlan, change: &'static str, t0: Instant) -> Result<FrameReport> {
+        let step = &self.steps[f.step];
+        let renderer = self
+            .renderer
+            .as_mut()
+            .ok_or_else(|| anyhow!("no renderer"))?;
+        let Some((_, shading, time)) = &self.current else {
+            bail!("no shading");
+        };
+        let bounds = match self.camera_bounds {
+            Some(b) => b,
+            None => {
+                let b = step0_bounds(
+                    self.steps,
+                    f.step,
+                    renderer,
+                    self.ropts,
+                    self.spec.show_hidden,
+                )?;
+                self.camera_bounds = Some(b);
+                b
+            }
+        };
+        let load_s = t0.elapsed().as_secs_f64();
+        self.opts.camera.azimuth = f.azimuth;
+        let camera = Camera::fit(bounds, &self.opts.camera);
+        let (image, stats) = renderer
+            .render_with_camera(shading, &self.opts, &camera, |_, _| {})
+            .with_context(|| format!("{}", step.path.display()))?;
+        let t_write = Instant::now();
+        let path = self.out.join(frame_name(f.index));
+        super::legend::write_frame(&image, &path, &self.args.view, shading, Some(*time))?;
+        let write_s = t_write.elapsed().as_secs_f64();
+        let sort_s = match &stats.detail {
+            ModeStats::Projected(p) => p.sort_s,
+            _ => 0.0,
+        };
+        Ok(FrameReport {
+            frame: f.index,
+            step: f.step,
+            time: *time,
+            file: step.path.display().to_string(),
+            change,
+            range: shading.range,
+            load_s,
+            sort_s,
+            draw_s: (stats.total_s - sort_s).max(0.0),
+            write_s,
+            total_s: t0.elapsed().as_secs_f64(),
+            render: stats,
+        })
+    }
+}
+
+/// After the frame loop: says which frames are complete when it failed or
+/// was interrupted, prints the `--stats` summary, and assembles the GIF
+/// or MP4 of the frames done.
+fn finish(
+    args: &AnimateArgs,
+    out: &Path,
+    frames: &[FramePlan],
+    reports: &[FrameReport],
+    result: Result<()>,
+) -> Result<()> {
     let done: Vec<usize> = reports.iter().map(|r| r.frame).collect();
     if let Err(e) = result {
         if !done.is_empty() {
@@ -540,11 +620,11 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         );
     }
     if args.view.stats && !args.view.json {
-        summary(&reports);
+        summary(reports);
     }
     if args.gif.is_some() || args.mp4.is_some() {
         assemble::run(&AssembleArgs {
-            dir: out.clone(),
+            dir: out.to_path_buf(),
             gif: args.gif.clone(),
             mp4: args.mp4.clone(),
             fps: args.fps,
