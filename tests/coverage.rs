@@ -45,7 +45,7 @@ use zoovr::mesh::Mesh;
 use zoovr::raycast::brute::Brute;
 use zoovr::raycast::{self, FieldModel, Raycaster};
 use zoovr::render::{
-    Compositor, ProjectedOptions, RenderOptions, Renderer, ScalarsRef, Scene, SceneSpec, Shading,
+    Compositor, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec, Shading,
 };
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
@@ -90,28 +90,15 @@ fn counts(
         .0
 }
 
-fn ray_scene(scene: &Scene) -> raycast::Scene<'_> {
-    let scalars = match scene.scalars() {
-        ScalarsRef::Point(v) => raycast::Scalars::Point(v),
-        ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
-        ScalarsRef::Constant(c) => raycast::Scalars::Constant(c),
-    };
-    raycast::Scene {
-        mesh: &scene.mesh,
-        topology: &scene.topology,
-        scalars,
-    }
-}
-
 /// The reference: the ray caster's brute force over the `tets`, built once
 /// per scene for all its views.
 fn reference(scene: &Scene) -> Brute<'_> {
-    Brute::new(ray_scene(scene), FieldModel::Tets).unwrap()
+    Brute::new(scene.ray_scene(), FieldModel::Tets).unwrap()
 }
 
 /// The `tets` walk of `scene`.
 fn walk(scene: &Scene) -> Raycaster<'_> {
-    Raycaster::new(ray_scene(scene), FieldModel::Tets).unwrap()
+    Raycaster::new(scene.ray_scene(), FieldModel::Tets).unwrap()
 }
 
 /// Tets each pixel's reference ray crosses for a positive length.
@@ -332,21 +319,26 @@ fn on_grid_meshes_are_covered_exactly_once() {
     }
 }
 
+/// The project's zoo_3x3x3 and ring_hole meshes, and the shared datasets
+/// `rel` that are present.
+fn project_and_shared(rel: &[&str]) -> Vec<std::path::PathBuf> {
+    let mut files = vec![mesh_file("zoo_3x3x3.vtu"), mesh_file("ring_hole.vtu")];
+    files.extend(rel.iter().filter_map(|r| shared_file(r)));
+    files
+}
+
 /// Real meshes in seeded random views: the GPU counts equal the twin's and
 /// the ray's tet counts at every centre.
 #[test]
 fn datasets_are_covered_exactly_once_in_random_views() {
-    let mut files = vec![mesh_file("zoo_3x3x3.vtu"), mesh_file("ring_hole.vtu")];
-    for rel in [
+    let files = project_and_shared(&[
         "tets_small/CylinderLinear.vtk",
         "tets_small/tetraMesh.vtk",
         "prisms_zoo/PentaHexa.vtk",
         "prisms_zoo/uGridEx.vtk",
         "angular_sector/AngularSector.vtk",
         "synthetic/mixed.vtk",
-    ] {
-        files.extend(shared_file(rel));
-    }
+    ]);
     random_views(files, 0x9e37_79b9_7f4a_7c15);
 }
 
@@ -461,14 +453,11 @@ fn group_mask(renderer: &Renderer, rc: &Brute, scene: &Scene, camera: &Camera) -
 /// refines several times more triangles.
 #[test]
 fn refinement_changes_no_coverage() {
-    let mut files = vec![mesh_file("zoo_3x3x3.vtu"), mesh_file("ring_hole.vtu")];
-    for rel in [
+    let files = project_and_shared(&[
         "prisms_zoo/PentaHexa.vtk",
         "angular_sector/AngularSector.vtk",
         "bluntfin/bluntfin_converted.vts",
-    ] {
-        files.extend(shared_file(rel));
-    }
+    ]);
     for path in files {
         let mesh = io::read(&path, &ReadOptions::default()).unwrap();
         let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();

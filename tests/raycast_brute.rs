@@ -29,7 +29,7 @@ use zoovr::raycast::{
     render, FieldModel, RayTracer, RaycastError, RaycastOptions, Raycaster, Scalars, Scene,
     Traversal,
 };
-use zoovr::render::{ScalarsRef, SceneSpec};
+use zoovr::render::SceneSpec;
 use zoovr::testdata::{mesh_file, shared_file, Rng};
 use zoovr::tf::TransferFunction;
 
@@ -178,15 +178,7 @@ fn file_scene(path: &std::path::Path, opts: &io::ReadOptions) -> zoovr::render::
 }
 
 fn ray_scene(s: &zoovr::render::Scene) -> Scene<'_> {
-    Scene {
-        mesh: &s.mesh,
-        topology: &s.topology,
-        scalars: match s.scalars() {
-            ScalarsRef::Point(v) => Scalars::Point(v),
-            ScalarsRef::Cell(v) => Scalars::Cell(v),
-            ScalarsRef::Constant(c) => Scalars::Constant(c),
-        },
-    }
+    s.ray_scene()
 }
 
 #[test]

@@ -311,4 +311,19 @@ impl Scene {
     pub fn scalars(&self) -> ScalarsRef<'_> {
         ScalarsRef::of(self.field.as_deref())
     }
+
+    /// The scene as the reference ray caster takes it (mesh, topology and
+    /// scalars).
+    pub fn ray_scene(&self) -> crate::raycast::Scene<'_> {
+        let scalars = match self.scalars() {
+            ScalarsRef::Point(v) => crate::raycast::Scalars::Point(v),
+            ScalarsRef::Cell(v) => crate::raycast::Scalars::Cell(v),
+            ScalarsRef::Constant(c) => crate::raycast::Scalars::Constant(c),
+        };
+        crate::raycast::Scene {
+            mesh: &self.mesh,
+            topology: &self.topology,
+            scalars,
+        }
+    }
 }

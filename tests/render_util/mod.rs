@@ -62,22 +62,7 @@ pub fn split_mask(
     camera: &zoovr::camera::Camera,
     split: &[bool],
 ) -> Vec<bool> {
-    use zoovr::raycast::{self, Raycaster};
-    use zoovr::render::ScalarsRef;
-    let scalars = match scene.scalars() {
-        ScalarsRef::Point(v) => raycast::Scalars::Point(v),
-        ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
-        ScalarsRef::Constant(c) => raycast::Scalars::Constant(c),
-    };
-    let rc = Raycaster::new(
-        raycast::Scene {
-            mesh: &scene.mesh,
-            topology: &scene.topology,
-            scalars,
-        },
-        FieldModel::Faces,
-    )
-    .unwrap();
+    let rc = zoovr::raycast::Raycaster::new(scene.ray_scene(), FieldModel::Faces).unwrap();
     let t_near = if camera.ortho { 0.0 } else { camera.near };
     let mut mask = Vec::with_capacity((camera.width * camera.height) as usize);
     for j in 0..camera.height {

@@ -44,16 +44,7 @@ pub(crate) fn render(
         return render_iso(scene, opts, camera, !opts.iso.alone, progress);
     }
     let t0 = Instant::now();
-    let scalars = match scene.scalars() {
-        ScalarsRef::Point(v) => raycast::Scalars::Point(v),
-        ScalarsRef::Cell(v) => raycast::Scalars::Cell(v),
-        ScalarsRef::Constant(c) => raycast::Scalars::Constant(c),
-    };
-    let rs = raycast::Scene {
-        mesh: &scene.mesh,
-        topology: &scene.topology,
-        scalars,
-    };
+    let rs = scene.ray_scene();
     let ro = RaycastOptions {
         model: opts.reference.model,
         traversal: opts.reference.traversal,
