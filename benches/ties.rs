@@ -84,6 +84,7 @@ fn bench(c: &mut Criterion) {
             }
         }
     }
+    paired(&mut renderer, &shading, &opts);
     let mut g = c.benchmark_group("exact_ties");
     g.sample_size(10);
     for ties in [true, false] {
@@ -97,6 +98,71 @@ fn bench(c: &mut Criterion) {
         });
     }
     g.finish();
+}
+
+/// Frames with and without the decisions, alternated (`TIES_PAIRS` pairs,
+/// default 6), so that drift of a shared, noisy machine falls on both
+/// alike: prints the median wall and process CPU time of each and the
+/// median of the pairs' ratios. Criterion's two groups run minutes apart,
+/// which on the 2-core machines moved their ratio by several percent.
+fn paired(
+    renderer: &mut Renderer,
+    shading: &zoovr::render::Shading,
+    opts: &dyn Fn(bool) -> RenderOptions,
+) {
+    let pairs: usize = std::env::var("TIES_PAIRS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(6);
+    let cpu = || {
+        let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+        // SAFETY: getrusage writes the struct it is given.
+        unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+        let t = |v: libc::timeval| v.tv_sec as f64 + v.tv_usec as f64 * 1e-6;
+        t(u.ru_utime) + t(u.ru_stime)
+    };
+    let mut frame = |ties: bool| {
+        let (w0, c0) = (std::time::Instant::now(), cpu());
+        renderer
+            .render(shading, &opts(ties), |_, _| {})
+            .expect("render");
+        (w0.elapsed().as_secs_f64(), cpu() - c0)
+    };
+    if let Ok(only) = std::env::var("TIES_ONLY") {
+        for _ in 0..pairs {
+            frame(only == "on");
+        }
+        std::process::exit(0);
+    }
+    let (mut on, mut off) = (Vec::new(), Vec::new());
+    for k in 0..pairs {
+        // Alternate which goes first.
+        let (a, b) = if k % 2 == 0 {
+            let a = frame(true);
+            (a, frame(false))
+        } else {
+            let b = frame(false);
+            (frame(true), b)
+        };
+        on.push(a);
+        off.push(b);
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let n = v.len();
+        (v[(n - 1) / 2] + v[n / 2]) / 2.0
+    };
+    let ratio =
+        |f: fn(&(f64, f64)) -> f64| median(on.iter().zip(&off).map(|(a, b)| f(a) / f(b)).collect());
+    eprintln!(
+        "paired ({pairs} pairs): wall on {:.3} s, off {:.3} s, ratio {:.4}; cpu on {:.3} s, off {:.3} s, ratio {:.4}",
+        median(on.iter().map(|p| p.0).collect()),
+        median(off.iter().map(|p| p.0).collect()),
+        ratio(|p| p.0),
+        median(on.iter().map(|p| p.1).collect()),
+        median(off.iter().map(|p| p.1).collect()),
+        ratio(|p| p.1),
+    );
 }
 
 criterion_group!(benches, bench);

@@ -453,6 +453,15 @@ impl Projected {
         self.region_faces.clear();
         self.seams.clear();
         self.tie_faces.clear();
+        self.spans.clear();
+    }
+
+    /// Each vertex's [`coverage::Span`]: the pixel centres within
+    /// [`crate::numeric::tolerance::COVERAGE_MARGIN_PX`] of it per axis, as
+    /// [`Projected::cull_to_pixels`] left them; `None` where the projection
+    /// was not culled (or vertices were added since).
+    pub fn vertex_spans(&self) -> Option<&[coverage::Span]> {
+        (self.spans.len() == self.vertices.len()).then_some(&self.spans[..])
     }
 
     /// The front (`side` 0) or back (1) triangle of region `r`.

@@ -300,22 +300,22 @@ pub fn decide_ties(
     let outline = &mut scratch.outline;
     outline.clear();
     if part.proj.vertices.len() <= 64 {
-        // Small parts (almost all): each edge's count's parity in a bit
-        // matrix, no sort. A triangulation shares an edge between at most
-        // two triangles, so an odd count is a count of one.
+        // Small parts (almost all): each directed edge in a bit matrix, no
+        // sort. The triangles wind the same way (CCW in pixel
+        // coordinates), so an edge shared by two of them appears once in
+        // each direction, and an outline edge in one direction only.
         let mut bits = [0u64; 64];
         for (t, _) in part.drawn {
             for k in 0..3 {
-                let (a, b) = key(t[k], t[(k + 1) % 3]);
-                bits[a as usize] ^= 1 << b;
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                bits[a as usize] |= 1 << b;
             }
         }
         for (t, _) in part.drawn {
             for k in 0..3 {
-                let (a, b) = key(t[k], t[(k + 1) % 3]);
-                if bits[a as usize] >> b & 1 == 1 {
-                    bits[a as usize] &= !(1 << b);
-                    outline.push((a, b));
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if bits[b as usize] >> a & 1 == 0 {
+                    outline.push(key(a, b));
                 }
             }
         }
@@ -352,7 +352,17 @@ pub fn decide_ties(
     // Centres within the band of each outline edge.
     let centres = &mut scratch.centres;
     centres.clear();
+    // The box of an edge grown by the coverage margin (1/64 px, more than
+    // the band) holds every centre within the band of it; most short
+    // edges' boxes hold none, and the culling's spans say so at once.
+    let spans = part.proj.vertex_spans();
     for &(ia, ib) in outline.iter() {
+        if let Some(s) = spans {
+            let s = s[ia as usize].join(&s[ib as usize]);
+            if s.x0 > s.x1 || s.y0 > s.y1 {
+                continue;
+            }
+        }
         near_centres(pos(ia), pos(ib), part.width, part.height, centres);
     }
     // Centres next to the mode's seams: decided exactly wherever the part
@@ -367,12 +377,27 @@ pub fn decide_ties(
     // its corners shifts them by up to its gradient times 1/256 pixel; the
     // exact segment is taken there instead.
     let mut rate = None;
+    // A triangle's thickness changes by at most the part's, so the bound
+    // on the rate and the part's thickness range bound the width below
+    // which the snap can matter; a part where no triangle can be that
+    // narrow (most parts of a fine mesh: thin, or optically thin) has no
+    // sliver to decide.
+    let (l_lo, l_hi) = part
+        .proj
+        .vertices
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v.l), hi.max(v.l))
+        });
+    let widest = (part.rate_bound * (l_hi - l_lo) * SNAP_PX / SLIVER_DEPTH_TOL).min(SLIVER_TIE_PX);
+    // False for NaN too: no sliver test where the bound is not a number.
+    let slivers = if widest > 0.0 { part.exact } else { &[] };
     // Every exact triangle, also those whose snapped corners collapse (a
     // sliver a few thousandths of a pixel wide on the steep side of a face
     // seen nearly edge-on, dropped as flat on the grid, whose centres the
     // neighbouring triangle then takes with its own, far different,
     // values).
-    for t in part.exact {
+    for t in slivers {
         let p = t.map(&pos);
         // Cheap tests first: narrow (twice the area against the longest
         // edge, squared), then what the snap can do to the optical depth
@@ -381,16 +406,17 @@ pub fn decide_ties(
         // rate, then the part's own rate.
         let area2 = (p[1] - p[0]).perp_dot(p[2] - p[0]);
         let d2 = [0, 1, 2].map(|k| (p[(k + 1) % 3] - p[k]).length_squared());
-        let k = if d2[0] >= d2[1] && d2[0] >= d2[2] {
+        let longest = d2[0].max(d2[1]).max(d2[2]);
+        if !(longest > 0.0 && area2 * area2 < widest * widest * longest) {
+            continue;
+        }
+        let k = if d2[0] == longest {
             0
-        } else if d2[1] >= d2[2] {
+        } else if d2[1] == longest {
             1
         } else {
             2
         };
-        if !(d2[k] > 0.0 && area2 * area2 < SLIVER_TIE_PX * SLIVER_TIE_PX * d2[k]) {
-            continue;
-        }
         let l = t.map(|i| part.proj.vertices[i as usize].l);
         let dl = l[0].max(l[1]).max(l[2]) - l[0].min(l[1]).min(l[2]);
         let long = d2[k].sqrt();
@@ -478,9 +504,47 @@ fn in_grown_triangle(p: [DVec2; 3], c: DVec2) -> bool {
 }
 
 /// Appends the image's pixel centres within [`TIE_BAND_PX`] of segment `a b`
-/// (a superset: the band is walked along the segment's major axis).
+/// (a superset: the band is walked along the segment's major axis, one
+/// candidate row per column). The hot loop of the decisions (millions of
+/// outline edges a frame), so without branches but the loop's.
+#[inline]
 fn near_centres(a: DVec2, b: DVec2, width: u32, height: u32, out: &mut Vec<(u32, u32)>) {
-    centres_within(a, b, TIE_BAND_PX, width, height, out);
+    if !(a.is_finite() && b.is_finite()) {
+        return;
+    }
+    let d = b - a;
+    let major_x = d.x.abs() >= d.y.abs();
+    let (a_m, b_m, a_n, b_n, n_major, n_minor) = if major_x {
+        (a.x, b.x, a.y, b.y, width, height)
+    } else {
+        (a.y, b.y, a.x, b.x, height, width)
+    };
+    let (m_lo, m_hi) = (a_m.min(b_m), a_m.max(b_m));
+    let k0 = ceil_i(m_lo - TIE_BAND_PX - 0.5).max(0);
+    let k1 = floor_i(m_hi + TIE_BAND_PX - 0.5).min(n_major as i64 - 1);
+    if k0 > k1 {
+        return;
+    }
+    // Across the major axis, the segment's coordinate at the column
+    // (clamped to the segment) is within `reach` of at most one centre row
+    // (`reach` < 1/2).
+    let reach = TIE_BAND_PX * std::f64::consts::SQRT_2;
+    let slope = if b_m != a_m {
+        (b_n - a_n) / (b_m - a_m)
+    } else {
+        0.0
+    };
+    for k in k0..=k1 {
+        let m = (k as f64 + 0.5).clamp(m_lo, m_hi);
+        // Minus 1/2: the centre rows at integers.
+        let r = a_n + slope * (m - a_m) - 0.5;
+        let l = floor_i(r + 0.5);
+        let hit = ((r - l as f64).abs() <= reach) & (l >= 0) & (l < n_minor as i64);
+        if hit {
+            let (i, j) = if major_x { (k, l) } else { (l, k) };
+            out.push((i as u32, j as u32));
+        }
+    }
 }
 
 /// Appends the image's pixel centres within `band` pixels of segment `a b`
@@ -541,26 +605,18 @@ fn centres_within(
 }
 
 /// `x.floor()` as an integer (saturating), without the libm call the
-/// baseline x86-64 target makes of `floor`.
+/// baseline x86-64 target makes of `floor`, and without a branch.
 #[inline]
 fn floor_i(x: f64) -> i64 {
     let i = x as i64;
-    if (i as f64) > x {
-        i - 1
-    } else {
-        i
-    }
+    i.saturating_sub(((i as f64) > x) as i64)
 }
 
 /// `x.ceil()` as an integer (saturating); see [`floor_i`].
 #[inline]
 fn ceil_i(x: f64) -> i64 {
     let i = x as i64;
-    if (i as f64) < x {
-        i + 1
-    } else {
-        i
-    }
+    i.saturating_add(((i as f64) < x) as i64)
 }
 
 #[cfg(test)]
