@@ -6,6 +6,12 @@
 //! function for comparison. Prints pieces, skipped pieces and triangles of
 //! each, then criterion times whole frames.
 //!
+//! Frustum culling (`zoovr::visibility::frustum`): the exact mode at 512 x
+//! 512 zoomed 4x into the hex_shell scene (shared data; a generated 60^3
+//! grid without it), cells outside the view left out before the sort (the
+//! default) and kept. Each frame nudges the azimuth by 1e-6 degree so that
+//! it sorts again (the renderer reuses the order of an unchanged view).
+//!
 //! Run: `cargo bench --bench skipping`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -106,5 +112,83 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+fn frustum_scene() -> (&'static str, Scene) {
+    if let (Some(p), Some(tf)) = (
+        shared_file("synthetic/hex_shell_zlib.vtu"),
+        shared_file("synthetic/bench_tf.json"),
+    ) {
+        let mesh = io::read(&p, &ReadOptions::default()).expect("hex_shell");
+        let spec = SceneSpec {
+            tf_file: Some(tf),
+            ..Default::default()
+        };
+        return ("hex_shell", Scene::build(mesh, &spec).expect("scene"));
+    }
+    let mesh = warped_hex_grid(
+        60,
+        &Warp {
+            amplitude: 0.05,
+            seed: 1,
+        },
+    );
+    (
+        "grid_60",
+        Scene::build(mesh, &SceneSpec::default()).expect("scene"),
+    )
+}
+
+fn frustum(c: &mut Criterion) {
+    let (name, scene) = frustum_scene();
+    let shading = scene.shading();
+    let mut renderer = Renderer::new(scene.geometry());
+    let opts = |nudge: bool| RenderOptions {
+        mode: Mode::Exact,
+        camera: CameraParams {
+            width: 512,
+            height: 512,
+            azimuth: 20.0 + if nudge { 1e-6 } else { 0.0 },
+            elevation: 35.0,
+            zoom: 4.0,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let default_margin = renderer.sorter().frustum_margin;
+    let mut g = c.benchmark_group("frustum");
+    g.sample_size(10);
+    for (label, margin) in [("culled", default_margin), ("kept", None)] {
+        renderer.sorter().frustum_margin = margin;
+        match renderer.render(&shading, &opts(false), |_, _| {}) {
+            Ok((_, stats)) => {
+                let p = stats.projected().expect("projected");
+                eprintln!(
+                    "{name} zoom 4 {label}: {} cells outside the view, {} pieces, {} triangles, sort {:.3} s (classify {:.3} s), project+draw {:.3} s, total {:.3} s",
+                    p.order.frustum_culled,
+                    p.pieces,
+                    p.triangles,
+                    p.sort_s,
+                    p.order.time_classify.as_secs_f64(),
+                    p.project_s,
+                    stats.total_s
+                );
+            }
+            Err(e) => {
+                eprintln!("skipped: {e}");
+                return;
+            }
+        }
+        let mut nudge = false;
+        g.bench_function(format!("{name}_zoom4_{label}"), |b| {
+            b.iter(|| {
+                nudge = !nudge;
+                renderer
+                    .render(&shading, &opts(nudge), |_, _| {})
+                    .expect("render")
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, frustum);
 criterion_main!(benches);

@@ -7,7 +7,11 @@
 //! rasteriser. Prints the tie pixels and stage times of one frame of each,
 //! then criterion times whole frames (the visibility order is reused
 //! between frames of one camera, so the figures are projection, payload,
-//! ties and drawing).
+//! ties and drawing). Before criterion, `TIES_PAIRS` (default 6) pairs of
+//! frames with and without the decisions, alternated, give the median
+//! wall and process CPU time of each and of their ratio: the figure to
+//! quote on a shared, noisy machine. `TIES_ONLY=on` (or `off`) renders
+//! `TIES_PAIRS` frames of that kind only and exits, for a profiler.
 //!
 //! Run: `cargo bench --bench ties`.
 

@@ -156,3 +156,123 @@ fn the_last_order_is_reused_only_when_nothing_it_depends_on_changed() {
     frag(&shading);
     assert!(frag(&revalued), "exact-frag: values alone keep the order");
 }
+
+/// Cells outside the view frustum (zoomed into a detail) are left out of
+/// the order before the sort (`zoovr::visibility::frustum`), with the image
+/// unchanged: the CPU twin, perspective and orthographic, on a convex grid
+/// and on a mesh with a hole (boundary constraints), the exact mode with
+/// whole cells and `--split all`, exact-frag and preint2d. A frustum shrunk by a few pixels leaves out visible
+/// cells, and that shows.
+///
+/// With whole cells, the one difference the cull may make is which cells
+/// in view a cycle splits into tets: a cycle that runs through cells out of
+/// view is not met any more. A cell drawn as its tets integrates the tets'
+/// field, so its pixels may differ by that model difference (measured
+/// 4e-4); the bound holds outside the pixels whose rays meet a cell split
+/// in one order and not in the other, and everywhere with `--split all`.
+#[test]
+fn cells_outside_the_frustum_are_left_out_and_the_image_is_unchanged() {
+    let grid = warped_hex_grid(
+        12,
+        &Warp {
+            amplitude: 0.08,
+            seed: 9,
+        },
+    );
+    let ring = zoovr::io::read(
+        std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/meshes/ring_hole.vtu")),
+        &Default::default(),
+    )
+    .unwrap();
+    let mut split_differs = 0;
+    // The ring's 64 cells are large: a closer view leaves some out.
+    for (name, mesh, closer) in [("grid", grid, 1.0), ("ring_hole", ring, 2.0)] {
+        let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        let shading = scene.shading();
+        let cells = scene.mesh.cells.len();
+        let mut renderer = Renderer::new(scene.geometry());
+        for (ortho, azimuth, zoom) in [(false, 30.0, 3.0), (true, 200.0, 2.5), (false, 120.0, 4.0)]
+        {
+            let runs = [
+                (Mode::Exact, false),
+                (Mode::Exact, true),
+                (Mode::ExactFrag, false),
+                (Mode::Preint2d, false),
+            ];
+            for (mode, split_all) in runs {
+                let params = zoovr::camera::CameraParams {
+                    width: 56,
+                    height: 48,
+                    azimuth,
+                    elevation: 20.0,
+                    zoom: zoom * closer,
+                    ortho,
+                    ..Default::default()
+                };
+                let opts = RenderOptions {
+                    mode,
+                    camera: params,
+                    projected: ProjectedOptions {
+                        compositor: Compositor::Cpu,
+                        split_all,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                };
+                let mut frame = |margin: Option<f64>| {
+                    renderer.sorter().frustum_margin = margin;
+                    let (img, stats) = renderer.render(&shading, &opts, |_, _| {}).unwrap();
+                    let culled = stats.projected().unwrap().order.frustum_culled;
+                    (img, culled, render_util::split_cells(&renderer, cells))
+                };
+                let case = format!(
+                    "{name} ortho {ortho} azimuth {azimuth} zoom {zoom} split all {split_all}"
+                );
+                let (all, none_culled, split_a) = frame(None);
+                assert_eq!(none_culled, 0);
+                let (culled, n, split_b) =
+                    frame(Some(zoovr::numeric::tolerance::FRUSTUM_MARGIN_PX));
+                assert!(
+                    n >= 3 && n * 20 >= cells,
+                    "{case}: {n} of {cells} cells left out"
+                );
+                // Cells in view that one order splits and the other not.
+                let camera = zoovr::camera::Camera::fit(scene.mesh.bounds(), &params);
+                let in_view: Vec<bool> = {
+                    let mut out = Vec::new();
+                    zoovr::visibility::frustum::outside_cells(&camera, &scene.mesh, 1.0, &mut out);
+                    out.iter().map(|o| !o).collect()
+                };
+                let differs: Vec<bool> = (0..cells)
+                    .map(|c| in_view[c] && split_a[c] != split_b[c])
+                    .collect();
+                let k = differs.iter().filter(|&&d| d).count();
+                if split_all {
+                    assert_eq!(k, 0, "{case}");
+                }
+                split_differs += k;
+                let mask = render_util::split_mask(&scene, &camera, &differs);
+                let (d, at) = render_util::max_outside(&culled, &all, &mask);
+                assert!(
+                    d <= 1e-6,
+                    "{case}: {d} at {at:?} ({k} cells split differently)"
+                );
+                let lit = all.pixels.iter().filter(|p| p[3] > 0.05).count();
+                assert!(lit > 200, "{case}: {lit} lit pixels");
+                // Shrunk by 14 pixels: cells seen near the image's edges go.
+                let (wrong, m, _) = frame(Some(-14.0));
+                assert!(m > n, "{case}");
+                let (d, _) = compare_float(&wrong, &all).unwrap();
+                assert!(
+                    d.max_abs > 0.01,
+                    "{case}: culling visible cells went unseen"
+                );
+            }
+        }
+    }
+    // The whole-cell exception is the one measured above, not the rule.
+    assert!(
+        split_differs < 100,
+        "{split_differs} cells split differently"
+    );
+}

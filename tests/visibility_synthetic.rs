@@ -33,8 +33,17 @@ fn random_camera(mesh: &Mesh, rng: &mut Rng, ortho: bool, size: u32) -> Camera {
     Camera::fit(mesh.bounds(), &p)
 }
 
-/// Every piece id appears once, every cell is covered exactly once.
-fn check_cover(mesh: &Mesh, order: &Order) {
+/// Every piece id appears once, every cell in view is covered exactly
+/// once, and the cells outside the view frustum not at all.
+fn check_cover(mesh: &Mesh, order: &Order, camera: &Camera) {
+    let mut outside = Vec::new();
+    let n = zoovr::visibility::frustum::outside_cells(
+        camera,
+        mesh,
+        zoovr::numeric::tolerance::FRUSTUM_MARGIN_PX,
+        &mut outside,
+    );
+    assert_eq!(order.stats.frustum_culled, n);
     let mut whole = vec![0u32; mesh.cells.len()];
     let mut tets = vec![0u32; mesh.cells.len()];
     for p in &order.pieces {
@@ -46,6 +55,10 @@ fn check_cover(mesh: &Mesh, order: &Order) {
         }
     }
     for c in 0..mesh.cells.len() {
+        if outside[c] {
+            assert_eq!((whole[c], tets[c]), (0, 0), "cell {c} is outside the view");
+            continue;
+        }
         assert!(
             (whole[c] == 1 && tets[c] == 0) || (whole[c] == 0 && tets[c] >= 2),
             "cell {c}: {} whole, {} tets",
@@ -65,7 +78,7 @@ fn run_views(mesh: &Mesh, views: usize, size: u32, seed: u64, policy: &SplitPoli
         let cam = random_camera(mesh, &mut rng, ortho, size);
         let order = sorter.order(&cam, policy).expect("order");
         sorter.sanity_check().expect("sanity");
-        check_cover(mesh, &order);
+        check_cover(mesh, &order, &cam);
         assert!(
             order.groups.is_empty(),
             "unresolved cycles: {:?}",

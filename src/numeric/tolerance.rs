@@ -66,6 +66,14 @@ pub const NEAR_CLIP_SCALE: f64 = 2.0;
 /// any margin of at least half a pixel loses nothing. A few pixels keep the
 /// window's own edges well away from every centre.
 pub const IMAGE_CLIP_MARGIN_PX: f64 = 4.0;
+/// Frustum culling ([`crate::visibility::frustum`]): a cell is left out of
+/// the order only when all its points lie beyond one side of the image's
+/// view pyramid (perspective) or box (orthographic) grown by this many
+/// pixels. The outermost pixel-centre rays are half a pixel inside the
+/// image's edge, so the grown side is 1.5 px from every ray; the rounding
+/// of a point's view coordinates (~1e-16 of its distance from the eye) is
+/// far below that at any image size.
+pub const FRUSTUM_MARGIN_PX: f64 = 1.0;
 /// Coverage culling ([`crate::projection::coverage`]): a region triangle is
 /// dropped only when no pixel centre lies within this many pixels of it.
 /// The GPU rasterises `f32` clip coordinates snapped to its sub-pixel grid:

@@ -30,6 +30,7 @@ struct Key {
     scalars: Option<(usize, u64)>,
     nonconvex: NonConvex,
     plane_split: bool,
+    frustum_margin: Option<f64>,
 }
 
 /// A 64-bit hash of the bits of `v` (FxHash-style mixing; equal slices hash
@@ -80,6 +81,7 @@ impl OrderCache {
                 .map(|s| (s.len(), hash_bits(s))),
             nonconvex: sorter.nonconvex,
             plane_split: sorter.plane_split,
+            frustum_margin: sorter.frustum_margin,
         };
         if let Some((k, order)) = &self.last {
             if *k == key {

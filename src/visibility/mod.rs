@@ -78,6 +78,7 @@
 //! pieces met by depth and checks that they are drawn back to front.
 
 pub mod bsp;
+pub mod frustum;
 mod geometry;
 mod input;
 mod raster;
@@ -166,6 +167,8 @@ pub struct OrderStats {
     pub cells: usize,
     /// Pieces in the order.
     pub pieces: usize,
+    /// Cells left out as outside the view frustum ([`frustum`]).
+    pub frustum_culled: usize,
     /// Cells drawn as tets in this view (all reasons).
     pub split_cells: usize,
     /// Tets emitted (whole or as slabs).

@@ -33,7 +33,7 @@ use crate::mesh::topology::Topology;
 use crate::mesh::{Cells, Mesh, NONE};
 use crate::numeric::predicates::orient_dir;
 use crate::numeric::predicates::{orient3d, Side};
-use crate::numeric::tolerance::PLANE_FILTER_EPS;
+use crate::numeric::tolerance::{FRUSTUM_MARGIN_PX, PLANE_FILTER_EPS};
 
 /// Split reasons (bits of `want`).
 const PROBLEM: u8 = 1;
@@ -106,7 +106,13 @@ pub struct Sorter {
     /// ([`super::bsp`]) before being left to per-pixel compositing
     /// (default: true).
     pub plane_split: bool,
+    /// Leave out the cells outside the view frustum grown by this many
+    /// pixels ([`super::frustum`]; default
+    /// [`FRUSTUM_MARGIN_PX`]); `None` keeps every cell.
+    pub frustum_margin: Option<f64>,
     // Per-view scratch.
+    /// Cells outside the frustum in this view.
+    culled: Vec<bool>,
     tri_sign: Vec<i8>,
     face_target: Vec<u32>,
     /// `face_target` by cell-face slot (`topo.cell_faces` layout), kept only
@@ -165,6 +171,8 @@ impl Sorter {
             invalid,
             nonconvex: NonConvex::PixelConstraints,
             plane_split: true,
+            frustum_margin: Some(FRUSTUM_MARGIN_PX),
+            culled: Vec::new(),
             tri_sign: vec![0; nt],
             face_target: vec![NONE; nf],
             slot_target: Vec::new(),
@@ -216,6 +224,16 @@ impl Sorter {
             ..Default::default()
         };
 
+        // 0. Cells outside the frustum.
+        stats.frustum_culled = match self.frustum_margin {
+            Some(m) => super::frustum::outside_cells(camera, &self.mesh, m, &mut self.culled),
+            None => {
+                self.culled.clear();
+                self.culled.resize(n, false);
+                0
+            }
+        };
+
         // 1. Classify faces.
         let t0 = Instant::now();
         self.want.clear();
@@ -226,6 +244,14 @@ impl Sorter {
             self.want[c as usize] |= NONCONVEX_CELL;
         }
         stats.nonconvex_cells = self.geom.nonconvex_cells.len();
+        if stats.frustum_culled > 0 {
+            // Nothing splits a cell that is not drawn.
+            for (w, &out) in self.want.iter_mut().zip(&self.culled) {
+                if out {
+                    *w = 0;
+                }
+            }
+        }
         stats.time_classify = t0.elapsed();
 
         // 2. Non-convex constraints at triangle level (once per view).
@@ -268,7 +294,8 @@ impl Sorter {
 
             let tk = Instant::now();
             let emitted = self.kahn(&graph);
-            let total_alive = n - self.pool.active.len() + (graph.pieces - n);
+            let total_alive =
+                n - stats.frustum_culled - self.pool.active.len() + (graph.pieces - n);
             if emitted.len() == total_alive {
                 let order = self.finish(emitted, Vec::new(), &graph, camera, policy, &mut stats);
                 stats.time_sort += tk.elapsed();
@@ -318,8 +345,18 @@ impl Sorter {
         let nf = self.topo.face_count();
         let mut fallbacks = 0usize;
         let mut problems = 0usize;
+        let culled = &self.culled;
         for f in 0..nf {
             let r = g.tri_off[f] as usize..g.tri_off[f + 1] as usize;
+            let [c0, c1] = self.topo.face_cells[f];
+            let out = [culled[c0 as usize], c1 != NONE && culled[c1 as usize]];
+            if out[0] && (c1 == NONE || out[1]) {
+                // Only cells left out (frustum) touch it: no constraint,
+                // and no side for the boundary rasteriser.
+                self.tri_sign[r].fill(0);
+                self.face_target[f] = NONE;
+                continue;
+            }
             let [m, amax] = g.face_err[f];
             let bound =
                 PLANE_FILTER_EPS * m as f64 * if vw == 1.0 { vmag + amax as f64 } else { dmag };
@@ -365,8 +402,21 @@ impl Sorter {
                 }
             }
             let flags = g.face_flags[f];
-            let [c0, c1] = self.topo.face_cells[f];
             let problem = pos > 0 && neg > 0;
+            if out[0] || out[1] {
+                // Between a cell in view and one left out: no constraint
+                // (the one left out is not drawn), but a problem face
+                // splits the cell in view as it would without the cull,
+                // so that the cells drawn are drawn the same.
+                if problem {
+                    problems += 1;
+                    let c = if out[0] { c1 } else { c0 };
+                    self.want[c as usize] |= PROBLEM;
+                }
+                self.tri_sign[r].fill(0);
+                self.face_target[f] = NONE;
+                continue;
+            }
             if flags & BOUNDARY != 0 {
                 self.face_target[f] = NONE;
                 if problem && flags & CONCAVE != 0 {
@@ -643,7 +693,8 @@ impl Sorter {
             .rev()
             .filter(|&v| {
                 self.indeg[v as usize] == 0
-                    && (v as usize >= n || self.pool.slot_of[v as usize] == NONE)
+                    && (v as usize >= n
+                        || (self.pool.slot_of[v as usize] == NONE && !self.culled[v as usize]))
             })
             .collect();
         while let Some(v) = stack.pop() {
@@ -692,6 +743,9 @@ impl Sorter {
         }
         for &c in &self.pool.active {
             done[c as usize] = true;
+        }
+        for (d, &out) in done.iter_mut().zip(&self.culled) {
+            *d |= out;
         }
         tarjan(
             graph.pieces,
