@@ -34,7 +34,7 @@ use zoovr::gpu::{Backend, Context, GpuOptions};
 use zoovr::image::compare_display;
 use zoovr::io::{self, ReadOptions};
 use zoovr::render::{Mode, RenderOptions, Renderer, Scene, SceneSpec};
-use zoovr::testdata::shared_file;
+use zoovr::testdata::{hex_shell_scene, shared_file};
 
 fn scenes() -> Vec<(&'static str, Scene, CameraParams)> {
     let mut out = Vec::new();
@@ -46,18 +46,10 @@ fn scenes() -> Vec<(&'static str, Scene, CameraParams)> {
             CameraParams::default(),
         ));
     }
-    if let (Some(p), Some(tf)) = (
-        shared_file("synthetic/hex_shell_zlib.vtu"),
-        shared_file("synthetic/bench_tf.json"),
-    ) {
-        let mesh = io::read(&p, &ReadOptions::default()).unwrap();
-        let spec = SceneSpec {
-            tf_file: Some(tf),
-            ..Default::default()
-        };
+    if let Some(scene) = hex_shell_scene() {
         out.push((
             "hex_shell",
-            Scene::build(mesh, &spec).unwrap(),
+            scene,
             CameraParams {
                 azimuth: 20.0,
                 elevation: 35.0,

@@ -19,7 +19,7 @@ use zoovr::camera::CameraParams;
 use zoovr::generate::{warped_hex_grid, Warp};
 use zoovr::io::{self, ReadOptions};
 use zoovr::render::{Mode, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec, Shading};
-use zoovr::testdata::shared_file;
+use zoovr::testdata::{hex_shell_scene, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
 fn scene() -> (&'static str, Scene) {
@@ -113,16 +113,8 @@ fn bench(c: &mut Criterion) {
 }
 
 fn frustum_scene() -> (&'static str, Scene) {
-    if let (Some(p), Some(tf)) = (
-        shared_file("synthetic/hex_shell_zlib.vtu"),
-        shared_file("synthetic/bench_tf.json"),
-    ) {
-        let mesh = io::read(&p, &ReadOptions::default()).expect("hex_shell");
-        let spec = SceneSpec {
-            tf_file: Some(tf),
-            ..Default::default()
-        };
-        return ("hex_shell", Scene::build(mesh, &spec).expect("scene"));
+    if let Some(scene) = hex_shell_scene() {
+        return ("hex_shell", scene);
     }
     let mesh = warped_hex_grid(
         60,

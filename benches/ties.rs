@@ -18,9 +18,8 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use zoovr::camera::CameraParams;
 use zoovr::generate::{warped_hex_grid, Warp};
-use zoovr::io::{self, ReadOptions};
 use zoovr::render::{Mode, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec};
-use zoovr::testdata::shared_file;
+use zoovr::testdata::hex_shell_scene;
 
 fn scene() -> (&'static str, Scene, CameraParams) {
     let camera = CameraParams {
@@ -31,20 +30,8 @@ fn scene() -> (&'static str, Scene, CameraParams) {
         zoom: 1.25,
         ..Default::default()
     };
-    if let (Some(p), Some(tf)) = (
-        shared_file("synthetic/hex_shell_zlib.vtu"),
-        shared_file("synthetic/bench_tf.json"),
-    ) {
-        let mesh = io::read(&p, &ReadOptions::default()).expect("hex_shell");
-        let spec = SceneSpec {
-            tf_file: Some(tf),
-            ..Default::default()
-        };
-        return (
-            "hex_shell",
-            Scene::build(mesh, &spec).expect("scene"),
-            camera,
-        );
+    if let Some(scene) = hex_shell_scene() {
+        return ("hex_shell", scene, camera);
     }
     let mesh = warped_hex_grid(
         40,

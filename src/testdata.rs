@@ -76,6 +76,21 @@ pub fn read_options(rel: &str) -> crate::io::ReadOptions {
     o
 }
 
+/// The hex_shell benchmark scene (`synthetic/hex_shell_zlib.vtu`: 250,047
+/// curvilinear hexahedra in a twisted, C-shaped annular sector, with
+/// `synthetic/bench_tf.json`), shared by the benchmarks; `None` without the
+/// shared data.
+pub fn hex_shell_scene() -> Option<crate::render::Scene> {
+    let mesh = shared_file("synthetic/hex_shell_zlib.vtu")?;
+    let tf = shared_file("synthetic/bench_tf.json")?;
+    let mesh = crate::io::read(&mesh, &crate::io::ReadOptions::default()).ok()?;
+    let spec = crate::render::SceneSpec {
+        tf_file: Some(tf),
+        ..Default::default()
+    };
+    crate::render::Scene::build(mesh, &spec).ok()
+}
+
 /// xorshift64* (Vigna): the seeded generator of the tests and benchmarks
 /// (fixed seeds, reproducible runs, no dependency). The seed must not be 0.
 #[derive(Clone, Debug)]

@@ -1,5 +1,6 @@
 //! Work a scene does not need, skipped with the image unchanged: pieces
-//! whose scalar range maps to zero extinction are not projected, and the
+//! whose scalar range maps to zero extinction are not projected (nor their
+//! cells split at breakpoints by the sort), and the
 //! image is the same bit for bit (within 1e-6 in float) as with every piece
 //! drawn, in every projected mode, through the CPU twin and on the GPU
 //! where there is one. A skip that left out a visible piece would change
@@ -27,10 +28,18 @@ fn dark_pieces_are_skipped_and_the_image_is_unchanged() {
     let mut shading = scene.shading();
     let (lo, hi) = shading.range;
     // Visible only in the top tenth of the range: most cells are dark.
+    // The colours jump in the middle of the dark part (a discrete colour
+    // map), where the exact mode splits at a colour jump.
     let b = lo + 0.9 * (hi - lo);
+    let mid = lo + 0.5 * (hi - lo);
     shading.tf = TransferFunction::from_channels(
         &[(lo, [0.0]), (b, [0.0]), (hi, [8.0])],
-        &[(lo, [0.2, 0.4, 1.0]), (hi, [1.0, 0.8, 0.1])],
+        &[
+            (lo, [0.2, 0.4, 1.0]),
+            (mid, [0.3, 0.5, 0.9]),
+            (mid, [0.9, 0.1, 0.1]),
+            (hi, [1.0, 0.8, 0.1]),
+        ],
         None,
         EmissionModel::Glow,
     )
@@ -72,6 +81,15 @@ fn dark_pieces_are_skipped_and_the_image_is_unchanged() {
                 p_with.pieces
             );
             assert!(p_with.triangles < p_without.triangles / 2, "{mode:?}");
+            // Dark cells are not split at breakpoints either (the sort's
+            // share of the skip): the exact mode splits at the transfer
+            // function's kinks, most of which lie in the dark range here.
+            assert_eq!(p_without.order.dark_unsplit, 0, "{mode:?}");
+            if mode == Mode::Exact {
+                let (a, b) = (&p_with.order, &p_without.order);
+                assert!(a.dark_unsplit > 0, "{mode:?}: {a:?}");
+                assert_eq!(a.breakpoint_cells + a.dark_unsplit, b.breakpoint_cells);
+            }
             let (d, _) = compare_float(&with, &without).unwrap();
             assert!(d.max_abs <= 1e-6, "{mode:?} {compositor:?}: {d:?}");
             // Something is drawn at all (the test could not fail otherwise).

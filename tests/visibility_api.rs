@@ -85,6 +85,7 @@ fn breakpoint_cells_match_brute_force() {
         all: false,
         breakpoints: &bps,
         point_scalars: Some(&scalars),
+        dark: None,
     };
     let o = s.order(&cam(&mesh, 10.0, 10.0, false), &pol).unwrap();
     assert_eq!(o.stats.breakpoint_cells, want);
@@ -140,6 +141,7 @@ fn slabs_are_listed_back_to_front() {
         all: false,
         breakpoints: &bps,
         point_scalars: Some(&scalars),
+        dark: None,
     };
     let mut checked = 0;
     for (az, el, ortho) in [
@@ -281,6 +283,7 @@ fn bad_input_is_a_typed_error() {
         all: false,
         breakpoints: &[1.5],
         point_scalars: Some(&short),
+        dark: None,
     };
     assert!(matches!(
         s.order(&c, &pol),

@@ -23,7 +23,7 @@ proptest! {
         prop_assume!(!mesh.cells.is_empty());
         let scalars: Vec<f64> = mesh.points.iter().map(|p| p.x + 0.5 * p.y).collect();
         let bps: Vec<f64> = breakpoint.into_iter().collect();
-        let policy = SplitPolicy { all: false, breakpoints: &bps, point_scalars: Some(&scalars) };
+        let policy = SplitPolicy { all: false, breakpoints: &bps, point_scalars: Some(&scalars), dark: None };
         let topo = Topology::build(&mesh.cells);
         let mut sorter = Sorter::new(mesh.clone(), topo);
         for (az, el, ortho) in views {

@@ -60,7 +60,7 @@ use crate::gpu::{
 use crate::image::Image;
 use crate::projection::coverage::PixelGrid;
 use crate::projection::{Polyhedron, Projected, Projector};
-use crate::visibility::{Piece, Sorter, SplitPolicy};
+use crate::visibility::{DarkRanges, Piece, Sorter, SplitPolicy};
 
 pub use super::projected_mode::ProjectedMode;
 
@@ -540,10 +540,19 @@ pub fn render_projected<M: ProjectedMode>(
         _ => None,
     };
     let t0 = Instant::now();
+    // Dark cells (drawn by no piece) are not split at breakpoints: the
+    // same test as the pieces' skip, and only where that skip is on.
+    let (iso, volume) = (mode.isosurfaces(), mode.draws_volume());
+    let dark_test = |lo: f64, hi: f64| super::pieces::dark_range(&scene.tf, iso, volume, lo, hi);
+    let dark = opts.projected.skip_invisible.then(|| DarkRanges {
+        test: &dark_test,
+        key: super::pieces::dark_key(&scene.tf, iso, volume),
+    });
     let policy = SplitPolicy {
         all: opts.projected.split_all,
         breakpoints: &breakpoints,
         point_scalars,
+        dark,
     };
     let (order, reused) = orders.order(sorter, camera, &policy)?;
     stats.order_reused = reused;
@@ -745,6 +754,7 @@ mod tests {
             all: true,
             breakpoints: &breakpoints,
             point_scalars,
+            dark: None,
         };
         let mut sorter = Sorter::new(scene.mesh.clone(), scene.topology.clone());
         let order = sorter.order(&camera, &policy).unwrap();
@@ -808,6 +818,7 @@ mod tests {
             all: true,
             breakpoints: &breakpoints,
             point_scalars: None,
+            dark: None,
         };
         let mut sorter = Sorter::new(scene.mesh.clone(), scene.topology.clone());
         let order = sorter.order(&camera, &policy).unwrap();

@@ -31,6 +31,8 @@ struct Key {
     nonconvex: NonConvex,
     plane_split: bool,
     frustum_margin: Option<f64>,
+    /// What decides which cells are dark (not split).
+    dark: Option<u64>,
 }
 
 /// A 64-bit hash of the bits of `v` (FxHash-style mixing; equal slices hash
@@ -82,6 +84,11 @@ impl OrderCache {
             nonconvex: sorter.nonconvex,
             plane_split: sorter.plane_split,
             frustum_margin: sorter.frustum_margin,
+            // Only where scalars decide splits.
+            dark: policy
+                .dark
+                .filter(|_| policy.point_scalars.is_some() && !policy.breakpoints.is_empty())
+                .map(|d| d.key),
         };
         if let Some((k, order)) = &self.last {
             if *k == key {

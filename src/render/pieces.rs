@@ -438,30 +438,76 @@ impl PieceSource<'_> {
     /// not only the mode's split points: a mode that slices at none still
     /// skips only what is truly dark.
     pub fn invisible(&self, lo: f64, hi: f64) -> bool {
-        if !(self.skip_invisible && lo.is_finite() && hi.is_finite()) {
-            return false;
-        }
-        if self.iso.is_some_and(|set| set.any_in(lo, hi)) {
-            return false;
-        }
-        if !self.volume {
-            return true;
-        }
-        let dark = |s: f64| {
-            let m = self.tf.material(s);
-            m.tau == 0.0 && m.source == [0.0; 3]
-        };
-        if !dark(lo) || !dark(hi) {
-            return false;
-        }
-        for &b in self.tf.breakpoints_slice() {
-            if b >= lo && b <= hi {
-                let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
-                if !dark(b) || !dark(left) {
-                    return false;
-                }
+        self.skip_invisible && dark_range(self.tf, self.iso, self.volume, lo, hi)
+    }
+}
+
+/// Whether nothing of a piece with scalars in `[lo, hi]` is drawn (see
+/// [`PieceSource::invisible`], which asks this where skipping is on): no
+/// isosurface of `iso` in it, and the volume not drawn or `tf` dark over
+/// the whole interval. The visibility sort asks the same of whole cells
+/// ([`crate::visibility::SplitPolicy::dark`]), so that a dark cell is not
+/// split at breakpoints.
+pub fn dark_range(
+    tf: &TransferFunction,
+    iso: Option<&IsoSet>,
+    volume: bool,
+    lo: f64,
+    hi: f64,
+) -> bool {
+    if !(lo.is_finite() && hi.is_finite()) {
+        return false;
+    }
+    if iso.is_some_and(|set| set.any_in(lo, hi)) {
+        return false;
+    }
+    if !volume {
+        return true;
+    }
+    let dark = |s: f64| {
+        let m = tf.material(s);
+        m.tau == 0.0 && m.source == [0.0; 3]
+    };
+    if !dark(lo) || !dark(hi) {
+        return false;
+    }
+    for &b in tf.breakpoints_slice() {
+        if b >= lo && b <= hi {
+            let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
+            if !dark(b) || !dark(left) {
+                return false;
             }
         }
-        true
     }
+    true
+}
+
+/// A 64-bit key of what [`dark_range`] answers with these inputs: the
+/// transfer function's nodes and darkness on both sides of each and
+/// beyond its ends (piecewise linear between them), the isosurface
+/// levels, and whether the volume is drawn. Equal keys give equal
+/// answers, but for a 2^-64 chance.
+pub fn dark_key(tf: &TransferFunction, iso: Option<&IsoSet>, volume: bool) -> u64 {
+    const K: u64 = 0x517c_c1b7_2722_0a95;
+    let mut h = volume as u64;
+    let mut mix = |x: u64| h = (h.rotate_left(5) ^ x).wrapping_mul(K);
+    let dark = |s: f64| {
+        let m = tf.material(s);
+        (m.tau == 0.0 && m.source == [0.0; 3]) as u64
+    };
+    let nodes = tf.breakpoints_slice();
+    for &b in nodes {
+        let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
+        mix(b.to_bits());
+        mix(dark(b) << 1 | dark(left));
+    }
+    if let (Some(&first), Some(&last)) = (nodes.first(), nodes.last()) {
+        mix(dark(first - first.abs().max(1.0)) << 1 | dark(last + last.abs().max(1.0)));
+    } else {
+        mix(dark(0.0));
+    }
+    for &v in iso.map(|s| &s.levels[..]).unwrap_or(&[]) {
+        mix(v.to_bits());
+    }
+    h
 }

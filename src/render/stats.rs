@@ -59,12 +59,13 @@ impl fmt::Display for ProjectedStats {
         let (e, o) = (self, &self.order);
         writeln!(
             f,
-            "sort         {:.3} s{}  ({} pieces, {} cells outside the view, {} split cells, {} problem cells, {} cycles, {} cut by planes into {} fragments, {} cycle groups of {} pieces over {} pixels)",
+            "sort         {:.3} s{}  ({} pieces, {} cells outside the view, {} split cells, {} dark cells left whole, {} problem cells, {} cycles, {} cut by planes into {} fragments, {} cycle groups of {} pieces over {} pixels)",
             e.sort_s,
             if e.order_reused { ", order reused" } else { "" },
             e.pieces,
             o.frustum_culled,
             o.split_cells,
+            o.dark_unsplit,
             o.problem_cells,
             o.cycles_found,
             o.cycles_resolved_by_planes,

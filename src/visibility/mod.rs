@@ -158,6 +158,29 @@ pub struct SplitPolicy<'a> {
     /// are split into tets, and those tets whose range strictly contains
     /// one are listed as slabs ([`Piece::Slab`]).
     pub point_scalars: Option<&'a [f64]>,
+    /// Scalar ranges nothing is drawn for (the renderer's dark pieces):
+    /// a cell whose nodal range is one is not split at breakpoints. Whole
+    /// or as its tets it carries the same constraints between the pieces
+    /// drawn, and it is drawn by neither.
+    pub dark: Option<DarkRanges<'a>>,
+}
+
+/// Which nodal ranges `[lo, hi]` are drawn by no piece ([`SplitPolicy::dark`]).
+#[derive(Clone, Copy)]
+pub struct DarkRanges<'a> {
+    /// Whether nothing is drawn for a piece with scalars in `[lo, hi]`.
+    pub test: &'a (dyn Fn(f64, f64) -> bool + Sync),
+    /// Equal for two tests that answer alike: orders are reused on it
+    /// (`render::order_cache`).
+    pub key: u64,
+}
+
+impl std::fmt::Debug for DarkRanges<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DarkRanges")
+            .field("key", &self.key)
+            .finish()
+    }
 }
 
 /// What one call of [`Sorter::order`] did.
@@ -183,6 +206,9 @@ pub struct OrderStats {
     pub problem_cells: usize,
     /// Cells split because their scalar range holds a breakpoint.
     pub breakpoint_cells: usize,
+    /// Cells whose scalar range holds a breakpoint but is dark
+    /// ([`SplitPolicy::dark`]): left whole.
+    pub dark_unsplit: usize,
     /// Cells split because they are non-convex beyond their face diagonals
     /// (distorted cells; split in every view).
     pub nonconvex_cells: usize,

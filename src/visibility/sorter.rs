@@ -457,7 +457,7 @@ impl Sorter {
             stats.all_split_cells = n;
         }
         if let (Some(s), false) = (policy.point_scalars, policy.breakpoints.is_empty()) {
-            let mut count = 0;
+            let (mut count, mut dark) = (0, 0);
             for c in 0..n {
                 let mut lo = f64::INFINITY;
                 let mut hi = f64::NEG_INFINITY;
@@ -467,11 +467,16 @@ impl Sorter {
                     hi = hi.max(x);
                 }
                 if policy.breakpoints.iter().any(|&b| lo < b && b < hi) {
-                    self.want[c] |= BREAKPOINT;
-                    count += 1;
+                    if policy.dark.is_some_and(|d| (d.test)(lo, hi)) {
+                        dark += 1;
+                    } else {
+                        self.want[c] |= BREAKPOINT;
+                        count += 1;
+                    }
                 }
             }
             stats.breakpoint_cells = count;
+            stats.dark_unsplit = dark;
         }
     }
 
