@@ -7,7 +7,9 @@
 //! the tets whose nodal scalar range strictly holds a transfer-function
 //! breakpoint (consecutive, back to front along the gradient: [`slabs`]).
 //! A piece is drawn after every piece it occludes at the image's pixel
-//! centres.
+//! centres. Cells no pixel-centre ray meets (outside the view frustum,
+//! [`frustum`]) are left out; cells the renderer draws nothing of
+//! ([`SplitPolicy::dark`]) are not split at breakpoints.
 //!
 //! # How it works
 //! 1. **Per geometry** ([`Sorter::new`]): every unique face is split into its
