@@ -44,9 +44,13 @@
 //!    at image resolution.
 //! 4. **Topological sort** (Kahn) back to front.
 //! 5. **Cycles**: pieces Kahn cannot emit are grouped into strongly connected
-//!    components (Tarjan, [`scc`]). Whole cells in a cycle are split into
-//!    consistent tets and everything is re-sorted (at most
-//!    [`MAX_SPLIT_ROUNDS`] rounds). A cycle of tets that remains is cut by
+//!    components (Tarjan, [`scc`]). The whole cells on cycles are split
+//!    into consistent tets and everything is re-sorted (at most
+//!    [`MAX_SPLIT_ROUNDS`] rounds): one depth-first search per component
+//!    finds vertex-disjoint cycles and only their members are split (a
+//!    large component held together by a few cycles: on the generated
+//!    1M-hex grid 49k cells rather than 444k), and in the last round every
+//!    whole cell of a component is. A cycle of tets that remains is cut by
 //!    planes through faces of its members ([`bsp`], an auto-partition
 //!    restricted to the cycle): the far side of a plane is drawn before the
 //!    near side, so the fragments ([`Piece::Frag`], [`Order::fragments`])
@@ -99,7 +103,7 @@ use std::time::Duration;
 pub use sorter::{NonConvex, Sorter};
 pub use validate::{sample_pixels, validate, Violation, Violations};
 
-/// Rounds of "split the whole cells of every cycle, then sort again" before
+/// Rounds of "split the whole cells on cycles, then sort again" before
 /// the remaining cycles are emitted as groups (composited per pixel).
 pub const MAX_SPLIT_ROUNDS: usize = 4;
 
@@ -218,6 +222,9 @@ pub struct OrderStats {
     pub all_split_cells: usize,
     /// Cells split to break a cycle.
     pub cycle_split_cells: usize,
+    /// Whole cells in the strongly connected components met (all rounds):
+    /// what splitting every member of a component would split.
+    pub cycle_component_cells: usize,
     /// Cells newly split in this view (not split in the previous one).
     pub newly_split: usize,
     /// Cells restored to whole cells (split in the previous view only).

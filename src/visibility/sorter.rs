@@ -113,6 +113,8 @@ pub struct Sorter {
     // Per-view scratch.
     /// Cells outside the frustum in this view.
     culled: Vec<bool>,
+    /// Per piece, scratch of [`Sorter::cycle_members`].
+    dfs_state: Vec<u8>,
     tri_sign: Vec<i8>,
     face_target: Vec<u32>,
     /// `face_target` by cell-face slot (`topo.cell_faces` layout), kept only
@@ -173,6 +175,7 @@ impl Sorter {
             plane_split: true,
             frustum_margin: Some(FRUSTUM_MARGIN_PX),
             culled: Vec::new(),
+            dfs_state: Vec::new(),
             tri_sign: vec![0; nt],
             face_target: vec![NONE; nf],
             slot_target: Vec::new(),
@@ -308,9 +311,19 @@ impl Sorter {
             stats.cycles_found += cycles.len();
             let mut new_split = 0;
             if stats.rounds <= MAX_SPLIT_ROUNDS {
+                let mut state = std::mem::take(&mut self.dfs_state);
+                state.clear();
+                state.resize(graph.pieces, 0);
                 for comp in &cycles {
+                    stats.cycle_component_cells +=
+                        comp.iter().filter(|&&p| (p as usize) < n).count();
                     let mut any = false;
-                    for &p in comp.iter() {
+                    let members = if stats.rounds < MAX_SPLIT_ROUNDS {
+                        self.cycle_members(&graph, comp, &mut state)
+                    } else {
+                        comp.to_vec()
+                    };
+                    for &p in members.iter() {
                         if (p as usize) < n && self.want[p as usize] == 0 {
                             self.want[p as usize] = CYCLE;
                             new_split += 1;
@@ -321,6 +334,7 @@ impl Sorter {
                         stats.cycles_resolved_by_split += 1;
                     }
                 }
+                self.dfs_state = state;
             }
             stats.cycle_split_cells += new_split;
             if new_split == 0 {
@@ -737,6 +751,80 @@ impl Sorter {
             }
         }
         out
+    }
+
+    /// The members of vertex-disjoint cycles of the strongly connected
+    /// component `comp`, found by one depth-first search inside it: each
+    /// back edge closes a cycle, whose members are taken and leave the
+    /// search. Splitting them breaks every cycle the search met; one it did
+    /// not meet (through members taken) is left to the next round. A large
+    /// component held together by a few cycles splits a few cells, not all
+    /// of it. `state` is zero per piece and is left zero.
+    fn cycle_members(&self, graph: &RoundGraph, comp: &[u32], state: &mut [u8]) -> Vec<u32> {
+        const UNSEEN: u8 = 1;
+        const ON_PATH: u8 = 2;
+        const DONE: u8 = 3;
+        let n = self.mesh.cells.len();
+        for &v in comp {
+            state[v as usize] = UNSEEN;
+        }
+        let out_of = |v: u32, out: &mut Vec<u32>| {
+            out.clear();
+            if (v as usize) < n {
+                for &f in self.topo.faces_of(v as usize) {
+                    let t = self.face_target[f as usize];
+                    if t != NONE && t != v {
+                        out.push(t);
+                    }
+                }
+            }
+            out.extend_from_slice(self.graph_out(graph, v));
+        };
+        let mut members = Vec::new();
+        // Frames: (piece, its out-neighbours, next one to look at).
+        let mut path: Vec<(u32, Vec<u32>, usize)> = Vec::new();
+        let mut spare: Vec<Vec<u32>> = Vec::new();
+        for &root in comp {
+            if state[root as usize] != UNSEEN {
+                continue;
+            }
+            let mut nb = spare.pop().unwrap_or_default();
+            out_of(root, &mut nb);
+            state[root as usize] = ON_PATH;
+            path.push((root, nb, 0));
+            while let Some(top) = path.last_mut() {
+                if top.2 == top.1.len() {
+                    let (v, nb, _) = path.pop().expect("non-empty");
+                    state[v as usize] = DONE;
+                    spare.push(nb);
+                    continue;
+                }
+                let w = top.1[top.2];
+                top.2 += 1;
+                match state[w as usize] {
+                    UNSEEN => {
+                        let mut nb = spare.pop().unwrap_or_default();
+                        out_of(w, &mut nb);
+                        state[w as usize] = ON_PATH;
+                        path.push((w, nb, 0));
+                    }
+                    ON_PATH => {
+                        // A cycle: the path from w to the top.
+                        let at = path.iter().rposition(|f| f.0 == w).expect("on the path");
+                        for (v, nb, _) in path.drain(at..) {
+                            members.push(v);
+                            state[v as usize] = DONE;
+                            spare.push(nb);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        for &v in comp {
+            state[v as usize] = 0;
+        }
+        members
     }
 
     /// Strongly connected components of the pieces Kahn left (sinks first).
