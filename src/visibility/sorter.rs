@@ -764,21 +764,12 @@ impl Sorter {
         const UNSEEN: u8 = 1;
         const ON_PATH: u8 = 2;
         const DONE: u8 = 3;
-        let n = self.mesh.cells.len();
         for &v in comp {
             state[v as usize] = UNSEEN;
         }
         let out_of = |v: u32, out: &mut Vec<u32>| {
             out.clear();
-            if (v as usize) < n {
-                for &f in self.topo.faces_of(v as usize) {
-                    let t = self.face_target[f as usize];
-                    if t != NONE && t != v {
-                        out.push(t);
-                    }
-                }
-            }
-            out.extend_from_slice(self.graph_out(graph, v));
+            self.successors(graph, v, out);
         };
         let mut members = Vec::new();
         // Frames: (piece, its out-neighbours, next one to look at).
@@ -829,7 +820,6 @@ impl Sorter {
 
     /// Strongly connected components of the pieces Kahn left (sinks first).
     fn components(&self, graph: &RoundGraph, emitted: &[u32]) -> Vec<Vec<u32>> {
-        let n = self.mesh.cells.len();
         let mut done = vec![false; graph.pieces];
         for &v in emitted {
             done[v as usize] = true;
@@ -843,18 +833,23 @@ impl Sorter {
         tarjan(
             graph.pieces,
             |v| !done[v as usize],
-            |v, out| {
-                if (v as usize) < n {
-                    for &f in self.topo.faces_of(v as usize) {
-                        let t = self.face_target[f as usize];
-                        if t != NONE && t != v {
-                            out.push(t);
-                        }
-                    }
-                }
-                out.extend_from_slice(self.graph_out(graph, v));
-            },
+            |v, out| self.successors(graph, v, out),
         )
+    }
+
+    /// Appends to `out` the pieces drawn after piece `v` by this round's
+    /// constraints: across the faces of a whole cell, and the round graph's
+    /// edges.
+    fn successors(&self, graph: &RoundGraph, v: u32, out: &mut Vec<u32>) {
+        if (v as usize) < self.mesh.cells.len() {
+            for &f in self.topo.faces_of(v as usize) {
+                let t = self.face_target[f as usize];
+                if t != NONE && t != v {
+                    out.push(t);
+                }
+            }
+        }
+        out.extend_from_slice(self.graph_out(graph, v));
     }
 }
 
