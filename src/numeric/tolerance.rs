@@ -74,6 +74,13 @@ pub const IMAGE_CLIP_MARGIN_PX: f64 = 4.0;
 /// of a point's view coordinates (~1e-16 of its distance from the eye) is
 /// far below that at any image size.
 pub const FRUSTUM_MARGIN_PX: f64 = 1.0;
+/// Occlusion culling ([`crate::render::occlusion`]): a piece is left out
+/// when the optical depth in front of every pixel centre it may cover is
+/// at least `ln(brightest colour / this)`, so what it would add changes no
+/// premultiplied channel by more than this: ten times below the 1e-6 the
+/// image tests allow, and below the ray caster's own
+/// [`RAY_TERMINATION_TRANSMITTANCE`].
+pub const OCCLUSION_TRANSMITTANCE: f64 = 1e-7;
 /// Coverage culling ([`crate::projection::coverage`]): a region triangle is
 /// dropped only when no pixel centre lies within this many pixels of it.
 /// The GPU rasterises `f32` clip coordinates snapped to its sub-pixel grid:

@@ -22,6 +22,7 @@ mod group;
 pub mod iso;
 pub mod marching;
 pub mod modes;
+pub mod occlusion;
 mod options;
 mod order_cache;
 pub mod pieces;

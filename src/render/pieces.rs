@@ -429,6 +429,26 @@ impl PieceSource<'_> {
         }
     }
 
+    /// The least extinction (per unit length) the transfer function takes
+    /// on `[lo, hi]` (at its ends and on both sides of every node inside),
+    /// 0 when not a number: what a segment with scalars in `[lo, hi]`
+    /// absorbs at least per unit length ([`super::occlusion`]).
+    pub fn min_extinction(&self, lo: f64, hi: f64) -> f64 {
+        let tau = |s: f64| self.tf.material(s).tau;
+        let mut t = tau(lo).min(tau(hi));
+        for &b in self.tf.breakpoints_slice() {
+            if b >= lo && b <= hi {
+                let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
+                t = t.min(tau(b)).min(tau(left));
+            }
+        }
+        if t.is_nan() {
+            0.0
+        } else {
+            t
+        }
+    }
+
     /// Whether nothing of a piece with scalars in `[lo, hi]` is drawn: it
     /// holds no isosurface, and the volume is not drawn or the material is
     /// dark over the whole interval: zero

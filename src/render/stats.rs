@@ -26,6 +26,14 @@ pub struct ProjectedStats {
     /// Pixel centres next to a part's outline that snapping would have put
     /// on the wrong side, decided by a pixel quad ([`super::ties`]).
     pub tie_pixels: usize,
+    /// Triangles steep enough that the snap of their corners would shift
+    /// the optical depth, drawn with the exact triangle's values at the
+    /// snapped corners ([`super::ties::snap_is_steep`]).
+    pub steep_triangles: usize,
+    /// Pieces left out as hidden behind opaque ones
+    /// ([`super::occlusion`]), and the time the pass took.
+    pub hidden_pieces: usize,
+    pub occlusion_s: f64,
     /// Pixels of the per-pixel layers of cycle groups
     /// ([`super::group`]).
     pub group_pixels: usize,
@@ -84,8 +92,13 @@ impl fmt::Display for ProjectedStats {
         )?;
         writeln!(
             f,
-            "project+draw {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles, {} tie pixels)",
-            e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles, e.tie_pixels
+            "occlusion    {:.3} s  ({} pieces hidden behind opaque ones)",
+            e.occlusion_s, e.hidden_pieces
+        )?;
+        writeln!(
+            f,
+            "project+draw {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles, {} tie pixels, {} steep triangles)",
+            e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles, e.tie_pixels, e.steep_triangles
         )?;
         if let Some(t) = &e.table {
             writeln!(
