@@ -294,3 +294,108 @@ fn cells_outside_the_frustum_are_left_out_and_the_image_is_unchanged() {
         "{split_differs} cells split differently"
     );
 }
+
+/// A warped grid whose field rises with depth along `camera`'s view: the
+/// front layer (the lowest third of the values) is opaque.
+fn front_opaque_scene(camera_params: &zoovr::camera::CameraParams) -> Scene {
+    let mut mesh = warped_hex_grid(
+        14,
+        &Warp {
+            amplitude: 0.08,
+            seed: 5,
+        },
+    );
+    let camera = zoovr::camera::Camera::fit(mesh.bounds(), camera_params);
+    let depth: Vec<f64> = mesh.points.iter().map(|&p| camera.to_view(p).z).collect();
+    let (lo, hi) = depth
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &d| (a.min(d), b.max(d)));
+    let f = mesh
+        .point_data
+        .iter_mut()
+        .find(|a| a.name == "f")
+        .expect("generated field");
+    f.data = zoovr::field::ArrayData::F64(depth.iter().map(|d| (d - lo) / (hi - lo)).collect());
+    f.vtk_type = "Float64".into();
+    let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+    scene.tf = TransferFunction::from_channels(
+        &[(0.0, [400.0]), (0.3, [400.0]), (0.35, [2.0]), (1.0, [3.0])],
+        &[
+            (0.0, [0.9, 0.3, 0.2]),
+            (0.5, [0.2, 0.8, 0.3]),
+            (1.0, [0.2, 0.3, 1.0]),
+        ],
+        None,
+        EmissionModel::Glow,
+    )
+    .unwrap();
+    scene
+}
+
+#[test]
+fn pieces_behind_opaque_ones_are_left_out_and_the_image_is_unchanged() {
+    for (ortho, azimuth, elevation) in [
+        (false, 30.0, 20.0),
+        (true, 200.0, -35.0),
+        (false, 110.0, 60.0),
+    ] {
+        let params = zoovr::camera::CameraParams {
+            width: 48,
+            height: 40,
+            azimuth,
+            elevation,
+            ortho,
+            ..Default::default()
+        };
+        let scene = front_opaque_scene(&params);
+        let shading = scene.shading();
+        let mut renderer = Renderer::new(scene.geometry());
+        let runs = [
+            (Mode::Exact, false),
+            (Mode::Exact, true),
+            (Mode::ExactFrag, false),
+            (Mode::Preint2d, false),
+        ];
+        for (mode, split_all) in runs {
+            let case = format!("ortho {ortho} azimuth {azimuth} {mode:?} split all {split_all}");
+            let mut frame = |occlusion: Option<f64>| {
+                let opts = RenderOptions {
+                    mode,
+                    camera: params,
+                    projected: ProjectedOptions {
+                        compositor: Compositor::Cpu,
+                        split_all,
+                        occlusion,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                };
+                let (img, stats) = renderer.render(&shading, &opts, |_, _| {}).unwrap();
+                let p = stats.projected().unwrap();
+                (img, p.hidden_pieces, p.pieces)
+            };
+            let (all, none, pieces) = frame(None);
+            assert_eq!(none, 0, "{case}");
+            let (culled, hidden, _) =
+                frame(Some(zoovr::numeric::tolerance::OCCLUSION_TRANSMITTANCE));
+            eprintln!("{case}: {hidden} of {pieces} pieces hidden");
+            assert!(
+                hidden * 5 >= pieces,
+                "{case}: {hidden} of {pieces} pieces hidden"
+            );
+            let (d, _) = compare_float(&culled, &all).unwrap();
+            assert!(d.max_abs <= 1e-6, "{case}: {:e}", d.max_abs);
+            let lit = all.pixels.iter().filter(|p| p[3] > 0.5).count();
+            assert!(lit > 300, "{case}: {lit} lit pixels");
+            // Hiding what lies behind half the light is visible.
+            let (wrong, more, _) = frame(Some(0.5));
+            assert!(more > hidden, "{case}");
+            let (d, _) = compare_float(&wrong, &all).unwrap();
+            assert!(
+                d.max_abs > 0.01,
+                "{case}: hiding visible pieces went unseen ({:e})",
+                d.max_abs
+            );
+        }
+    }
+}

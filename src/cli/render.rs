@@ -138,6 +138,13 @@ pub struct ViewArgs {
     /// to the ray caster, higher draws fewer triangles.
     #[arg(long, value_name = "T", value_parser = parse_positive)]
     pub refine_tol: Option<f64>,
+    /// Projected modes: draw the pieces hidden behind opaque ones too. By
+    /// default a front-to-back pass over the order leaves out every piece
+    /// whose pixels already lie behind an optical depth that lets through
+    /// less than 1e-7 of its light (the image changes by at most that);
+    /// this flag turns the pass off, to compare or measure it.
+    #[arg(long)]
+    pub no_occlusion: bool,
     /// Background colour R,G,B in [0,1] for PNG output.
     #[arg(long, value_parser = parse_rgb, default_value = "0,0,0")]
     pub background: [f32; 3],
@@ -194,6 +201,8 @@ impl ViewArgs {
                 refine_tol: self
                     .refine_tol
                     .unwrap_or(zoovr::numeric::tolerance::COLOR_REFINE_TOL),
+                occlusion: (!self.no_occlusion)
+                    .then_some(zoovr::numeric::tolerance::OCCLUSION_TRANSMITTANCE),
                 ..Default::default()
             },
             gpu: GpuOptions {

@@ -694,9 +694,11 @@ pub fn render_projected<M: ProjectedMode>(
     // Pieces hidden behind opaque ones are left out (not when counting
     // coverage, which counts every piece).
     let t_occ = Instant::now();
-    let occlusion = (opts.projected.occlusion && opts.projected.draw == DrawKind::Composite)
-        .then(|| super::occlusion::hidden_pieces(&src, &order))
-        .flatten()
+    let occlusion = opts
+        .projected
+        .occlusion
+        .filter(|_| opts.projected.draw == DrawKind::Composite)
+        .and_then(|t| super::occlusion::hidden_pieces(&src, &order, t))
         .filter(|o| o.count > 0);
     stats.occlusion_s = t_occ.elapsed().as_secs_f64();
     stats.hidden_pieces = occlusion.as_ref().map_or(0, |o| o.count);

@@ -18,43 +18,47 @@
 //! piece gets, whatever the geometry (cycle groups aside, below).
 //!
 //! **The bound.** A cell is credited once all its pieces have been walked
-//! (its tets and slabs tile it, so at every centre they add up to the
-//! cell's own segment). Its credit is that of its largest ball about the
-//! mean of its points: where every boundary triangle's plane (the `faces`
-//! field's triangles, which are the cell's faces everywhere) lies on one
-//! side at distance at least `r`, the ball of radius `r` lies in the
-//! intersection of those half-spaces, which is inside the cell. A pixel
-//! ray passing at distance `d < r` from the centre crosses the ball over
-//! the chord `2 sqrt(r^2 - d^2)`, which the cell's segment contains, and
-//! the extinction along it is at least the transfer function's least on
-//! the cell's scalar range. The credit is that product, shrunk by
-//! [`CREDIT_SHRINK`] for the rounding of the drawn segment. A dense opaque
-//! layer is credited about half its true depth; that is plenty, since the
-//! cut is at an optical depth of about 16 and such layers reach hundreds.
+//! (its tets, slabs and fragments tile it, so at every centre they add up
+//! to the cell's own segment). At each centre of its screen box, its
+//! credit is the ray's chord through the intersection of the inner
+//! half-spaces of its boundary triangles' planes (the `faces` field's
+//! triangles, which are the cell's faces everywhere): for a convex cell
+//! that is the cell, for any other a part of it (its kernel), so the chord
+//! lies in the cell's segment. The inner side is the one the mean of the
+//! cell's points lies on for every plane (a cell without such a point, or
+//! with a degenerate triangle, credits nothing). The chord times the
+//! transfer function's least extinction on the cell's scalar range, shrunk
+//! by [`CREDIT_SHRINK`] for the rounding of the drawn segment, is the
+//! credit.
 //!
 //! **The test.** A piece's pixels lie in the box of its cell's projected
 //! points (the projection of a convex piece is the hull of its corners',
 //! and the pixels the driver's exact decisions give it are on rays that
-//! meet it), grown by [`FRUSTUM_MARGIN_PX`]. Pieces with a corner not in
+//! meet it), grown by [`FRUSTUM_MARGIN_PX`]. Cells with a point not in
 //! front of the near plane are never hidden and never credit.
+//!
+//! **Blocks.** The walk goes in blocks of a size fixed by the number of
+//! pieces ([`BLOCKS`] of them, within [`BLOCK_MIN`] and [`BLOCK_MAX`]): the
+//! pieces of a block are tested against the credits of the blocks before
+//! it (in parallel), then the cells the block completes are credited (their
+//! chords in parallel, the sums in order). Leaving a block's own credits
+//! out of its tests only hides less, and the blocks do not depend on the
+//! number of threads, so the result is the same on every run.
 //!
 //! **What it leaves alone.** Cycle groups are composited per pixel into
 //! one layer: their pieces are never hidden, and their cells never
 //! credited. Independent emission is not bounded by the opacity in front
 //! (no culling there), and neither is a frame that draws no volume (`--mode
-//! iso`) or counts coverage.
-//!
-//! The pass is sequential (each test depends on the credits before it);
-//! the balls are computed in parallel first. A transfer function whose
-//! largest extinction times the mesh's diagonal cannot reach the cut skips
-//! it at once.
+//! iso`) or counts coverage. A transfer function whose largest extinction
+//! times the mesh's diagonal cannot reach the cut skips the pass at once.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::camera::Camera;
 use crate::mesh::tetra::triangulate_face;
-use crate::numeric::tolerance::{FRUSTUM_MARGIN_PX, OCCLUSION_TRANSMITTANCE};
+use crate::numeric::tolerance::FRUSTUM_MARGIN_PX;
+#[cfg(doc)]
+use crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE;
 use crate::tf::EmissionModel;
 use crate::visibility::Order;
 
@@ -65,12 +69,21 @@ use super::pieces::{value_range, PieceSource};
 /// a tenth.
 pub const CREDIT_SHRINK: f64 = 0.9;
 
+/// Blocks per walk (see the module docs): a block's own credits do not
+/// hide its pieces, so the walk needs many; blocks hold from
+/// [`BLOCK_MIN`] to [`BLOCK_MAX`] pieces.
+pub const BLOCKS: usize = 256;
+/// The smallest block (parallel work worth the hand-over).
+pub const BLOCK_MIN: usize = 32;
+/// The largest block.
+pub const BLOCK_MAX: usize = 4096;
+
 /// The optical depth in front of a centre beyond which nothing behind it
-/// can change a channel by more than [`OCCLUSION_TRANSMITTANCE`]: `ln(c /
-/// OCCLUSION_TRANSMITTANCE)` with `c` the brightest colour (at least 1,
-/// the most an isosurface adds).
-pub fn cut_depth(brightest: f64) -> f64 {
-    (brightest.max(1.0) / OCCLUSION_TRANSMITTANCE).ln()
+/// can change a channel by more than `transmittance` (by default
+/// [`OCCLUSION_TRANSMITTANCE`]): `ln(c / transmittance)` with `c` the
+/// brightest colour (at least 1, the most an isosurface adds).
+pub fn cut_depth(brightest: f64, transmittance: f64) -> f64 {
+    (brightest.max(1.0) / transmittance).ln()
 }
 
 /// What the pass found.
@@ -82,31 +95,34 @@ pub struct Occlusion {
     pub count: usize,
 }
 
-/// A cell's ball: centre (world), radius, and least extinction.
-#[derive(Clone, Copy)]
-struct Ball {
-    centre: DVec3,
-    radius: f64,
-    tau: f64,
+/// The frame's pixel rays and the points' pixel positions.
+struct View {
+    width: usize,
+    /// Unit pixel-centre rays (origin, direction), row by row.
+    rays: Vec<(DVec3, DVec3)>,
+    /// Pixel position of each mesh point (`None`: not in front of the near
+    /// plane).
+    screen: Vec<Option<(f64, f64)>>,
 }
 
-/// Runs the pass over `order` for `src` (see the module docs); `None` when
-/// it does not apply or cannot hide anything.
-pub fn hidden_pieces(src: &PieceSource, order: &Order) -> Option<Occlusion> {
+/// Runs the pass over `order` for `src` (see the module docs), hiding what
+/// can change no channel by more than `transmittance`; `None` when it does
+/// not apply or cannot hide anything.
+pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Option<Occlusion> {
     let tf = src.tf;
     if !src.volume || tf.model() != EmissionModel::Glow || order.pieces.is_empty() {
         return None;
     }
-    let nodes = tf.nodes();
-    let brightest = nodes
+    let brightest = tf
+        .nodes()
         .iter()
         .flat_map(|n| n.color)
         .fold(0.0f64, |a, c| a.max(c.abs()));
-    let cut = cut_depth(brightest);
+    let cut = cut_depth(brightest, transmittance);
     let (lo, hi) = tf.scalar_range();
     let tau_max = src.max_rate(lo.min(hi), hi.max(lo));
     let mesh = src.mesh;
-    if !(tau_max * mesh.diagonal() >= cut) || !cut.is_finite() {
+    if !(cut.is_finite() && tau_max * mesh.diagonal() >= cut) {
         return None;
     }
     let camera = src.camera;
@@ -114,230 +130,271 @@ pub fn hidden_pieces(src: &PieceSource, order: &Order) -> Option<Occlusion> {
     if w == 0 || h == 0 {
         return None;
     }
-    // Pieces per cell (a cell is credited when its last one is walked),
-    // and the cells in cycle groups (never credited).
-    let ncells = mesh.cells.len();
-    let mut left = vec![0u32; ncells];
+    // Pieces per cell (a cell is credited when its last one is walked);
+    // the cells of cycle groups are never credited.
+    let n = order.pieces.len();
+    let mut left = vec![0u32; mesh.cells.len()];
     for p in &order.pieces {
         left[p.cell() as usize] += 1;
     }
-    let mut in_group = vec![false; order.pieces.len()];
+    let mut in_group = vec![false; n];
     for g in &order.groups {
         for k in g.clone() {
             in_group[k] = true;
             left[order.pieces[k].cell() as usize] = u32::MAX;
         }
     }
-    // The pixel positions of the points (None: not in front of the near
-    // plane).
     let he = camera.half_extent();
-    let screen: Vec<Option<(f64, f64)>> = mesh
-        .points
-        .par_iter()
-        .map(|&p| {
-            let v = camera.to_view(p);
-            if v.z <= camera.near.max(0.0) {
-                return None;
-            }
-            camera
-                .view_to_pixel_with(v, he)
-                .map(|(x, y, _)| (x, y))
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
-        })
-        .collect();
-    // The balls of the cells that may credit, in parallel.
-    let credited: Vec<u32> = {
-        let mut seen = vec![false; ncells];
-        let mut v = Vec::new();
-        for p in &order.pieces {
-            let c = p.cell() as usize;
-            if left[c] != u32::MAX && !seen[c] {
-                seen[c] = true;
-                v.push(c as u32);
-            }
-        }
-        v
+    let view = View {
+        width: w,
+        rays: (0..w * h)
+            .into_par_iter()
+            .map(|k| {
+                let r = camera.pixel_ray((k % w) as u32, (k / w) as u32);
+                (r.origin, r.dir)
+            })
+            .collect(),
+        screen: mesh
+            .points
+            .par_iter()
+            .map(|&p| {
+                let v = camera.to_view(p);
+                if v.z.is_nan() || v.z <= camera.near.max(0.0) {
+                    return None;
+                }
+                camera
+                    .view_to_pixel_with(v, he)
+                    .map(|(x, y, _)| (x, y))
+                    .filter(|(x, y)| x.is_finite() && y.is_finite())
+            })
+            .collect(),
     };
-    let mut balls: Vec<Option<Ball>> = vec![None; ncells];
-    let computed: Vec<(u32, Option<Ball>)> = credited
-        .par_iter()
-        .map(|&c| (c, ball(src, c, cut)))
-        .collect();
-    for (c, b) in computed {
-        balls[c as usize] = b;
-    }
-    // Unit pixel-ray directions and origins, computed once.
-    let rays: Vec<(DVec3, DVec3)> = (0..w * h)
-        .into_par_iter()
-        .map(|k| {
-            let r = camera.pixel_ray((k % w) as u32, (k / w) as u32);
-            (r.origin, r.dir)
-        })
-        .collect();
     let mut depth = vec![0.0f64; w * h];
-    let mut hidden = vec![false; order.pieces.len()];
+    let mut hidden = vec![false; n];
     let mut count = 0;
     let mut any_opaque = false;
-    let m = FRUSTUM_MARGIN_PX;
-    for k in (0..order.pieces.len()).rev() {
-        let piece = &order.pieces[k];
-        let c = piece.cell() as usize;
-        if any_opaque && !in_group[k] {
-            if let Some((x0, x1, y0, y1)) = cell_box(src, c, &screen, m) {
-                let covered =
-                    (y0..y1).all(|j| depth[j * w + x0..j * w + x1].iter().all(|&d| d >= cut));
-                if covered {
-                    hidden[k] = true;
-                    count += 1;
-                }
+    let mut completed = Vec::new();
+    let block = (n / BLOCKS).clamp(BLOCK_MIN, BLOCK_MAX);
+    let mut end = n;
+    while end > 0 {
+        let start = end.saturating_sub(block);
+        // Tests against the blocks in front.
+        if any_opaque {
+            let found: Vec<usize> = (start..end)
+                .into_par_iter()
+                .filter(|&k| {
+                    !in_group[k]
+                        && cell_box(
+                            src,
+                            order.pieces[k].cell() as usize,
+                            &view.screen,
+                            FRUSTUM_MARGIN_PX,
+                        )
+                        .is_some_and(|(x0, x1, y0, y1)| {
+                            (y0..y1)
+                                .all(|j| depth[j * w + x0..j * w + x1].iter().all(|&d| d >= cut))
+                        })
+                })
+                .collect();
+            count += found.len();
+            for k in found {
+                hidden[k] = true;
             }
         }
-        if left[c] == u32::MAX {
-            continue;
+        // The cells this block completes, front to back.
+        completed.clear();
+        for k in (start..end).rev() {
+            let c = order.pieces[k].cell() as usize;
+            if left[c] == u32::MAX {
+                continue;
+            }
+            left[c] -= 1;
+            if left[c] == 0 {
+                completed.push(c as u32);
+            }
         }
-        left[c] -= 1;
-        if left[c] > 0 {
-            continue;
+        let credits: Vec<Vec<(u32, f64)>> = completed
+            .par_iter()
+            .fold(Vec::new, |mut acc, &c| {
+                cell_credit(src, &view, c, &depth, cut, &mut acc);
+                acc
+            })
+            .collect();
+        for list in credits {
+            for (at, d) in list {
+                let v = &mut depth[at as usize];
+                *v += d;
+                any_opaque |= *v >= cut;
+            }
         }
-        let Some(b) = balls[c] else { continue };
-        any_opaque |= credit(camera, &b, &rays, &mut depth, cut);
+        end = start;
     }
     Some(Occlusion { hidden, count })
 }
 
 /// Pixel-centre index ranges `[x0, x1) x [y0, y1)` of the box of cell
-/// `c`'s projected points grown by `margin` (centres at `i + 0.5`); `None`
-/// when a point is not in front of the near plane or the box misses the
-/// image.
+/// `c`'s projected points grown by `m` pixels (centres at `i + 0.5`);
+/// `None` when a point is not in front of the near plane or the box holds
+/// no centre.
 fn cell_box(
     src: &PieceSource,
     c: usize,
     screen: &[Option<(f64, f64)>],
-    margin: f64,
+    m: f64,
 ) -> Option<(usize, usize, usize, usize)> {
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &n in src.mesh.cells.nodes(c) {
-        let (x, y) = screen.get(n as usize).copied().flatten()?;
+    for &p in src.mesh.cells.nodes(c) {
+        let (x, y) = screen.get(p as usize).copied().flatten()?;
         x0 = x0.min(x);
         x1 = x1.max(x);
         y0 = y0.min(y);
         y1 = y1.max(y);
     }
     let (w, h) = (src.camera.width as f64, src.camera.height as f64);
-    // Centres i + 0.5 with x0 - margin <= i + 0.5 <= x1 + margin.
-    let lo = |v: f64| (v - margin - 0.5).ceil().max(0.0);
-    let hi = |v: f64, n: f64| (v + margin - 0.5).floor().min(n - 1.0);
+    // Centres i + 0.5 with x0 - m <= i + 0.5 <= x1 + m.
+    let lo = |v: f64| (v - m - 0.5).ceil().max(0.0);
+    let hi = |v: f64, n: f64| (v + m - 0.5).floor().min(n - 1.0);
     let (i0, i1, j0, j1) = (lo(x0), hi(x1, w), lo(y0), hi(y1, h));
-    if i0 > i1 || j0 > j1 {
-        // No centre: nothing of it is drawn, so nothing to hide.
+    if !(i0 <= i1 && j0 <= j1) {
         return None;
     }
     Some((i0 as usize, i1 as usize + 1, j0 as usize, j1 as usize + 1))
 }
 
-/// The ball of cell `c` (see the module docs), or `None` when it credits
-/// nothing worth adding (no extinction, a cell whose planes do not all
-/// face the centre, a credit far below `cut`).
-fn ball(src: &PieceSource, c: u32, cut: f64) -> Option<Ball> {
+/// Appends cell `c`'s credit at each centre of its box (see the module
+/// docs) to `out` as (pixel index, optical depth), leaving out centres
+/// already behind `cut` in `depth`.
+fn cell_credit(
+    src: &PieceSource,
+    view: &View,
+    c: u32,
+    depth: &[f64],
+    cut: f64,
+    out: &mut Vec<(u32, f64)>,
+) {
     let mesh = src.mesh;
     let nodes = mesh.cells.nodes(c as usize);
-    let (lo, hi) = value_range(nodes.iter().map(|&n| src.scalar(c, n)));
-    let tau = src.min_extinction(lo, hi);
-    if !(tau > 0.0) {
-        return None;
+    let (lo, hi) = value_range(nodes.iter().map(|&p| src.scalar(c, p)));
+    let tau = src.min_extinction(lo, hi) * CREDIT_SHRINK;
+    // False for NaN too.
+    if tau.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return;
+    }
+    // The chord is 0 outside the hull of the projected points.
+    let Some((x0, x1, y0, y1)) = cell_box(src, c as usize, &view.screen, 0.0) else {
+        return;
+    };
+    if (y0..y1).all(|j| {
+        depth[j * view.width + x0..j * view.width + x1]
+            .iter()
+            .all(|&d| d >= cut)
+    }) {
+        return;
     }
     let centre = nodes
         .iter()
-        .map(|&n| mesh.points[n as usize])
+        .map(|&p| mesh.points[p as usize])
         .sum::<DVec3>()
         / nodes.len() as f64;
-    let (mut pos, mut neg) = (f64::INFINITY, f64::INFINITY);
-    let mut faces = 0;
+    // Planes (unit normal n, point a) with the centre on the inner side
+    // (n . (x - a) <= 0); 32 triangles hold every zoo cell and most
+    // polyhedra.
+    let mut planes: smallvec_planes::Planes = Default::default();
+    let mut sign = 0.0f64;
+    let mut ok = true;
     mesh.cells.for_each_face(c as usize, |_, face| {
         triangulate_face(face, |t| {
             let [a, b, d] = t.map(|i| mesh.points[i as usize]);
             let n = (b - a).cross(d - a);
             let len = n.length();
-            faces += 1;
-            if !(len > 0.0) {
-                // A degenerate triangle: no plane to keep the ball inside.
-                pos = f64::NEG_INFINITY;
-                neg = f64::NEG_INFINITY;
+            let s = (centre - a).dot(n);
+            if len.is_nan()
+                || len <= 0.0
+                || s.is_nan()
+                || s == 0.0
+                || (sign != 0.0 && s.signum() != sign)
+            {
+                ok = false;
                 return;
             }
-            let s = (centre - a).dot(n) / len;
-            if s >= 0.0 {
-                pos = pos.min(s);
-                neg = f64::NEG_INFINITY;
-            } else {
-                neg = neg.min(-s);
-                pos = f64::NEG_INFINITY;
+            sign = s.signum();
+            if !planes.push((n / len, a)) {
+                ok = false;
             }
         })
     });
-    // Shrunk by a relative 1e-9 for the rounding of the distances.
-    let radius = pos.max(neg) * (1.0 - 1e-9);
-    if faces < 4 || !(radius > 0.0 && radius.is_finite()) {
-        return None;
+    if !ok || planes.len() < 4 {
+        return;
     }
-    // A credit below a millionth of the cut is not worth its pixels.
-    if tau * 2.0 * radius * CREDIT_SHRINK < cut * 1e-6 {
-        return None;
-    }
-    Some(Ball {
-        centre,
-        radius,
-        tau,
-    })
-}
-
-/// Adds ball `b`'s credit to the centres whose rays pass through it;
-/// returns whether one of them reached `cut`.
-fn credit(camera: &Camera, b: &Ball, rays: &[(DVec3, DVec3)], depth: &mut [f64], cut: f64) -> bool {
-    let v = camera.to_view(b.centre);
-    if v.z - b.radius <= camera.near.max(0.0) {
-        return false;
-    }
-    // The box of the ball's view-space bounding cube, projected: every ray
-    // through the ball passes through it.
-    let he = camera.half_extent();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for k in 0..8 {
-        let d = DVec3::new(
-            if k & 1 == 0 { -b.radius } else { b.radius },
-            if k & 2 == 0 { -b.radius } else { b.radius },
-            if k & 4 == 0 { -b.radius } else { b.radius },
-        );
-        let Some((x, y, _)) = camera.view_to_pixel_with(v + d, he) else {
-            return false;
-        };
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    let (w, h) = (camera.width as usize, camera.height as usize);
-    let i0 = (x0 - 0.5).ceil().max(0.0);
-    let i1 = (x1 - 0.5).floor().min(w as f64 - 1.0);
-    let j0 = (y0 - 0.5).ceil().max(0.0);
-    let j1 = (y1 - 0.5).floor().min(h as f64 - 1.0);
-    if !(i0 <= i1 && j0 <= j1) {
-        return false;
-    }
-    let r2 = b.radius * b.radius;
-    let mut reached = false;
-    for j in j0 as usize..=j1 as usize {
-        for i in i0 as usize..=i1 as usize {
-            let (o, dir) = rays[j * w + i];
-            let to = b.centre - o;
-            let along = to.dot(dir);
-            let d2 = to.length_squared() - along * along;
-            if d2 < r2 {
-                let at = &mut depth[j * w + i];
-                *at += b.tau * 2.0 * (r2 - d2).sqrt() * CREDIT_SHRINK;
-                reached |= *at >= cut;
+    // Outward normals: the centre is on the negative side.
+    let flip = -sign;
+    let w = view.width;
+    for j in y0..y1 {
+        for i in x0..x1 {
+            if depth[j * w + i] >= cut {
+                continue;
+            }
+            let (o, dir) = view.rays[j * w + i];
+            let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+            for &(n, a) in planes.as_slice() {
+                let n = n * flip;
+                let nd = n.dot(dir);
+                let no = n.dot(o - a);
+                if nd > 0.0 {
+                    t1 = t1.min(-no / nd);
+                } else if nd < 0.0 {
+                    t0 = t0.max(-no / nd);
+                } else if no > 0.0 {
+                    t1 = f64::NEG_INFINITY;
+                }
+            }
+            if t1 > t0 {
+                out.push(((j * w + i) as u32, tau * (t1 - t0)));
             }
         }
     }
-    reached
+}
+
+/// A fixed-capacity list of planes, kept on the stack.
+mod smallvec_planes {
+    use glam::DVec3;
+
+    /// Capacity: a hexahedron has 12 triangles; 32 hold any cell but large
+    /// polyhedra, which then credit nothing.
+    const CAP: usize = 32;
+
+    #[derive(Clone, Copy)]
+    pub struct Planes {
+        items: [(DVec3, DVec3); CAP],
+        len: usize,
+    }
+
+    impl Default for Planes {
+        fn default() -> Self {
+            Planes {
+                items: [(DVec3::ZERO, DVec3::ZERO); CAP],
+                len: 0,
+            }
+        }
+    }
+
+    impl Planes {
+        /// Appends `p`; false when full.
+        pub fn push(&mut self, p: (DVec3, DVec3)) -> bool {
+            if self.len == CAP {
+                return false;
+            }
+            self.items[self.len] = p;
+            self.len += 1;
+            true
+        }
+
+        pub fn len(&self) -> usize {
+            self.len
+        }
+
+        pub fn as_slice(&self) -> &[(DVec3, DVec3)] {
+            &self.items[..self.len]
+        }
+    }
 }

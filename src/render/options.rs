@@ -124,11 +124,11 @@ pub struct ProjectedOptions {
     /// the decisions cost: centres within the snap of an outline are then
     /// left to the rasteriser's rounding, which can miss or double them.
     pub exact_ties: bool,
-    /// Leave out pieces hidden behind opaque ones ([`super::occlusion`];
-    /// on by default). The image changes by at most
-    /// [`crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE`]; off only to
-    /// check that and to measure what it saves.
-    pub occlusion: bool,
+    /// Leave out pieces hidden behind opaque ones ([`super::occlusion`]):
+    /// what can change no channel by more than this (by default
+    /// [`crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE`]); `None`
+    /// draws them, to check the image and measure what the pass saves.
+    pub occlusion: Option<f64>,
 }
 
 impl Default for ProjectedOptions {
@@ -142,7 +142,7 @@ impl Default for ProjectedOptions {
             skip_invisible: true,
             refine_tol: crate::numeric::tolerance::COLOR_REFINE_TOL,
             exact_ties: true,
-            occlusion: false,
+            occlusion: Some(crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE),
         }
     }
 }
