@@ -12,7 +12,13 @@
 //! default) and kept. Each frame nudges the azimuth by 1e-6 degree so that
 //! it sorts again (the renderer reuses the order of an unchanged view).
 //!
-//! Run: `cargo bench --bench skipping`.
+//! Occlusion culling (`zoovr::render::occlusion`): the exact-frag mode at
+//! 512 x 512 on the same scene with a transfer function opaque below 20 %
+//! of the range (extinction 500 per unit length, the hex_shell's front
+//! layer) and thin above, pieces hidden behind opaque ones left out (the
+//! default) and drawn.
+//!
+//! Run: `cargo bench --bench skipping` (one group: `-- occlusion`).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use zoovr::camera::CameraParams;
@@ -182,5 +188,74 @@ fn frustum(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, frustum);
+/// Opaque (extinction 500 per unit length) below 20 % of the range, thin
+/// (10) above 25 %.
+fn opaque_front(shading: &Shading) -> Shading {
+    let (lo, hi) = shading.range;
+    let at = |x: f64| lo + (hi - lo) * x;
+    let mut out = shading.clone();
+    out.tf = TransferFunction::from_channels(
+        &[
+            (at(0.0), [500.0]),
+            (at(0.2), [500.0]),
+            (at(0.25), [10.0]),
+            (at(1.0), [10.0]),
+        ],
+        &[(at(0.0), [0.2, 0.3, 0.9]), (at(1.0), [1.0, 0.6, 0.1])],
+        None,
+        EmissionModel::Glow,
+    )
+    .expect("tf");
+    out
+}
+
+fn occlusion(c: &mut Criterion) {
+    let (name, scene) = frustum_scene();
+    let shading = opaque_front(&scene.shading());
+    let mut renderer = Renderer::new(scene.geometry());
+    let opts = |occlusion: Option<f64>| RenderOptions {
+        mode: Mode::ExactFrag,
+        camera: CameraParams {
+            width: 512,
+            height: 512,
+            azimuth: 20.0,
+            elevation: 35.0,
+            zoom: 1.25,
+            ..Default::default()
+        },
+        projected: ProjectedOptions {
+            occlusion,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let mut g = c.benchmark_group("occlusion");
+    g.sample_size(10);
+    let on = ProjectedOptions::default().occlusion;
+    for (label, occ) in [("hidden_left_out", on), ("all_drawn", None)] {
+        match renderer.render(&shading, &opts(occ), |_, _| {}) {
+            Ok((_, stats)) => {
+                let p = stats.projected().expect("projected");
+                eprintln!(
+                    "{name} opaque front {label}: {} of {} pieces hidden (pass {:.3} s), {} triangles, project+draw {:.3} s, total {:.3} s",
+                    p.hidden_pieces, p.pieces, p.occlusion_s, p.triangles, p.project_s, stats.total_s
+                );
+            }
+            Err(e) => {
+                eprintln!("skipped: {e}");
+                return;
+            }
+        }
+        g.bench_function(format!("{name}_opaque_front_{label}"), |b| {
+            b.iter(|| {
+                renderer
+                    .render(&shading, &opts(occ), |_, _| {})
+                    .expect("render")
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, frustum, occlusion);
 criterion_main!(benches);

@@ -7,6 +7,8 @@
 //!    the mode asks ([`ProjectedMode::split_points`]: a cell whose nodal
 //!    scalar range holds one of those values comes as its consistent tets,
 //!    a tet holding one as its slabs; every cell's tets with `--split all`).
+//!    Pieces hidden behind opaque ones are then left out
+//!    ([`super::occlusion`], a front-to-back pass over the order).
 //! 2. Each piece becomes its view-space parts ([`PieceSource::parts`]:
 //!    pieces with zero extinction over their range are skipped), each part
 //!    is projected into regions ([`Projector`]), leaving out pieces and
