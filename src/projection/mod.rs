@@ -59,6 +59,7 @@ pub use clip::{ClipValue, Clipper};
 pub use polyhedron::Polyhedron;
 pub use project::Projector;
 pub use refine::{perspective_split, refine};
+pub(crate) use refine::{refine_with, RefineScratch};
 pub use slabs::slice_tet;
 pub use subdivision::{Subdivision, TopologyError};
 

@@ -33,7 +33,7 @@ use crate::gpu::cpu::{lerp, CpuStage};
 use crate::gpu::{Binding, Context, GpuError, GpuVertex, Resource, Stage, StageDesc, Table};
 use crate::integrate::{vertex_values, VertexValues};
 use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL};
-use crate::projection::{refine, Polyhedron, Projected};
+use crate::projection::{refine_with, Polyhedron, Projected, RefineScratch};
 use crate::render::breakpoints::split_points;
 use crate::render::driver::ProjectedMode;
 use crate::render::pieces::{value_range, PieceSource};
@@ -310,6 +310,8 @@ impl Default for ExactMode {
 pub struct ExactPayload {
     pub(in crate::render::modes) values: Vec<VertexValues>,
     balance: f64,
+    /// The colour refinement's scratch.
+    refine: RefineScratch,
 }
 
 impl ProjectedMode for ExactMode {
@@ -371,15 +373,28 @@ impl ProjectedMode for ExactMode {
         let tol = self.refine_tol;
         if depth * spread > tol {
             let before = proj.triangles.len();
-            refine(proj, COLOR_REFINE_MAX_DEPTH, |a, b| {
-                let va = vertex_values(tf, a.l, a.s_front, a.s_back);
-                let vb = vertex_values(tf, b.l, b.s_front, b.s_back);
-                let depth = va.depth.max(vb.depth).min(1.0);
-                let spread = (0..3)
-                    .map(|k| (va.glow[k] - vb.glow[k]).abs())
-                    .fold(0.0, f64::max);
-                depth * spread > tol
-            });
+            // Each vertex's values once (a vertex has about six edges, and
+            // an edge may be tested at every level): the refinement's new
+            // vertices are appended to `vals` as the tests reach them.
+            refine_with(
+                proj,
+                COLOR_REFINE_MAX_DEPTH,
+                |v, a, b| {
+                    let n = vals.len();
+                    vals.extend(
+                        v[n..]
+                            .iter()
+                            .map(|w| vertex_values(tf, w.l, w.s_front, w.s_back)),
+                    );
+                    let (va, vb) = (&vals[a as usize], &vals[b as usize]);
+                    let depth = va.depth.max(vb.depth).min(1.0);
+                    let spread = (0..3)
+                        .map(|k| (va.glow[k] - vb.glow[k]).abs())
+                        .fold(0.0, f64::max);
+                    depth * spread > tol
+                },
+                &mut payload.refine,
+            );
             if src.cull {
                 proj.cull_to_pixels(&src.grid);
             }
