@@ -497,3 +497,41 @@ fn refine_tolerance_trades_triangles() {
     let o = render(&mesh, &png, &["--refine-tol", "0"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+/// Occlusion culling: with an opaque transfer function the pieces behind
+/// the first layer are left out (`hidden_pieces` in `--stats --json`), and
+/// `--no-occlusion` draws them; the PNGs are the same byte for byte.
+#[test]
+fn no_occlusion_draws_hidden_pieces_and_the_image_is_the_same() {
+    let dir = tempfile::tempdir().unwrap();
+    let tf = dir.path().join("opaque.json");
+    std::fs::write(
+        &tf,
+        r#"{"unit_distance": 0.001,
+            "opacity_points": [{"s": 0.0, "opacity": 1.0}, {"s": 1.0, "opacity": 1.0}],
+            "color_points": [{"s": 0.0, "rgb": [0.9, 0.3, 0.1]}, {"s": 1.0, "rgb": [0.1, 0.5, 0.9]}]}"#,
+    )
+    .unwrap();
+    let mesh = mesh_file("zoo_3x3x3.vtu");
+    let run = |extra: &[&str], png: &std::path::Path| -> Option<u64> {
+        let tf = tf.to_str().unwrap();
+        let mut args = vec!["--size", "40x32", "--mode", "exact-frag", "--tf", tf];
+        args.extend_from_slice(&["--stats", "--json"]);
+        args.extend_from_slice(extra);
+        let o = render(&mesh, png, &args);
+        if no_adapter(&o) {
+            return None;
+        }
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["detail"]["hidden_pieces"].as_u64()
+    };
+    let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+    let (Some(hidden), Some(none)) = (run(&[], &a), run(&["--no-occlusion"], &b)) else {
+        eprintln!("skipped: no adapter");
+        return;
+    };
+    assert!(hidden > 0, "{hidden}");
+    assert_eq!(none, 0);
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
