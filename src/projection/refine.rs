@@ -169,9 +169,18 @@ pub(crate) fn refine_with(
     s: &mut RefineScratch,
 ) {
     s.widths.clear();
+    // Vertices from this index on are new since the edges were last
+    // tested. `split` depends on an edge's two vertices alone, and every
+    // edge a level creates has a new vertex (a midpoint), so an edge of
+    // two older vertices was tested and kept whole before: it is not asked
+    // again.
+    let mut fresh = 0u32;
     for _ in 0..max_depth {
         s.edges.clear();
         for t in &out.triangles {
+            if t.iter().all(|&i| i < fresh) {
+                continue;
+            }
             let [a, b, c] = t.map(|i| out.vertices[i as usize].pos());
             if is_sliver(a, b, c) {
                 // Negligible: split only where a neighbour asks (conforming).
@@ -180,7 +189,7 @@ pub(crate) fn refine_with(
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 let key = (a.min(b), a.max(b));
-                if split(&out.vertices, key.0, key.1) {
+                if key.1 >= fresh && split(&out.vertices, key.0, key.1) {
                     s.edges.push(key);
                 }
             }
@@ -197,6 +206,8 @@ pub(crate) fn refine_with(
                     .map(|f| f.map(|t| out.faces[t as usize].width())),
             );
         }
+        let prev = fresh;
+        fresh = out.vertices.len() as u32;
         s.mids.clear();
         s.mids.resize(s.edges.len(), NIL);
         // Front and back values of a midpoint come from the widest front
@@ -204,8 +215,14 @@ pub(crate) fn refine_with(
         // `FaceTri::width`).
         s.best.clear();
         s.best.resize(s.edges.len(), [(NIL, -1.0); 2]);
+        // Only edges with a vertex from `old` on were asked, so triangles
+        // of older vertices alone keep all their edges.
+        let old = prev;
         for ti in 0..out.triangles.len() {
             let t = out.triangles[ti];
+            if t.iter().all(|&i| i < old) {
+                continue;
+            }
             let r = out.triangle_region[ti];
             let w = s.widths[r as usize];
             for k in 0..3 {
@@ -224,6 +241,11 @@ pub(crate) fn refine_with(
         for ti in 0..out.triangles.len() {
             let t = out.triangles[ti];
             let r = out.triangle_region[ti];
+            if t.iter().all(|&i| i < old) {
+                s.tris.push(t);
+                s.regs.push(r);
+                continue;
+            }
             let mut m = [NIL; 3];
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
