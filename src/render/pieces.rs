@@ -19,7 +19,7 @@ use glam::DVec3;
 
 use crate::camera::Camera;
 use crate::integrate::segment;
-use crate::integrate::{RayMaterial, SegmentValue};
+use crate::integrate::{Material, RayMaterial, SegmentValue};
 use crate::mesh::Mesh;
 use crate::numeric::tolerance::{LEFT_LIMIT_FLOOR, LEFT_LIMIT_REL};
 use crate::projection::coverage::PixelGrid;
@@ -411,17 +411,9 @@ impl PieceSource<'_> {
     /// when not finite: a bound on how fast a segment's optical depth and
     /// colour grow with its length ([`super::ties`] weighs slivers by it).
     pub fn max_rate(&self, lo: f64, hi: f64) -> f64 {
-        let rate = |s: f64| {
-            let m = self.tf.material(s);
-            m.source.iter().fold(m.tau, |a, &c| a.max(c.abs()))
-        };
-        let mut r = rate(lo).max(rate(hi));
-        for &b in self.tf.breakpoints_slice() {
-            if b >= lo && b <= hi {
-                let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
-                r = r.max(rate(b)).max(rate(left));
-            }
-        }
+        let r = self.fold_nodes(lo, hi, 0.0, |r, m| {
+            m.source.iter().fold(r.max(m.tau), |a, &c| a.max(c.abs()))
+        });
         if r.is_finite() {
             r
         } else {
@@ -434,19 +426,29 @@ impl PieceSource<'_> {
     /// 0 when not a number: what a segment with scalars in `[lo, hi]`
     /// absorbs at least per unit length ([`super::occlusion`]).
     pub fn min_extinction(&self, lo: f64, hi: f64) -> f64 {
-        let tau = |s: f64| self.tf.material(s).tau;
-        let mut t = tau(lo).min(tau(hi));
-        for &b in self.tf.breakpoints_slice() {
-            if b >= lo && b <= hi {
-                let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
-                t = t.min(tau(b)).min(tau(left));
-            }
-        }
+        let t = self.fold_nodes(lo, hi, f64::INFINITY, |t, m| t.min(m.tau));
         if t.is_nan() {
             0.0
         } else {
             t
         }
+    }
+
+    /// Folds `f` over the materials at the ends of `[lo, hi]` and on both
+    /// sides of every transfer-function node inside: where a piecewise
+    /// linear function takes its extremes.
+    fn fold_nodes(&self, lo: f64, hi: f64, init: f64, f: impl Fn(f64, Material) -> f64) -> f64 {
+        let m = |s: f64| self.tf.material(s);
+        let mut acc = f(init, m(lo));
+        acc = f(acc, m(hi));
+        for &b in self.tf.breakpoints_slice() {
+            if b >= lo && b <= hi {
+                let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
+                acc = f(acc, m(b));
+                acc = f(acc, m(left));
+            }
+        }
+        acc
     }
 
     /// Whether nothing of a piece with scalars in `[lo, hi]` is drawn: it
