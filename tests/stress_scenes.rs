@@ -52,7 +52,7 @@ const ISO_GAPS: &[(&str, usize, &str)] = &[
     (
         "eye_inside",
         0,
-        "every pixel off in iso and exact-frag, 6733 in the exact mode: the eye inside the mesh",
+        "every pixel off in iso and exact-frag, 6733 in the exact mode: the eye inside the mesh; with flat or no light the images agree to the last bit, so it is the smooth gradient where the near plane cuts the eye's cell",
     ),
     (
         "range_1e-12",
