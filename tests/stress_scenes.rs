@@ -44,7 +44,7 @@ const ISO_GAPS: &[(&str, usize, &str)] = &[
     (
         "offset_1e7",
         1,
-        "328 pixels off in iso (1552 in exact-frag), from the surface at 37 %, seen orthographically: 92 pixels drawn only by the projected mode, the rest shaded up to ~1e-2 apart",
+        "328 pixels off in iso (1552 in exact-frag), from the surface at 37 %, seen orthographically: 92 pixels drawn only by the projected mode, where the mesh's boundary face (scalar 3.6e-4 above the isovalue) is seen at a grazing angle and the crack-filling rule of shaders/iso.wgsl `iso_crosses` (an opaque surface within the snap bound of a segment's front end) claims a crossing the ray never makes; the rest shaded up to ~1e-2 apart (flat light too)",
     ),
     ("tau_0", 1, "the same 328 pixels as offset_1e7 view 1 (no volume)"),
     ("tau_1e3", 1, "the same 328 pixels as offset_1e7 view 1"),
