@@ -58,7 +58,7 @@
 use glam::{DVec2, DVec3};
 
 use crate::camera::Camera;
-use crate::gpu::SUBPIXEL;
+use crate::gpu::{GpuVertex, SUBPIXEL};
 use crate::projection::{Polyhedron, Projected, RegionVertex};
 use crate::raycast::geometry::{bounding_sphere, Proj, RayFrame};
 
@@ -111,6 +111,31 @@ pub fn snap_is_steep(p: [DVec2; 3], l: [f64; 3], rate: f64) -> bool {
     longest > 0.0
         && area2 >= SLIVER_TIE_PX * longest
         && rate * dl * SNAP_PX > SLIVER_DEPTH_TOL * area2 / longest
+}
+
+/// Appends the drawn triangle at `p` (pixels; snapped to grid positions
+/// `g`, sub-pixel units) whose corners in `vertices` are `exact` as three
+/// new corners, each with the exact triangle's values at its snapped
+/// position and `exact`'s clip position (see [`snap_is_steep`]).
+pub fn push_steep<V: GpuVertex>(
+    p: [DVec2; 3],
+    g: [[i64; 2]; 3],
+    exact: [V; 3],
+    vertices: &mut Vec<V>,
+    indices: &mut Vec<u32>,
+) {
+    let base = vertices.len() as u32;
+    let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+    for k in 0..3 {
+        let q = DVec2::new(g[k][0] as f64, g[k][1] as f64) / SUBPIXEL;
+        let b1 = (q - p[0]).perp_dot(p[2] - p[0]) / area;
+        let b2 = (p[1] - p[0]).perp_dot(q - p[0]) / area;
+        let v = V::lerp3([&exact[0], &exact[1], &exact[2]], [1.0 - b1 - b2, b1, b2])
+            .with_clip(exact[k].clip())
+            .with_piece(exact[k].piece());
+        vertices.push(v);
+    }
+    indices.extend_from_slice(&[base, base + 1, base + 2]);
 }
 
 /// Whether any triangle of a part whose thickness spans `l_range` can be
