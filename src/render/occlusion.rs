@@ -215,10 +215,14 @@ pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Op
         }
         let credits: Vec<Vec<(u32, f64)>> = completed
             .par_iter()
-            .fold(Vec::new, |mut acc, &c| {
-                cell_credit(src, &view, c, &depth, cut, &mut acc);
-                acc
-            })
+            .fold(
+                || (Vec::new(), Vec::new()),
+                |(mut acc, mut planes), &c| {
+                    cell_credit(src, &view, c, &depth, cut, &mut planes, &mut acc);
+                    (acc, planes)
+                },
+            )
+            .map(|(acc, _)| acc)
             .collect();
         for list in credits {
             for (at, d) in list {
@@ -263,13 +267,14 @@ fn cell_box(
 
 /// Appends cell `c`'s credit at each centre of its box (see the module
 /// docs) to `out` as (pixel index, optical depth), leaving out centres
-/// already behind `cut` in `depth`.
+/// already behind `cut` in `depth` (`planes` is scratch).
 fn cell_credit(
     src: &PieceSource,
     view: &View,
     c: u32,
     depth: &[f64],
     cut: f64,
+    planes: &mut Vec<(DVec3, DVec3)>,
     out: &mut Vec<(u32, f64)>,
 ) {
     let mesh = src.mesh;
@@ -296,10 +301,8 @@ fn cell_credit(
         .map(|&p| mesh.points[p as usize])
         .sum::<DVec3>()
         / nodes.len() as f64;
-    // Planes (unit normal n, point a) with the centre on the inner side
-    // (n . (x - a) <= 0); 32 triangles hold every zoo cell and most
-    // polyhedra.
-    let mut planes: smallvec_planes::Planes = Default::default();
+    // Planes (unit normal n, point a), the centre on one side of all.
+    planes.clear();
     let mut sign = 0.0f64;
     let mut ok = true;
     mesh.cells.for_each_face(c as usize, |_, face| {
@@ -318,9 +321,7 @@ fn cell_credit(
                 return;
             }
             sign = s.signum();
-            if !planes.push((n / len, a)) {
-                ok = false;
-            }
+            planes.push((n / len, a));
         })
     });
     if !ok || planes.len() < 4 {
@@ -336,7 +337,7 @@ fn cell_credit(
             }
             let (o, dir) = view.rays[j * w + i];
             let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
-            for &(n, a) in planes.as_slice() {
+            for &(n, a) in planes.iter() {
                 let n = n * flip;
                 let nd = n.dot(dir);
                 let no = n.dot(o - a);
@@ -351,50 +352,6 @@ fn cell_credit(
             if t1 > t0 {
                 out.push(((j * w + i) as u32, tau * (t1 - t0)));
             }
-        }
-    }
-}
-
-/// A fixed-capacity list of planes, kept on the stack.
-mod smallvec_planes {
-    use glam::DVec3;
-
-    /// Capacity: a hexahedron has 12 triangles; 32 hold any cell but large
-    /// polyhedra, which then credit nothing.
-    const CAP: usize = 32;
-
-    #[derive(Clone, Copy)]
-    pub struct Planes {
-        items: [(DVec3, DVec3); CAP],
-        len: usize,
-    }
-
-    impl Default for Planes {
-        fn default() -> Self {
-            Planes {
-                items: [(DVec3::ZERO, DVec3::ZERO); CAP],
-                len: 0,
-            }
-        }
-    }
-
-    impl Planes {
-        /// Appends `p`; false when full.
-        pub fn push(&mut self, p: (DVec3, DVec3)) -> bool {
-            if self.len == CAP {
-                return false;
-            }
-            self.items[self.len] = p;
-            self.len += 1;
-            true
-        }
-
-        pub fn len(&self) -> usize {
-            self.len
-        }
-
-        pub fn as_slice(&self) -> &[(DVec3, DVec3)] {
-            &self.items[..self.len]
         }
     }
 }
