@@ -106,6 +106,9 @@ pub struct Projector {
     pub(crate) vertex_faces_by_search: bool,
     clipper: Clipper,
     clipped: Polyhedron,
+    /// Whether the last call projected `clipped` (the piece reached the
+    /// near plane).
+    used_clipped: bool,
     arr: Arrangement,
     pub(super) overlay: Overlay,
     tet: TetRegions,
@@ -167,6 +170,7 @@ impl Default for Projector {
             vertex_faces_by_search: false,
             clipper: Clipper::default(),
             clipped: Polyhedron::default(),
+            used_clipped: false,
             arr: Arrangement::default(),
             overlay: Overlay::default(),
             tet: TetRegions::default(),
@@ -223,6 +227,7 @@ impl Projector {
         };
         let zc = camera.near * NEAR_CLIP_SCALE;
         let needs_clip = poly.points.iter().any(|p| p.z < zc);
+        self.used_clipped = needs_clip;
         if needs_clip {
             let mut clipped = std::mem::take(&mut self.clipped);
             let kept = self
@@ -237,6 +242,18 @@ impl Projector {
             r
         } else {
             self.project_inner(poly, camera, out)
+        }
+    }
+
+    /// The polyhedron the last [`Self::project`] of `poly` projected:
+    /// `poly` itself, or its part beyond the near plane. The face indices
+    /// of the result ([`Projected::faces`], [`Projected::region_faces`])
+    /// are this one's triangles.
+    pub fn projected_piece<'a>(&'a self, poly: &'a Polyhedron) -> &'a Polyhedron {
+        if self.used_clipped {
+            &self.clipped
+        } else {
+            poly
         }
     }
 

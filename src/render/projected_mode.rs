@@ -63,7 +63,10 @@ pub trait ProjectedMode: Sync {
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<Self::Vertex>>;
 
     /// Computes the payload of `part`'s projection at every vertex
-    /// `used[i]` marks (a kept triangle uses it). It may refine
+    /// `used[i]` marks (a kept triangle uses it). `part` is the polyhedron
+    /// whose triangles `proj`'s faces index: a part reaching the near plane
+    /// comes clipped there ([`crate::projection::Projector::projected_piece`]),
+    /// with its cap. It may refine
     /// `proj.triangles` (adding vertices, then marking them used) and must
     /// then cull them again when `src.cull`; `refined` counts the triangles
     /// it added.

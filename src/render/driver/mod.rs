@@ -222,7 +222,10 @@ fn draw_part<M: ProjectedMode>(
             used[i as usize] = true;
         }
     }
-    mode.payload(src, part, proj, used, &mut w.payload, &mut out.refined);
+    // The faces the regions index are those of the part beyond the near
+    // plane when it reached it.
+    let projected = w.projector.projected_piece(part);
+    mode.payload(src, projected, proj, used, &mut w.payload, &mut out.refined);
     let mapper = ClipMapper::for_camera(src.camera);
     let piece = out.pieces;
     out.pieces += 1;
