@@ -37,22 +37,23 @@ const ISO_PIXEL_TOL: f64 = 2.0 / 255.0;
 /// Pixels off per view (surface silhouettes and the edges of faces that
 /// hold the isovalue may differ on single pixels).
 const ISO_OFF_MAX: usize = 8;
-/// Isosurface views known to differ from the ray caster (scene, view,
-/// what was measured): printed, and held only to finite pixels in every
-/// mode, until their causes are found.
-const ISO_GAPS: &[(&str, usize, Mode, &str)] = &[
+/// Isosurface views known to differ from the ray caster by more than
+/// [`ISO_OFF_MAX`] pixels (scene, view, the pixels off allowed, what was
+/// measured). The one left is a limit of the reference, not of the
+/// projected modes: a field spanning 1e-12 around 1 has only about 4500
+/// `f64` values in its range (one ulp is 2.2e-4 of it), and the ray caster
+/// interpolates the raw values, so its crossings move by ulps (and by the
+/// level's margin, `ISO_LEVEL_ULPS` ulps) where the GPU stages interpolate
+/// the normalised scalars in `f32` (6e-8 of the range). The exact mode,
+/// which slices at the reference's own levels, is within 1 pixel.
+const ISO_GAPS: &[(&str, usize, usize, &str)] = &[
     (
         "range_1e-12",
         0,
-        Mode::ExactFrag,
-        "1615 pixels off whole, 1616 split (iso alone: none): surfaces mixed with the volume in a field spanning 1e-12",
+        48,
+        "23 to 38 pixels off in iso and exact-frag: crossings within the reference's ulps of the isovalue",
     ),
-    (
-        "range_1e-12",
-        1,
-        Mode::ExactFrag,
-        "60 pixels off whole (outside the split cells), 1951 split, as view 0",
-    ),
+    ("range_1e-12", 1, 48, "17 to 19 pixels off split, as view 0"),
 ];
 const RMS: f64 = 2e-3;
 /// exact-frag whole cells against `faces`: cells with nonplanar faces are
@@ -363,15 +364,12 @@ fn run(case: Case, gpu: bool) {
                 case.name,
                 mask.iter().filter(|&&m| m).count()
             );
-            let gap = ISO_GAPS
-                .iter()
-                .find(|g| g.0 == case.name && g.1 == vi && g.2 == mode);
+            let gap = ISO_GAPS.iter().find(|g| g.0 == case.name && g.1 == vi);
             if let Some(g) = gap {
-                eprintln!("  KNOWN GAP, not bounded: {}", g.3);
-                continue;
+                eprintln!("  known gap, up to {} pixels: {}", g.2, g.3);
             }
             assert!(
-                off <= ISO_OFF_MAX,
+                off <= gap.map_or(ISO_OFF_MAX, |g| g.2),
                 "{} view {vi} iso {mode:?}: {off} pixels off",
                 case.name
             );

@@ -404,14 +404,23 @@ pub const TABLE_LENGTH_MARGIN: f64 = 1e-3;
 /// thinner than about 1e-6 of their size).
 pub const GRADIENT_FLAT_REL: f64 = 1e-12;
 
-/// Isosurface level, `f64` (the reference, cycle groups): a scalar reaches
-/// the isovalue `V` when it is at least `V - ISO_LEVEL_F64 * max(|V|, span)`
-/// (`span` the transfer function's node range). A surface through vertices
-/// with the value `V` (integer data, fields built from levels) is then one
-/// surface: barycentric interpolation of equal values rounds to a few ulps
-/// either side of `V`, and without the margin the segments on both sides
-/// of such a face would both or neither cross it.
+/// Isosurface level, `f64` (the reference, cycle groups, the exact mode's
+/// slices): a scalar reaches the isovalue `V` when it is at least
+/// `V - max(ISO_LEVEL_F64 * span, ISO_LEVEL_ULPS * eps * |V|)` (`span` the
+/// transfer function's node range, `eps` the `f64` machine epsilon). A
+/// surface through vertices with the value `V` (integer data, fields built
+/// from levels) is then one surface: barycentric interpolation of equal
+/// values rounds to a few ulps either side of `V`, and without the margin
+/// the segments on both sides of such a face would both or neither cross
+/// it. The margin is relative to the span, not to `|V|`: a field spanning
+/// 1e-12 around 1 would otherwise lie wholly within it, and no segment
+/// would cross any of its values.
 pub const ISO_LEVEL_F64: f64 = 1e-12;
+
+/// The `|V|`-relative floor of the `f64` isosurface level's margin, in
+/// ulps of `V` (see [`ISO_LEVEL_F64`]): the rounding of a barycentric
+/// interpolation of equal values, with room.
+pub const ISO_LEVEL_ULPS: f64 = 4.0;
 
 /// The same margin for the GPU stages and their twins, in normalised scalar
 /// units (`f32`, about 16 ulps of 1), relative to `max(1, |V|)`: the

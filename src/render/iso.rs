@@ -16,7 +16,8 @@
 //! crosses nothing (the crossing, if any, is where the ray enters the
 //! level region). An isovalue at the field's minimum is never crossed; at
 //! its maximum only where a ray touches the maximum. "At or above" allows
-//! for rounding: a scalar within [`ISO_LEVEL_F64`] (relative; the GPU
+//! for rounding: a scalar within [`ISO_LEVEL_F64`] (relative to the
+//! span, at least a few ulps of `V`; the GPU
 //! stages [`crate::numeric::tolerance::ISO_LEVEL_F32`]) below `V` counts as
 //! reaching it, so that a face whose points all have the value `V` is one
 //! surface.
@@ -51,7 +52,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::integrate::SegmentValue;
-use crate::numeric::tolerance::ISO_LEVEL_F64;
+use crate::numeric::tolerance::{ISO_LEVEL_F64, ISO_LEVEL_ULPS};
 use crate::tf::TransferFunction;
 
 /// Ambient part of the headlight.
@@ -287,7 +288,8 @@ pub struct IsoSet {
     /// The isovalues as asked for.
     pub values: Vec<f64>,
     /// The levels a scalar must reach to be at or above each value: the
-    /// value less [`ISO_LEVEL_F64`] of its scale (a face whose points all
+    /// value less [`ISO_LEVEL_F64`] of the span or [`ISO_LEVEL_ULPS`] ulps
+    /// of the value, whichever is more (a face whose points all
     /// have the value is one surface, not two or none).
     pub levels: Vec<f64>,
     /// Front and back side of each: `[r, g, b, opacity]`, not premultiplied.
@@ -312,7 +314,10 @@ impl IsoSet {
             values: specs.iter().map(|s| s.value).collect(),
             levels: specs
                 .iter()
-                .map(|s| s.value - ISO_LEVEL_F64 * s.value.abs().max(span))
+                .map(|s| {
+                    let ulps = ISO_LEVEL_ULPS * f64::EPSILON * s.value.abs();
+                    s.value - (ISO_LEVEL_F64 * span).max(ulps)
+                })
                 .collect(),
             sides: specs
                 .iter()
@@ -529,5 +534,52 @@ mod tests {
         assert!((v.color[2] - 0.5 * t).abs() < 1e-12);
         assert!((v.color[1] - (1.0 + 0.5 * t)).abs() < 1e-12);
         assert!((v.alpha - (1.0 - 0.5 * t * t)).abs() < 1e-12);
+    }
+
+    /// The level's margin is relative to the span (with a floor of a few
+    /// ulps of the value): in a field spanning 1e-12 around 1, a margin of
+    /// 1e-12 of the value would put the level below the whole field, and
+    /// no segment would cross it.
+    #[test]
+    fn levels_resolve_a_field_spanning_1e_minus_12() {
+        let (lo, span) = (1.0, 1e-12);
+        let tf = TransferFunction::from_channels(
+            &[(lo, [0.0]), (lo + span, [1.0])],
+            &[(lo, [1.0, 1.0, 1.0])],
+            None,
+            crate::tf::EmissionModel::Glow,
+        )
+        .unwrap();
+        let v = lo + 0.37 * span;
+        let opts = IsoOptions {
+            surfaces: vec![IsoSpec {
+                value: v,
+                front: SideStyle::default(),
+                back: SideStyle::default(),
+            }],
+            ..Default::default()
+        };
+        let set = IsoSet::new(&opts, &tf);
+        let margin = v - set.levels[0];
+        assert!(margin > 0.0 && margin <= 1e-3 * span, "margin {margin:e}");
+        assert_eq!(set.crossed(lo + 0.3 * span, lo + 0.4 * span), 0..1);
+        assert_eq!(set.crossed(lo, lo + 0.36 * span), 0..0);
+        // A value of order 1 over a span of 1: the span's margin.
+        let tf = TransferFunction::from_channels(
+            &[(0.0, [0.0]), (1.0, [1.0])],
+            &[(0.0, [1.0, 1.0, 1.0])],
+            None,
+            crate::tf::EmissionModel::Glow,
+        )
+        .unwrap();
+        let opts = IsoOptions {
+            surfaces: vec![IsoSpec {
+                value: 0.5,
+                front: SideStyle::default(),
+                back: SideStyle::default(),
+            }],
+            ..Default::default()
+        };
+        assert_eq!(IsoSet::new(&opts, &tf).levels[0], 0.5 - ISO_LEVEL_F64);
     }
 }
