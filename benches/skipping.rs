@@ -18,7 +18,12 @@
 //! layer) and thin above, pieces hidden behind opaque ones left out (the
 //! default) and drawn.
 //!
-//! Run: `cargo bench --bench skipping` (one group: `-- occlusion`).
+//! Dark cells left out of the sort (`zoovr::render::visible`): the exact
+//! mode at 512 x 512 on the generated 1M-hex grid, the default TF against
+//! one dark below 90 % of the range (see `dark_cells`).
+//!
+//! Run: `cargo bench --bench skipping` (one group: `-- occlusion`,
+//! `-- dark_cells`).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use zoovr::camera::CameraParams;
@@ -257,5 +262,74 @@ fn occlusion(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, frustum, occlusion);
+/// Dark cells left out of the sort (`zoovr::render::visible`): the exact
+/// mode at 512 x 512 on the generated 1M-hex grid (100^3 warped cells),
+/// the default TF against one dark below 90 % of the range, with the dark
+/// cells left out of the sort (the default), only their pieces skipped,
+/// and nothing skipped. Each frame nudges the azimuth by 1e-6 degree so
+/// that it sorts again, as a new view does (the subset itself is reused
+/// while the field and the TF's darkness hold).
+fn dark_cells(c: &mut Criterion) {
+    let mesh = warped_hex_grid(
+        100,
+        &Warp {
+            amplitude: 0.05,
+            seed: 1,
+        },
+    );
+    let scene = Scene::build(mesh, &SceneSpec::default()).expect("scene");
+    let full = scene.shading();
+    let narrow = narrow(&full);
+    let mut renderer = Renderer::new(scene.geometry());
+    let opts = |nudge: bool, skip: bool, subset: bool| RenderOptions {
+        mode: Mode::Exact,
+        camera: CameraParams {
+            width: 512,
+            height: 512,
+            azimuth: if nudge { 1e-6 } else { 0.0 },
+            ..Default::default()
+        },
+        projected: ProjectedOptions {
+            skip_invisible: skip,
+            dark_subset: subset,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let cases = [
+        ("full_tf", &full, true, true),
+        ("narrow_tf_left_out", &narrow, true, true),
+        ("narrow_tf_pieces_skipped", &narrow, true, false),
+        ("narrow_tf_all", &narrow, false, false),
+    ];
+    let mut g = c.benchmark_group("dark_cells");
+    g.sample_size(10);
+    for (label, shading, skip, subset) in cases {
+        match renderer.render(shading, &opts(false, skip, subset), |_, _| {}) {
+            Ok((_, stats)) => {
+                let p = stats.projected().expect("projected");
+                eprintln!(
+                    "grid_100 {label}: {} dark cells left out (subset {:.3} s), {} pieces, {} skipped, {} triangles, sort {:.3} s, project+draw {:.3} s, total {:.3} s",
+                    p.dark_cells_left_out, p.visible_subset_s, p.pieces, p.culled_pieces, p.triangles, p.sort_s, p.project_s, stats.total_s
+                );
+            }
+            Err(e) => {
+                eprintln!("skipped: {e}");
+                return;
+            }
+        }
+        let mut nudge = false;
+        g.bench_function(format!("grid_100_{label}"), |b| {
+            b.iter(|| {
+                nudge = !nudge;
+                renderer
+                    .render(shading, &opts(nudge, skip, subset), |_, _| {})
+                    .expect("render")
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, frustum, occlusion, dark_cells);
 criterion_main!(benches);

@@ -49,9 +49,22 @@ fn dark_pieces_are_skipped_and_the_image_is_unchanged() {
     if render_util::gpu_available() {
         compositors.push(Compositor::Gpu);
     }
-    for mode in [Mode::Exact, Mode::ExactFrag, Mode::Preint3d, Mode::Preint2d] {
+    let cells = scene.mesh.cells.len();
+    let iso = zoovr::render::iso::IsoOptions {
+        surfaces: zoovr::render::iso::parse_list(&format!("{}", lo + 0.5 * (hi - lo))).unwrap(),
+        ..Default::default()
+    };
+    for mode in [
+        Mode::Exact,
+        Mode::ExactFrag,
+        Mode::Preint3d,
+        Mode::Preint2d,
+        Mode::Iso,
+    ] {
         for &compositor in &compositors {
-            let render = |renderer: &mut Renderer, skip: bool| {
+            // skip: pieces skipped; subset: dark cells left out of the
+            // sort (src/render/visible.rs).
+            let render = |renderer: &mut Renderer, skip: bool, subset: bool| {
                 let opts = RenderOptions {
                     mode,
                     camera: zoovr::camera::CameraParams {
@@ -64,16 +77,41 @@ fn dark_pieces_are_skipped_and_the_image_is_unchanged() {
                     projected: ProjectedOptions {
                         compositor,
                         skip_invisible: skip,
+                        dark_subset: subset,
                         ..Default::default()
+                    },
+                    iso: if mode == Mode::Iso {
+                        iso.clone()
+                    } else {
+                        Default::default()
                     },
                     ..Default::default()
                 };
                 renderer.render(&shading, &opts, |_, _| {}).unwrap()
             };
-            let (with, s_with) = render(&mut renderer, true);
-            let (without, s_without) = render(&mut renderer, false);
-            let (p_with, p_without) = (s_with.projected().unwrap(), s_without.projected().unwrap());
+            let (left_out, s_left_out) = render(&mut renderer, true, true);
+            let (with, s_with) = render(&mut renderer, true, false);
+            let (without, s_without) = render(&mut renderer, false, false);
+            let (p_left_out, p_with, p_without) = (
+                s_left_out.projected().unwrap(),
+                s_with.projected().unwrap(),
+                s_without.projected().unwrap(),
+            );
             assert_eq!(p_without.culled_pieces, 0, "{mode:?}");
+            assert_eq!(p_with.dark_cells_left_out, 0, "{mode:?}");
+            assert_eq!(p_without.dark_cells_left_out, 0, "{mode:?}");
+            // Most cells are dark: the sort leaves them out, its order
+            // holds only the others (each once at least).
+            assert!(
+                p_left_out.dark_cells_left_out * 10 >= cells * 6,
+                "{mode:?} {compositor:?}: {} of {cells} dark cells left out",
+                p_left_out.dark_cells_left_out
+            );
+            assert_eq!(
+                p_left_out.order.cells + p_left_out.dark_cells_left_out,
+                cells,
+                "{mode:?}"
+            );
             assert!(
                 p_with.culled_pieces * 10 >= p_with.pieces * 7,
                 "{mode:?} {compositor:?}: {} of {} pieces skipped",
@@ -81,6 +119,7 @@ fn dark_pieces_are_skipped_and_the_image_is_unchanged() {
                 p_with.pieces
             );
             assert!(p_with.triangles < p_without.triangles / 2, "{mode:?}");
+            assert_eq!(p_left_out.triangles, p_with.triangles, "{mode:?}");
             // Dark cells are not split at breakpoints either (the sort's
             // share of the skip): the exact mode splits at the transfer
             // function's kinks, most of which lie in the dark range here.
@@ -90,8 +129,13 @@ fn dark_pieces_are_skipped_and_the_image_is_unchanged() {
                 assert!(a.dark_unsplit > 0, "{mode:?}: {a:?}");
                 assert_eq!(a.breakpoint_cells + a.dark_unsplit, b.breakpoint_cells);
             }
-            let (d, _) = compare_float(&with, &without).unwrap();
-            assert!(d.max_abs <= 1e-6, "{mode:?} {compositor:?}: {d:?}");
+            for (what, image) in [
+                ("pieces skipped", &with),
+                ("dark cells left out", &left_out),
+            ] {
+                let (d, _) = compare_float(image, &without).unwrap();
+                assert!(d.max_abs <= 1e-6, "{mode:?} {compositor:?} {what}: {d:?}");
+            }
             // Something is drawn at all (the test could not fail otherwise).
             let lit = with.pixels.iter().filter(|p| p[3] > 0.05).count();
             assert!(lit > 50, "{mode:?}: {lit} lit pixels");

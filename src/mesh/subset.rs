@@ -47,18 +47,7 @@ pub fn keep_cells(mesh: &mut Mesh, keep: &[bool]) -> usize {
             }
         }
     }
-    let old = std::mem::take(&mut mesh.cells);
-    let mut cells = Cells {
-        offsets: vec![0],
-        poly_faces: BTreeMap::new(),
-        ..Default::default()
-    };
-    for c in (0..n).filter(|&c| kept(c)) {
-        if let Some(faces) = old.poly_faces.get(&(c as u32)) {
-            cells.poly_faces.insert(cells.len() as u32, faces.clone());
-        }
-        cells.push(old.kinds[c], old.nodes(c));
-    }
+    let (cells, _) = cells_subset(&mesh.cells, kept);
     mesh.cells = cells;
     let cell_keep: Vec<bool> = (0..n).map(kept).collect();
     for a in &mut mesh.cell_data {
@@ -69,6 +58,26 @@ pub fn keep_cells(mesh: &mut Mesh, keep: &[bool]) -> usize {
         renumber_points(mesh, &point_keep);
     }
     removed
+}
+
+/// The cells `c` of `cells` with `keep(c)`, in their order, with their
+/// point ids as they are (polyhedron faces re-keyed to the new cell ids),
+/// and the old id of each kept cell.
+pub fn cells_subset(cells: &Cells, keep: impl Fn(usize) -> bool) -> (Cells, Vec<u32>) {
+    let mut out = Cells {
+        offsets: vec![0],
+        poly_faces: BTreeMap::new(),
+        ..Default::default()
+    };
+    let mut old_id = Vec::new();
+    for c in (0..cells.len()).filter(|&c| keep(c)) {
+        if let Some(faces) = cells.poly_faces.get(&(c as u32)) {
+            out.poly_faces.insert(out.len() as u32, faces.clone());
+        }
+        out.push(cells.kinds[c], cells.nodes(c));
+        old_id.push(c as u32);
+    }
+    (out, old_id)
 }
 
 /// Removes points no cell uses (renumbering in order) and the matching

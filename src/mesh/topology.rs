@@ -355,6 +355,15 @@ impl Topology {
         &self.cell_faces[self.cell_face_offsets[c] as usize..self.cell_face_offsets[c + 1] as usize]
     }
 
+    /// Faces of cell `c` in local order, `None` for a cell the topology
+    /// does not have.
+    #[inline]
+    pub fn faces_of_checked(&self, c: usize) -> Option<&[u32]> {
+        let a = *self.cell_face_offsets.get(c)? as usize;
+        let b = *self.cell_face_offsets.get(c + 1)? as usize;
+        self.cell_faces.get(a..b)
+    }
+
     /// Whether face `f` is on the boundary.
     #[inline]
     pub fn is_boundary(&self, f: usize) -> bool {

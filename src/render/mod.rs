@@ -31,6 +31,7 @@ pub mod scene;
 pub mod stats;
 pub mod steps;
 pub mod ties;
+pub mod visible;
 mod workers;
 
 use std::time::Instant;
@@ -146,6 +147,11 @@ pub struct Renderer {
     sorter: Option<Sorter>,
     /// The last order, reused by a frame that asks for the same one.
     orders: order_cache::OrderCache,
+    /// The cells that are not dark, sorted without the rest when most
+    /// are ([`visible`]).
+    visible: visible::VisibleCache,
+    /// Whether the last projected-cell render sorted the visible subset.
+    last_visible: bool,
     gpu: Option<Context>,
     pending_gpu: Option<PendingContext>,
 }
@@ -157,6 +163,8 @@ impl Renderer {
             geometry,
             sorter: None,
             orders: Default::default(),
+            visible: Default::default(),
+            last_visible: false,
             gpu: None,
             pending_gpu: None,
         }
@@ -178,6 +186,7 @@ impl Renderer {
             self.sorter = None;
         }
         self.orders.clear();
+        self.visible.clear();
         self.geometry = geometry;
     }
 
@@ -207,8 +216,15 @@ impl Renderer {
     /// The visibility order the last projected-cell render drew (kept for
     /// the next render of the same view), e.g. to see which cells it drew
     /// as tets ([`crate::visibility::Piece`]).
-    pub fn last_order(&self) -> Option<&std::sync::Arc<crate::visibility::Order>> {
-        self.orders.last()
+    /// With the geometry's cell ids also when the render sorted the visible
+    /// subset ([`visible`]).
+    pub fn last_order(&self) -> Option<std::sync::Arc<crate::visibility::Order>> {
+        if self.last_visible {
+            let (subset, _, _) = self.visible.current()?;
+            let order = subset.orders.last()?;
+            return Some(std::sync::Arc::new(subset.whole_order(order)));
+        }
+        self.orders.last().cloned()
     }
 
     /// Renders one image of `shading` with the camera of `opts.camera`
@@ -324,22 +340,66 @@ impl Renderer {
         progress: impl FnMut(usize, usize),
     ) -> Result<(Image, ModeStats, f64), RenderError> {
         let t0 = Instant::now();
-        let g = &self.geometry;
-        let sorter = self
-            .sorter
-            .get_or_insert_with(|| Sorter::new(g.mesh.clone(), g.topology.clone()));
-        let sorter_s = t0.elapsed().as_secs_f64();
-        let (img, stats) = driver::render_projected(
-            mode,
-            scene,
+        let Renderer {
+            geometry: g,
             sorter,
-            &mut self.gpu,
-            &mut self.pending_gpu,
-            &mut self.orders,
-            opts,
-            camera,
-            progress,
-        )?;
+            orders,
+            visible,
+            last_visible,
+            gpu,
+            pending_gpu,
+        } = self;
+        let subset = if opts.projected.skip_invisible && opts.projected.dark_subset {
+            visible.prepare(scene, mode.isosurfaces(), mode.draws_volume())
+        } else {
+            (None, 0, 0.0)
+        };
+        *last_visible = subset.0.is_some();
+        let (img, stats, sorter_s) = match subset {
+            (Some(sub), dark_cells, built_s) => {
+                // The sorter's options are the whole mesh's.
+                if let Some(s) = sorter.as_ref() {
+                    sub.sorter.nonconvex = s.nonconvex;
+                    sub.sorter.plane_split = s.plane_split;
+                    sub.sorter.frustum_margin = s.frustum_margin;
+                }
+                let sub_scene = sub.scene_of(scene);
+                let (img, mut stats) = driver::render_projected(
+                    mode,
+                    &sub_scene,
+                    &mut sub.sorter,
+                    gpu,
+                    pending_gpu,
+                    &mut sub.orders,
+                    opts,
+                    camera,
+                    &scene.mesh,
+                    progress,
+                )?;
+                stats.dark_cells_left_out = dark_cells;
+                stats.visible_subset_s = built_s;
+                (img, stats, built_s)
+            }
+            (None, _, checked_s) => {
+                let sorter =
+                    sorter.get_or_insert_with(|| Sorter::new(g.mesh.clone(), g.topology.clone()));
+                let sorter_s = t0.elapsed().as_secs_f64();
+                let (img, mut stats) = driver::render_projected(
+                    mode,
+                    scene,
+                    sorter,
+                    gpu,
+                    pending_gpu,
+                    orders,
+                    opts,
+                    camera,
+                    &scene.mesh,
+                    progress,
+                )?;
+                stats.visible_subset_s = checked_s;
+                (img, stats, sorter_s)
+            }
+        };
         let setup_s = sorter_s + stats.gpu_open_s;
         Ok((img, ModeStats::Projected(Box::new(stats)), setup_s))
     }

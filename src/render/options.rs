@@ -129,6 +129,11 @@ pub struct ProjectedOptions {
     /// [`crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE`]); `None`
     /// draws them, to check the image and measure what the pass saves.
     pub occlusion: Option<f64>,
+    /// Sort and draw only the cells that are not dark when at least
+    /// [`super::visible::DARK_SUBSET_MIN`] of them are ([`super::visible`];
+    /// on by default, and only with [`Self::skip_invisible`]). Off to
+    /// measure what leaving them out of the sort saves.
+    pub dark_subset: bool,
 }
 
 impl Default for ProjectedOptions {
@@ -143,6 +148,7 @@ impl Default for ProjectedOptions {
             refine_tol: crate::numeric::tolerance::COLOR_REFINE_TOL,
             exact_ties: true,
             occlusion: Some(crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE),
+            dark_subset: true,
         }
     }
 }

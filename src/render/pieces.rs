@@ -56,7 +56,13 @@ pub fn value_range(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
 
 /// What a view needs to turn pieces into polyhedra; see the module docs.
 pub struct PieceSource<'a> {
+    /// The cells drawn: the geometry's, or its visible subset
+    /// ([`super::visible`]), over the same points.
     pub mesh: &'a Mesh,
+    /// The geometry's whole mesh: scene-wide lengths (the pre-integrated
+    /// tables' length range) come from it, so that they do not depend on
+    /// which cells are sorted.
+    pub whole: &'a Mesh,
     pub scalars: ScalarsRef<'a>,
     pub tf: &'a TransferFunction,
     pub camera: &'a Camera,

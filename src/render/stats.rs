@@ -38,6 +38,11 @@ pub struct ProjectedStats {
     /// ([`super::group`]).
     pub group_pixels: usize,
     pub sort_s: f64,
+    /// Dark cells left out of the sort ([`super::visible`]: the visible
+    /// subset was sorted and drawn), and the time spent building the
+    /// subset this frame (0 when it was reused).
+    pub dark_cells_left_out: usize,
+    pub visible_subset_s: f64,
     /// The frame took the renderer's last order, made for the same camera,
     /// split policy, scalars and sorter options, without sorting again
     /// (`order` then holds the statistics of the sort that made it).
@@ -90,6 +95,13 @@ impl fmt::Display for ProjectedStats {
             o.time_split.as_secs_f64(),
             o.time_sort.as_secs_f64()
         )?;
+        if e.dark_cells_left_out > 0 {
+            writeln!(
+                f,
+                "visible      {:.3} s  ({} dark cells left out of the sort)",
+                e.visible_subset_s, e.dark_cells_left_out
+            )?;
+        }
         writeln!(
             f,
             "occlusion    {:.3} s  ({} pieces hidden behind opaque ones)",

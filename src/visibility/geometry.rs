@@ -127,6 +127,7 @@ fn face_block(
     mesh: &Mesh,
     topo: &Topology,
     vol: &[f64],
+    cut: &[bool],
     range: std::ops::Range<usize>,
 ) -> FaceBlock {
     let p = &mesh.points;
@@ -179,7 +180,11 @@ fn face_block(
         if face.len() > 3 && face_planar(p, face) {
             flags |= PLANAR;
         }
-        if c1 == NONE && face.len() > 3 && boundary_face_concave(p, face, flags & FLIP != 0) {
+        let was_interior = cut.get(f).copied().unwrap_or(false);
+        if c1 == NONE
+            && face.len() > 3
+            && (was_interior || boundary_face_concave(p, face, flags & FLIP != 0))
+        {
             flags |= CONCAVE;
         }
         out.face_err.push([round_up(m), round_up(amax)]);
@@ -191,7 +196,12 @@ fn face_block(
 
 impl Geometry {
     /// Builds the data for `mesh` (point ids already checked in range).
-    pub fn build(mesh: &Mesh, topo: &Topology) -> Geometry {
+    /// For a mesh cut out of a larger one, the boundary faces `f` with
+    /// `cut[f]` were interior faces there, and are flagged [`CONCAVE`]
+    /// whatever their shape, so that a problem face there splits its cell
+    /// as the interior face did ([`super::Sorter::for_subset`]); `cut` is
+    /// empty for a whole mesh.
+    pub fn build(mesh: &Mesh, topo: &Topology, cut: &[bool]) -> Geometry {
         let p = &mesh.points;
         let nf = topo.face_count();
         let vol: Vec<f64> = (0..mesh.cells.len())
@@ -204,7 +214,7 @@ impl Geometry {
         const BLOCK: usize = 8192;
         let blocks: Vec<FaceBlock> = (0..nf.div_ceil(BLOCK))
             .into_par_iter()
-            .map(|b| face_block(mesh, topo, &vol, b * BLOCK..((b + 1) * BLOCK).min(nf)))
+            .map(|b| face_block(mesh, topo, &vol, cut, b * BLOCK..((b + 1) * BLOCK).min(nf)))
             .collect();
         let mut g = Geometry {
             tri_off: Vec::with_capacity(nf + 1),

@@ -153,6 +153,21 @@ impl Sorter {
     /// the values may. Invalid input (point ids out of range, non-finite
     /// points, a topology of another mesh) is reported by [`Sorter::order`].
     pub fn new(mesh: impl Into<Arc<Mesh>>, topo: impl Into<Arc<Topology>>) -> Sorter {
+        Sorter::for_subset(mesh, topo, &[])
+    }
+
+    /// [`Sorter::new`] for a mesh of some of the cells of a larger one
+    /// (the renderer's visible subset, `render::visible`): the boundary
+    /// faces `f` with `cut[f]` were interior there. A problem face among
+    /// them splits its cell as an interior problem face would (not only
+    /// where the cell is concave along the diagonal, the rule of true
+    /// boundary faces), so the cells the subset's orders draw as tets are
+    /// those the whole mesh's would, but for cycles.
+    pub fn for_subset(
+        mesh: impl Into<Arc<Mesh>>,
+        topo: impl Into<Arc<Topology>>,
+        cut: &[bool],
+    ) -> Sorter {
         let (mesh, topo) = (mesh.into(), topo.into());
         let n = mesh.cells.len();
         let invalid = super::input::check_input(&mesh, &topo);
@@ -162,7 +177,7 @@ impl Sorter {
                 Geometry::default(),
             )
         } else {
-            let geom = Geometry::build(&mesh, &topo);
+            let geom = Geometry::build(&mesh, &topo, cut);
             (topo, geom)
         };
         let nf = topo.face_count();

@@ -569,7 +569,10 @@ fn push_out<V: GpuVertex>(
 /// Renders the scene with a projected-cell mode. The GPU context is `gpu`,
 /// or, when that is empty, `pending` (a context opening on another thread,
 /// waited for after the sort, which it overlaps) or a new one opened with
-/// `opts.gpu`; it is left in `gpu`.
+/// `opts.gpu`; it is left in `gpu`. `whole` is the geometry's mesh
+/// (`scene` may hold only its visible subset, [`super::visible`]): the
+/// tie decisions take its bounding sphere, as the reference does, and the
+/// tables its lengths.
 #[allow(clippy::too_many_arguments)]
 pub fn render_projected<M: ProjectedMode>(
     mode: &M,
@@ -580,6 +583,7 @@ pub fn render_projected<M: ProjectedMode>(
     orders: &mut super::order_cache::OrderCache,
     opts: &RenderOptions,
     camera: &Camera,
+    whole: &crate::mesh::Mesh,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<(Image, ProjectedStats), RenderError> {
     let mut stats = ProjectedStats::default();
@@ -611,6 +615,7 @@ pub fn render_projected<M: ProjectedMode>(
 
     let src = PieceSource {
         mesh: &scene.mesh,
+        whole,
         scalars: scene.scalars(),
         tf: &scene.tf,
         camera,
@@ -621,7 +626,7 @@ pub fn render_projected<M: ProjectedMode>(
         cull: opts.projected.cull_to_pixels,
         skip_invisible: opts.projected.skip_invisible,
         grid: PixelGrid::new(camera.width, camera.height),
-        ties: TieRays::new(camera, scene.mesh.bounds()),
+        ties: TieRays::new(camera, whole.bounds()),
         exact_ties: opts.projected.exact_ties,
         iso: mode.isosurfaces(),
         volume: mode.draws_volume(),

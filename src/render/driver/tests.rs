@@ -19,6 +19,7 @@ fn test_ctx<'a>(
 ) -> PieceSource<'a> {
     PieceSource {
         mesh: &scene.mesh,
+        whole: &scene.mesh,
         scalars: scene.scalars(),
         tf: &scene.tf,
         camera,

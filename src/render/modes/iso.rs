@@ -645,7 +645,7 @@ impl ProjectedMode for IsoMode {
             Volume::Table(p) => p.bind_stage(
                 gpu,
                 Some(self.stage()),
-                src.mesh,
+                src.whole,
                 src.tf,
                 src.camera,
                 &extra,
@@ -654,7 +654,7 @@ impl ProjectedMode for IsoMode {
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<IsoVertex>> {
-        Box::new(self.twin_for(src.mesh, src.tf, src.camera))
+        Box::new(self.twin_for(src.whole, src.tf, src.camera))
     }
 
     fn payload(

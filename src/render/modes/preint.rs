@@ -446,10 +446,10 @@ impl PreintMode {
 
 impl SegmentMode for PreintMode {
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
-        self.bind_stage(gpu, None, src.mesh, src.tf, src.camera, &[])
+        self.bind_stage(gpu, None, src.whole, src.tf, src.camera, &[])
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {
-        Box::new(self.twin_for(src.mesh, src.tf, src.camera))
+        Box::new(self.twin_for(src.whole, src.tf, src.camera))
     }
 }
