@@ -98,8 +98,8 @@ fn bench(c: &mut Criterion) {
             let (_, stats) = r.render(&shading, &opts, |_, _| {}).unwrap();
             if let ModeStats::Projected(p) = &stats.detail {
                 eprintln!(
-                    "{name} {label}: {:.3} s, {} pieces, {} culled",
-                    stats.total_s, p.pieces, p.culled_pieces
+                    "{name} {label}: {:.3} s, {} pieces, {} culled, {} dark cells left out of the sort",
+                    stats.total_s, p.pieces, p.culled_pieces, p.dark_cells_left_out
                 );
             }
         }

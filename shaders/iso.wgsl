@@ -8,7 +8,8 @@
 // next, ..., the volume after the last. `volume(l, s0, s1)` is the stage's
 // volume integral (the exact-frag integral, a table lookup, or nothing for
 // `--mode iso`), defined by the stage next to this file. Only the values a
-// segment crosses are visited.
+// segment crosses are visited, and none behind a surface that made the
+// fragment opaque.
 //
 // Bindings 3 and 4 (after the volume's own 0-2). Twin: render::modes::iso.
 
@@ -166,6 +167,12 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, e: vec2<f32>) -> vec4<f32
                 back = iso_over(back, iso_surface(k, rising, g, u));
             } else {
                 acc = iso_over(acc, iso_surface(k, rising, g, 1.0));
+                // Opaque now: nothing behind shows (each later step would
+                // add t = 0 times itself), so the cost is one surface's,
+                // however many the segment crosses.
+                if acc.w >= 1.0 {
+                    break;
+                }
             }
         }
         u0 = u;

@@ -440,6 +440,9 @@ pub fn iso_segment(
                 back = iso_over(back, iso_surface(stage, k, rising, g, u));
             } else {
                 acc = iso_over(acc, iso_surface(stage, k, rising, g, 1.0));
+                if acc[3] >= 1.0 {
+                    break;
+                }
             }
         }
         (u0, s0) = (u, sv);
