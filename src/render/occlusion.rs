@@ -31,11 +31,13 @@
 //! by [`CREDIT_SHRINK`] for the rounding of the drawn segment, is the
 //! credit.
 //!
-//! **The test.** A piece's pixels lie in the box of its cell's projected
-//! points (the projection of a convex piece is the hull of its corners',
+//! **The test.** A piece's pixels lie in the box of its projected corners:
+//! its cell's points, or for a tet, a slab or a fragment its tet's corners
+//! (the projection of a convex piece is the hull of its corners',
 //! and the pixels the driver's exact decisions give it are on rays that
-//! meet it), grown by [`FRUSTUM_MARGIN_PX`]. Cells with a point not in
-//! front of the near plane are never hidden and never credit.
+//! meet it), grown by [`FRUSTUM_MARGIN_PX`]. Pieces with a corner not in
+//! front of the near plane are never hidden, cells with such a point never
+//! credit.
 //!
 //! **Blocks.** The walk goes in blocks of a size fixed by the number of
 //! pieces ([`BLOCKS`] of them, within [`BLOCK_MIN`] and [`BLOCK_MAX`]): the
@@ -60,7 +62,7 @@ use crate::numeric::tolerance::FRUSTUM_MARGIN_PX;
 #[cfg(doc)]
 use crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE;
 use crate::tf::EmissionModel;
-use crate::visibility::Order;
+use crate::visibility::{Order, Piece};
 
 use super::pieces::{value_range, PieceSource};
 
@@ -184,16 +186,12 @@ pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Op
                 .into_par_iter()
                 .filter(|&k| {
                     !in_group[k]
-                        && cell_box(
-                            src,
-                            order.pieces[k].cell() as usize,
-                            &view.screen,
-                            FRUSTUM_MARGIN_PX,
-                        )
-                        .is_some_and(|(x0, x1, y0, y1)| {
-                            (y0..y1)
-                                .all(|j| depth[j * w + x0..j * w + x1].iter().all(|&d| d >= cut))
-                        })
+                        && piece_box(src, &order.pieces[k], &view.screen, FRUSTUM_MARGIN_PX)
+                            .is_some_and(|(x0, x1, y0, y1)| {
+                                (y0..y1).all(|j| {
+                                    depth[j * w + x0..j * w + x1].iter().all(|&d| d >= cut)
+                                })
+                            })
                 })
                 .collect();
             count += found.len();
@@ -236,6 +234,23 @@ pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Op
     Some(Occlusion { hidden, count })
 }
 
+/// The box of [`points_box`] around a piece: its cell's points for a
+/// whole cell, its tet's corners for a tet, a slab or a fragment (which lie
+/// in their tet, so their pixels lie in the tet's projection).
+fn piece_box(
+    src: &PieceSource,
+    piece: &Piece,
+    screen: &[Option<(f64, f64)>],
+    m: f64,
+) -> Option<(usize, usize, usize, usize)> {
+    match *piece {
+        Piece::Cell(c) => points_box(src, src.mesh.cells.nodes(c as usize), screen, m),
+        Piece::Tet { tet, .. } | Piece::Slab { tet, .. } | Piece::Frag { tet, .. } => {
+            points_box(src, &tet, screen, m)
+        }
+    }
+}
+
 /// Pixel-centre index ranges `[x0, x1) x [y0, y1)` of the box of cell
 /// `c`'s projected points grown by `m` pixels (centres at `i + 0.5`);
 /// `None` when a point is not in front of the near plane or the box holds
@@ -246,8 +261,18 @@ fn cell_box(
     screen: &[Option<(f64, f64)>],
     m: f64,
 ) -> Option<(usize, usize, usize, usize)> {
+    points_box(src, src.mesh.cells.nodes(c), screen, m)
+}
+
+/// The box of [`cell_box`] around the projections of `points`.
+fn points_box(
+    src: &PieceSource,
+    points: &[u32],
+    screen: &[Option<(f64, f64)>],
+    m: f64,
+) -> Option<(usize, usize, usize, usize)> {
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &p in src.mesh.cells.nodes(c) {
+    for &p in points {
         let (x, y) = screen.get(p as usize).copied().flatten()?;
         x0 = x0.min(x);
         x1 = x1.max(x);
