@@ -220,7 +220,7 @@ impl Renderer {
     /// subset ([`visible`]).
     pub fn last_order(&self) -> Option<std::sync::Arc<crate::visibility::Order>> {
         if self.last_visible {
-            let (subset, _, _) = self.visible.current()?;
+            let subset = self.visible.current()?;
             let order = subset.orders.last()?;
             return Some(std::sync::Arc::new(subset.whole_order(order)));
         }
@@ -349,57 +349,44 @@ impl Renderer {
             gpu,
             pending_gpu,
         } = self;
-        let subset = if opts.projected.skip_invisible && opts.projected.dark_subset {
-            visible.prepare(scene, mode.isosurfaces(), mode.draws_volume())
-        } else {
-            (None, 0, 0.0)
-        };
-        *last_visible = subset.0.is_some();
-        let (img, stats, sorter_s) = match subset {
-            (Some(sub), dark_cells, built_s) => {
-                // The sorter's options are the whole mesh's.
+        let (subset, dark_cells, checked_s) =
+            if opts.projected.skip_invisible && opts.projected.dark_subset {
+                visible.prepare(scene, mode.isosurfaces(), mode.draws_volume())
+            } else {
+                (None, 0, 0.0)
+            };
+        *last_visible = subset.is_some();
+        // The visible subset's scene, sorter and order cache, or the
+        // geometry's; one driver call either way.
+        let sub_scene;
+        let (drawn, sorter, orders, sorter_s) = match subset {
+            Some(sub) => {
                 if let Some(s) = sorter.as_ref() {
-                    sub.sorter.nonconvex = s.nonconvex;
-                    sub.sorter.plane_split = s.plane_split;
-                    sub.sorter.frustum_margin = s.frustum_margin;
+                    sub.sorter.copy_options(s);
                 }
-                let sub_scene = sub.scene_of(scene);
-                let (img, mut stats) = driver::render_projected(
-                    mode,
-                    &sub_scene,
-                    &mut sub.sorter,
-                    gpu,
-                    pending_gpu,
-                    &mut sub.orders,
-                    opts,
-                    camera,
-                    &scene.mesh,
-                    progress,
-                )?;
-                stats.dark_cells_left_out = dark_cells;
-                stats.visible_subset_s = built_s;
-                (img, stats, built_s)
+                sub_scene = sub.scene_of(scene);
+                (&sub_scene, &mut sub.sorter, &mut sub.orders, checked_s)
             }
-            (None, _, checked_s) => {
+            None => {
                 let sorter =
                     sorter.get_or_insert_with(|| Sorter::new(g.mesh.clone(), g.topology.clone()));
-                let sorter_s = t0.elapsed().as_secs_f64();
-                let (img, mut stats) = driver::render_projected(
-                    mode,
-                    scene,
-                    sorter,
-                    gpu,
-                    pending_gpu,
-                    orders,
-                    opts,
-                    camera,
-                    &scene.mesh,
-                    progress,
-                )?;
-                stats.visible_subset_s = checked_s;
-                (img, stats, sorter_s)
+                (scene, sorter, orders, t0.elapsed().as_secs_f64())
             }
         };
+        let (img, mut stats) = driver::render_projected(
+            mode,
+            drawn,
+            sorter,
+            gpu,
+            pending_gpu,
+            orders,
+            opts,
+            camera,
+            &scene.mesh,
+            progress,
+        )?;
+        stats.dark_cells_left_out = dark_cells;
+        stats.visible_subset_s = checked_s;
         let setup_s = sorter_s + stats.gpu_open_s;
         Ok((img, ModeStats::Projected(Box::new(stats)), setup_s))
     }

@@ -251,20 +251,10 @@ fn piece_box(
     }
 }
 
-/// Pixel-centre index ranges `[x0, x1) x [y0, y1)` of the box of cell
-/// `c`'s projected points grown by `m` pixels (centres at `i + 0.5`);
+/// Pixel-centre index ranges `[x0, x1) x [y0, y1)` of the box of the
+/// projections of `points` grown by `m` pixels (centres at `i + 0.5`);
 /// `None` when a point is not in front of the near plane or the box holds
 /// no centre.
-fn cell_box(
-    src: &PieceSource,
-    c: usize,
-    screen: &[Option<(f64, f64)>],
-    m: f64,
-) -> Option<(usize, usize, usize, usize)> {
-    points_box(src, src.mesh.cells.nodes(c), screen, m)
-}
-
-/// The box of [`cell_box`] around the projections of `points`.
 fn points_box(
     src: &PieceSource,
     points: &[u32],
@@ -311,7 +301,9 @@ fn cell_credit(
         return;
     }
     // The chord is 0 outside the hull of the projected points.
-    let Some((x0, x1, y0, y1)) = cell_box(src, c as usize, &view.screen, 0.0) else {
+    let Some((x0, x1, y0, y1)) =
+        points_box(src, src.mesh.cells.nodes(c as usize), &view.screen, 0.0)
+    else {
         return;
     };
     if (y0..y1).all(|j| {

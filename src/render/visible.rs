@@ -138,10 +138,9 @@ pub struct VisibleCache {
 }
 
 impl VisibleCache {
-    /// The subset of the last key, with its dark cells and key darkness.
-    pub fn current(&self) -> Option<(&VisibleSubset, usize, u64)> {
-        let key = self.key.as_ref()?;
-        Some((self.subset.as_ref()?, self.dark_cells, key.dark))
+    /// The subset of the last key, if it has one.
+    pub fn current(&self) -> Option<&VisibleSubset> {
+        self.subset.as_ref()
     }
 
     /// Forgets the subset (a new geometry).

@@ -201,6 +201,15 @@ impl Sorter {
         }
     }
 
+    /// Takes `other`'s options ([`Self::nonconvex`], [`Self::plane_split`],
+    /// [`Self::frustum_margin`]): a sorter of a subset of `other`'s mesh
+    /// sorts as `other` would.
+    pub fn copy_options(&mut self, other: &Sorter) {
+        self.nonconvex = other.nonconvex;
+        self.plane_split = other.plane_split;
+        self.frustum_margin = other.frustum_margin;
+    }
+
     /// Whether the boundary of the mesh is convex (no pixel constraints).
     pub fn convex_boundary(&self) -> bool {
         self.geom.convex
