@@ -176,16 +176,18 @@ fn the_last_order_is_reused_only_when_nothing_it_depends_on_changed() {
         let (img, stats) = renderer
             .render(shading, &opts(Mode::Exact, az), |_, _| {})
             .unwrap();
-        (img, stats.projected().unwrap().order_reused)
+        let p = stats.projected().unwrap();
+        assert!(!(p.order_reused && p.sort_reused));
+        (img, p.order_reused, p.sort_reused)
     };
-    let (first, reused) = frame(&mut renderer, &shading, 30.0);
-    assert!(!reused);
-    let (again, reused) = frame(&mut renderer, &shading, 30.0);
+    let (first, reused, sort) = frame(&mut renderer, &shading, 30.0);
+    assert!(!reused && !sort);
+    let (again, reused, _) = frame(&mut renderer, &shading, 30.0);
     assert!(reused, "the same frame sorts again");
     assert_eq!(first.pixels, again.pixels);
     // Another camera.
-    let (_, reused) = frame(&mut renderer, &shading, 31.0);
-    assert!(!reused);
+    let (_, reused, sort) = frame(&mut renderer, &shading, 31.0);
+    assert!(!reused && !sort);
     // New colours, same split points: the order stands.
     let mut recoloured = shading.clone();
     let nodes: Vec<_> = shading.tf.nodes();
@@ -195,7 +197,7 @@ fn the_last_order_is_reused_only_when_nothing_it_depends_on_changed() {
         .map(|n| (n.s, [n.color[2], n.color[1], n.color[0]]))
         .collect();
     recoloured.tf = TransferFunction::from_channels(&tau, &col, None, EmissionModel::Glow).unwrap();
-    let (_, reused) = frame(&mut renderer, &recoloured, 31.0);
+    let (_, reused, _) = frame(&mut renderer, &recoloured, 31.0);
     assert!(reused, "colours alone do not change the order");
     // New values: sorted again.
     let mut revalued = shading.clone();
@@ -206,8 +208,20 @@ fn the_last_order_is_reused_only_when_nothing_it_depends_on_changed() {
         }
         revalued.field = Some(std::sync::Arc::new(f2));
     }
-    let (_, reused) = frame(&mut renderer, &revalued, 31.0);
-    assert!(!reused, "new values sort again where they decide splits");
+    let (spliced, reused, sort) = frame(&mut renderer, &revalued, 31.0);
+    assert!(
+        !reused,
+        "new values make a new order where they decide splits"
+    );
+    assert!(
+        sort,
+        "new values keep the view's sort and splice the values in"
+    );
+    // The same image as a renderer that never saw the old values.
+    let mut fresh = Renderer::new(scene.geometry());
+    let (alone, reused, sort) = frame(&mut fresh, &revalued, 31.0);
+    assert!(!reused && !sort);
+    assert_eq!(spliced.pixels, alone.pixels);
     // exact-frag splits at no value: new values keep its order.
     let mut frag = |shading: &zoovr::render::Shading| {
         let (_, stats) = renderer

@@ -179,13 +179,14 @@ impl Renderer {
     /// ([`Geometry::next_step`]), keeping what `change` allows: with
     /// [`StepChange::Values`] (or `None`) the visibility sorter (its planes,
     /// splits and scratch) stays, otherwise it is rebuilt on first use (on
-    /// the shared topology for [`StepChange::Points`]); the GPU context
-    /// always stays.
+    /// the shared topology for [`StepChange::Points`]), and so do the
+    /// views' sorts ([`order_cache`]: a values-only step splices its values
+    /// into the last sort of the view); the GPU context always stays.
     pub fn set_geometry(&mut self, geometry: Geometry, change: StepChange) {
         if !matches!(change, StepChange::None | StepChange::Values) {
             self.sorter = None;
+            self.orders.clear();
         }
-        self.orders.clear();
         self.visible.clear();
         self.geometry = geometry;
     }

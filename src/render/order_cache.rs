@@ -1,38 +1,59 @@
 //! The last visibility order a [`super::Renderer`] made, reused when the
-//! next frame asks for the same one.
+//! next frame asks for the same one, and the last view's sort, reused when
+//! only the values changed.
 //!
-//! An order depends on the camera, the split policy (`--split all`, the
-//! mode's split points, and through them the point scalars: cells whose
-//! range holds a split point are split) and the sorter's own options. The
-//! cache keeps the last order with those inputs as its key (the scalars by
-//! count and a 64-bit hash of their bits, computed once per frame: about a
-//! millisecond per million points); a frame whose key is equal takes the
-//! same order without sorting again (the order is shared, not copied). This
-//! is what a repeated frame (a benchmark's repeats), a change of colours
-//! that keeps the split points, or of isosurface styles, or of the mode's
-//! drawing options, saves; for a mode without split points (`exact-frag`
-//! with no `--split all`) new values alone keep the order too, since the
-//! scalars then split nothing. New geometry clears it
-//! ([`super::Renderer::set_geometry`]).
+//! An order is the geometry's order of the view ([`Sorter::base_order`]:
+//! it depends on the camera, `--split all` and the sorter's options) with
+//! the values spliced in ([`Sorter::splice`]: the mode's split points and,
+//! through them, the point scalars, and what is dark). The cache keeps
+//! both, each with its inputs as its key (the scalars by count and a 64-bit
+//! hash of their bits, computed once per frame: about a millisecond per
+//! million points):
+//! - a frame whose whole key is equal takes the same order without sorting
+//!   or splicing (a benchmark's repeats, new colours that keep the split
+//!   points, new isosurface styles or drawing options; for a mode without
+//!   split points, new values too, since the scalars then split nothing);
+//! - a frame of the same view with new values or new split points (a time
+//!   step, a new transfer function) keeps the sort and only splices, which
+//!   is what `zoovr animate` saves on a series whose values change.
+//!
+//! New geometry clears both ([`super::Renderer::set_geometry`]).
 
 use std::sync::Arc;
 
 use crate::camera::Camera;
 use crate::visibility::{NonConvex, Order, Sorter, SplitPolicy, VisibilityError};
 
-/// What an order was made from.
+/// What the geometry's order of a view was made from.
 #[derive(Clone, Debug, PartialEq)]
-struct Key {
+struct BaseKey {
     camera: Camera,
     all: bool,
-    breakpoints: Vec<f64>,
-    /// Count and hash of the point scalars, when the policy has them.
-    scalars: Option<(usize, u64)>,
     nonconvex: NonConvex,
     plane_split: bool,
     frustum_margin: Option<f64>,
+}
+
+/// What an order was made from.
+#[derive(Clone, Debug, PartialEq)]
+struct Key {
+    base: BaseKey,
+    breakpoints: Vec<f64>,
+    /// Count and hash of the point scalars, when the policy has them.
+    scalars: Option<(usize, u64)>,
     /// What decides which cells are dark (not split).
     dark: Option<u64>,
+}
+
+/// What a frame took from the cache.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reuse {
+    /// Nothing: the view was sorted.
+    None,
+    /// The view's sort; the values were spliced in.
+    Sort,
+    /// The whole order.
+    Order,
 }
 
 /// A 64-bit hash of the bits of `v` (FxHash-style mixing; equal slices hash
@@ -50,12 +71,14 @@ fn hash_bits(v: &[f64]) -> u64 {
 #[derive(Default)]
 pub struct OrderCache {
     last: Option<(Key, Arc<Order>)>,
+    base: Option<(BaseKey, Arc<Order>)>,
 }
 
 impl OrderCache {
-    /// Forgets the last order.
+    /// Forgets the last order and sort.
     pub fn clear(&mut self) {
         self.last = None;
+        self.base = None;
     }
 
     /// The last order made or reused, if any.
@@ -64,41 +87,56 @@ impl OrderCache {
     }
 
     /// The order of `sorter` for `camera` and `policy`: the last one when
-    /// its key is equal (`true`), else a new sort (`false`), kept for next
+    /// its key is equal, else the values spliced into the last sort of the
+    /// view when that is the same, else a new sort; both kept for next
     /// time.
     pub fn order(
         &mut self,
         sorter: &mut Sorter,
         camera: &Camera,
         policy: &SplitPolicy,
-    ) -> Result<(Arc<Order>, bool), VisibilityError> {
-        let key = Key {
+    ) -> Result<(Arc<Order>, Reuse), VisibilityError> {
+        let base_key = BaseKey {
             camera: *camera,
             all: policy.all,
+            nonconvex: sorter.nonconvex,
+            plane_split: sorter.plane_split,
+            frustum_margin: sorter.frustum_margin,
+        };
+        let splits = policy.point_scalars.is_some() && !policy.breakpoints.is_empty();
+        let key = Key {
+            base: base_key.clone(),
             breakpoints: policy.breakpoints.to_vec(),
             // Without split points the scalars split nothing.
             scalars: policy
                 .point_scalars
-                .filter(|_| !policy.breakpoints.is_empty())
+                .filter(|_| splits)
                 .map(|s| (s.len(), hash_bits(s))),
-            nonconvex: sorter.nonconvex,
-            plane_split: sorter.plane_split,
-            frustum_margin: sorter.frustum_margin,
             // Only where scalars decide splits.
-            dark: policy
-                .dark
-                .filter(|_| policy.point_scalars.is_some() && !policy.breakpoints.is_empty())
-                .map(|d| d.key),
+            dark: policy.dark.filter(|_| splits).map(|d| d.key),
         };
         if let Some((k, order)) = &self.last {
             if *k == key {
-                return Ok((order.clone(), true));
+                return Ok((order.clone(), Reuse::Order));
             }
         }
         self.last = None;
-        let order = Arc::new(sorter.order(camera, policy)?);
+        let (base, reuse) = match &self.base {
+            Some((k, base)) if *k == base_key => (base.clone(), Reuse::Sort),
+            _ => {
+                self.base = None;
+                let base = Arc::new(sorter.base_order(camera, policy.all)?);
+                self.base = Some((base_key, base.clone()));
+                (base, Reuse::None)
+            }
+        };
+        let order = if splits {
+            Arc::new(sorter.splice(&base, camera, policy)?)
+        } else {
+            base
+        };
         self.last = Some((key, order.clone()));
-        Ok((order, false))
+        Ok((order, reuse))
     }
 }
 

@@ -47,6 +47,11 @@ pub struct ProjectedStats {
     /// split policy, scalars and sorter options, without sorting again
     /// (`order` then holds the statistics of the sort that made it).
     pub order_reused: bool,
+    /// The frame took the sort of the same view (the geometry's order,
+    /// [`crate::visibility::Sorter::base_order`]) and only spliced its
+    /// values in: a time step or a transfer function that changed only the
+    /// values' splits.
+    pub sort_reused: bool,
     /// Time spent opening (or waiting for) the GPU context.
     pub gpu_open_s: f64,
     /// Projection, payloads and the draw calls, which overlap (workers
@@ -74,7 +79,13 @@ impl fmt::Display for ProjectedStats {
             f,
             "sort         {:.3} s{}  ({} pieces, {} cells outside the view, {} split cells, {} dark cells left whole, {} problem cells, {} cycles, {} cut by planes into {} fragments, {} cycle groups of {} pieces over {} pixels)",
             e.sort_s,
-            if e.order_reused { ", order reused" } else { "" },
+            if e.order_reused {
+                ", order reused"
+            } else if e.sort_reused {
+                ", sort reused, values spliced"
+            } else {
+                ""
+            },
             e.pieces,
             o.frustum_culled,
             o.split_cells,
@@ -89,11 +100,12 @@ impl fmt::Display for ProjectedStats {
         )?;
         writeln!(
             f,
-            "             (classify faces {:.3}, non-convex constraints {:.3}, splits {:.3}, topological sort {:.3})",
+            "             (classify faces {:.3}, non-convex constraints {:.3}, splits {:.3}, topological sort {:.3}, values spliced {:.3})",
             o.time_classify.as_secs_f64(),
             o.time_nonconvex.as_secs_f64(),
             o.time_split.as_secs_f64(),
-            o.time_sort.as_secs_f64()
+            o.time_sort.as_secs_f64(),
+            o.time_splice.as_secs_f64()
         )?;
         if e.dark_cells_left_out > 0 {
             writeln!(

@@ -8,7 +8,8 @@
 //! it with the geometry, exactly (bit for bit, no tolerance):
 //! - [`StepChange::Values`]: the same cells and the same point coordinates;
 //!   only the arrays differ. The renderer keeps everything: topology, the
-//!   sorter with its planes and splits, the GPU context.
+//!   sorter with its planes and splits, the last sort of the view (a step
+//!   only splices its values in), the GPU context.
 //! - [`StepChange::Points`]: the same cells (connectivity, kinds, polyhedron
 //!   faces) after the merge, new coordinates (a deforming mesh). The face
 //!   adjacency ([`Topology`]) depends on the cells alone and is shared; the

@@ -212,6 +212,10 @@ pub struct OrderStats {
     pub problem_cells: usize,
     /// Cells split because their scalar range holds a breakpoint.
     pub breakpoint_cells: usize,
+    /// Of those, the cells split by [`Sorter::splice`] (not in the
+    /// sorter's own split cells, [`Sorter::split_count`]); 0 when the
+    /// order was sorted in one step.
+    pub spliced_cells: usize,
     /// Cells whose scalar range holds a breakpoint but is dark
     /// ([`SplitPolicy::dark`]): left whole.
     pub dark_unsplit: usize,
@@ -259,6 +263,9 @@ pub struct OrderStats {
     pub time_nonconvex: Duration,
     /// Time for the topological sorts and cycle handling.
     pub time_sort: Duration,
+    /// Time to splice the values' splits into the geometry's order
+    /// ([`Sorter::splice`]).
+    pub time_splice: Duration,
     /// Total time of the call.
     pub time_total: Duration,
 }

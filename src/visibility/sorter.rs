@@ -90,6 +90,7 @@ pub enum NonConvex {
 }
 
 mod finish;
+mod splice;
 
 /// Built once per geometry; call [`Sorter::order`] per view.
 #[derive(Clone, Debug)]
@@ -220,12 +221,22 @@ impl Sorter {
         self.pool.active.len()
     }
 
-    /// The back-to-front order of pieces for `camera`.
+    /// The back-to-front order of pieces for `camera`: the geometry's
+    /// order ([`Sorter::base_order`]) with the values spliced in
+    /// ([`Sorter::splice`]).
     pub fn order(
         &mut self,
         camera: &Camera,
         policy: &SplitPolicy,
     ) -> Result<Order, VisibilityError> {
+        let base = self.base_order(camera, policy.all)?;
+        self.splice(&base, camera, policy)
+    }
+
+    /// The order in one step: every split of `policy` made before the
+    /// topological sort (the splice's fallback, and its base with no
+    /// values).
+    fn sort(&mut self, camera: &Camera, policy: &SplitPolicy) -> Result<Order, VisibilityError> {
         let t_start = Instant::now();
         if let Some(e) = &self.invalid {
             return Err(e.clone());

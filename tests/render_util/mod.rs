@@ -18,6 +18,18 @@ pub fn gpu_available() -> bool {
     }
 }
 
+/// Whether the default GPU context accumulates in f16 (GL on llvmpipe,
+/// which cannot blend f32 targets); false without an adapter.
+pub fn gpu_accumulates_f16() -> bool {
+    use zoovr::gpu::AccumFormat;
+    static F16: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *F16.get_or_init(|| {
+        Context::new(&GpuOptions::default())
+            .and_then(|c| c.resolve_format(AccumFormat::Auto))
+            .is_ok_and(|f| f == AccumFormat::F16)
+    })
+}
+
 /// Options of one render in `mode`: every cell drawn as its consistent tets
 /// when `split_all` (projected-cell modes), the ray caster's field `model`;
 /// the default camera, GPU and accumulation.

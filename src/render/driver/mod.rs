@@ -608,7 +608,8 @@ pub fn render_projected<M: ProjectedMode>(
         dark,
     };
     let (order, reused) = orders.order(sorter, camera, &policy)?;
-    stats.order_reused = reused;
+    stats.order_reused = reused == super::order_cache::Reuse::Order;
+    stats.sort_reused = reused == super::order_cache::Reuse::Sort;
     stats.sort_s = t0.elapsed().as_secs_f64();
     stats.pieces = order.pieces.len();
     stats.order = order.stats.clone();

@@ -37,14 +37,14 @@ impl Sorter {
             Some(_) => slabs::order_levels(policy.breakpoints),
             None => Vec::new(),
         };
-        let writer = |capacity: usize| OrderWriter {
-            pieces: Vec::with_capacity(capacity),
-            levels: &levels,
-            scalars: policy.point_scalars,
-            points: &self.mesh.points,
-            camera,
-            sliced: 0,
-            scratch: SlabScratch::default(),
+        let writer = |capacity: usize| {
+            OrderWriter::new(
+                capacity,
+                &levels,
+                policy.point_scalars,
+                &self.mesh.points,
+                camera,
+            )
         };
         // The emitted pieces in blocks on the thread pool (slicing a tet
         // into its ordered slabs is most of the work), joined in order.
@@ -170,18 +170,38 @@ impl Sorter {
 
 /// Writes pieces into (one block of) an order, a tet holding breakpoints
 /// as its slabs ([`slabs::tet_slabs`]).
-struct OrderWriter<'a> {
-    pieces: Vec<Piece>,
+pub(super) struct OrderWriter<'a> {
+    pub(super) pieces: Vec<Piece>,
     levels: &'a [f64],
     scalars: Option<&'a [f64]>,
     points: &'a [DVec3],
     camera: &'a Camera,
-    sliced: usize,
+    /// Tets written as slabs.
+    pub(super) sliced: usize,
     scratch: SlabScratch,
 }
 
-impl OrderWriter<'_> {
-    fn push(&mut self, piece: Piece) {
+impl<'a> OrderWriter<'a> {
+    pub(super) fn new(
+        capacity: usize,
+        levels: &'a [f64],
+        scalars: Option<&'a [f64]>,
+        points: &'a [DVec3],
+        camera: &'a Camera,
+    ) -> Self {
+        OrderWriter {
+            pieces: Vec::with_capacity(capacity),
+            levels,
+            scalars,
+            points,
+            camera,
+            sliced: 0,
+            scratch: SlabScratch::default(),
+        }
+    }
+
+    /// Writes `piece`; a tet holding breakpoints as its slabs.
+    pub(super) fn push(&mut self, piece: Piece) {
         let (Piece::Tet { cell, tet }, Some(sc)) = (piece, self.scalars) else {
             self.pieces.push(piece);
             return;
