@@ -130,6 +130,7 @@ fn alpha_follows_interpolated_thickness() {
             &[0, 1, 2],
         )
         .unwrap();
+        let format = ctx.resolve_format(AccumFormat::Auto).unwrap();
         let mut worst = 0.0f64;
         for j in 0..h {
             for i in 0..w {
@@ -145,9 +146,14 @@ fn alpha_follows_interpolated_thickness() {
             }
         }
         eprintln!("ortho {ortho}: max |alpha - exact| = {worst:.2e}");
-        // Table error plus the rasteriser's f32 interpolation.
+        // Table error plus the rasteriser's f32 interpolation, and the
+        // store's rounding with f16 (GL: measured 5.2e-4).
+        let store = match format {
+            AccumFormat::F32 => 0.0,
+            _ => store_tol(format),
+        };
         assert!(
-            worst < EXP_TABLE_MAX_ABS_ERROR + 5e-5,
+            worst < EXP_TABLE_MAX_ABS_ERROR + 5e-5 + store,
             "ortho {ortho}: {worst:.3e}"
         );
     }

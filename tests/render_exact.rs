@@ -5,7 +5,8 @@
 //! `--split all` against `--model tets`; orthographic and perspective; the
 //! default transfer function and one whose extinction has kinks inside the
 //! cells (so breakpoint slabs are exercised). Bounds are on the maximum
-//! over every pixel (2/255) and the RMS (2e-3), except where a constant
+//! over every pixel (2/255 with f32 accumulation, `F16_MAX` where the GPU
+//! accumulates in f16) and the RMS (2e-3), except where a constant
 //! below names the model difference that explains more, with its measured
 //! value. Failing cases write actual/expected/diff
 //! PNGs under target/test-output. Skips cleanly without a GPU adapter or
@@ -26,11 +27,18 @@ use zoovr::render::{Mode, ProjectedOptions, RenderOptions, Renderer, Scene, Scen
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
-/// Bound on every pixel (PNG values): 2/255 (the same field, f32 or f16
-/// accumulation; see `tests/gpu_exact.rs` for the f16 bound of many thin
-/// layers), and an RMS bound.
+/// Bound on every pixel (PNG values): 2/255 (the same field, f32
+/// accumulation; `F16_MAX` with f16), and an RMS bound.
 const MAX: f64 = 2.0 / 255.0;
 const RMS: f64 = 2e-3;
+/// The bound on every pixel where the GPU accumulates in f16 (GL on
+/// llvmpipe, which cannot blend f32 targets; `tests/gpu_exact.rs`
+/// measures the store): each blend rounds to 11 significant bits, up to
+/// half an ulp (2.4e-4 at 0.5 to 1) per layer the ray meets, so the
+/// error grows with the layers of a pixel. Measured up to 1.16e-2 where
+/// f32 is within 2/255 (bluntfin and AngularSector split into tets,
+/// kinked TF; both modes, both projections).
+const F16_MAX: f64 = 1.6e-2;
 /// One optically thick cell filling the view: inside a region the glow
 /// colour `C/alpha` is interpolated, which is exact only for constant colour
 /// (docs/math.md 8.1); colour refinement bounds it, but a single cell seen
@@ -144,6 +152,14 @@ fn check_mode(
     split_bounds: (f64, f64),
 ) {
     let slices = mode.info().slices_at_breakpoints;
+    let f16 = |(m, r): (f64, f64)| {
+        if render_util::gpu_accumulates_f16() {
+            (m.max(F16_MAX), r)
+        } else {
+            (m, r)
+        }
+    };
+    let (whole_bounds, split_bounds) = (f16(whole_bounds), f16(split_bounds));
     let single_cell = name.ends_with("prism")
         || ["tetra", "pyramid", "wedge", "hexahedron", "voxel"].contains(&name);
     let mesh = io::read(path, &ReadOptions::default()).unwrap();
