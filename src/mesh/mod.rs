@@ -210,11 +210,22 @@ impl Mesh {
                 hi = hi.max(*p);
             }
         } else {
-            for &n in &self.cells.conn {
-                let p = self.points[n as usize];
-                lo = lo.min(p);
-                hi = hi.max(p);
-            }
+            // In parallel blocks (a time step's renders ask for it several
+            // times); min and max are exact, so the result does not depend
+            // on the blocks.
+            use rayon::prelude::*;
+            let points = &self.points;
+            (lo, hi) = self
+                .cells
+                .conn
+                .par_chunks(1 << 16)
+                .map(|block| {
+                    block.iter().fold((lo, hi), |(l, h), &n| {
+                        let p = points[n as usize];
+                        (l.min(p), h.max(p))
+                    })
+                })
+                .reduce(|| (lo, hi), |a, b| (a.0.min(b.0), a.1.max(b.1)));
         }
         if lo.x > hi.x {
             return [0.0; 6];
