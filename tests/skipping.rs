@@ -222,6 +222,27 @@ fn the_last_order_is_reused_only_when_nothing_it_depends_on_changed() {
     let (alone, reused, sort) = frame(&mut fresh, &revalued, 31.0);
     assert!(!reused && !sort);
     assert_eq!(spliced.pixels, alone.pixels);
+    // A transfer function with other breakpoints: the sort stands too.
+    let mut kinked = shading.clone();
+    let (lo, hi) = shading.range;
+    let at = |x: f64| lo + (hi - lo) * x;
+    kinked.tf = TransferFunction::from_channels(
+        &[
+            (at(0.0), [0.0]),
+            (at(0.35), [3.0]),
+            (at(0.6), [0.5]),
+            (at(1.0), [2.0]),
+        ],
+        &[(at(0.0), [0.2, 0.4, 0.9]), (at(1.0), [0.9, 0.5, 0.1])],
+        None,
+        EmissionModel::Glow,
+    )
+    .unwrap();
+    let (spliced, reused, sort) = frame(&mut renderer, &kinked, 31.0);
+    assert!(!reused && sort, "new breakpoints keep the view's sort");
+    let mut fresh = Renderer::new(scene.geometry());
+    let (alone, _, _) = frame(&mut fresh, &kinked, 31.0);
+    assert_eq!(spliced.pixels, alone.pixels);
     // exact-frag splits at no value: new values keep its order.
     let mut frag = |shading: &zoovr::render::Shading| {
         let (_, stats) = renderer
