@@ -112,17 +112,23 @@ fn iso_crosses(k: u32, v: f32, seg: Seg, e: vec2<f32>) -> bool {
 // step b ends it at the segment's back. RKE's blend (iso.mix 1) instead
 // draws every surface's front-face layer (opacity times 1 - u), the whole
 // segment's volume at step b, then the back-face layers (times u).
-fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, e: vec2<f32>) -> vec4<f32> {
+fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, e: vec2<f32>, range: vec2<f32>) -> vec4<f32> {
     let lo = min(seg.s_f, seg.s_b);
     let hi = max(seg.s_f, seg.s_b);
     let m = max(e.x, e.y);
+    // The search window, within the part's scalar range (flat): a no-op
+    // inside the triangle, a bound on the lanes a rasteriser shades
+    // outside it with extrapolated scalars (whose loops would otherwise
+    // run over every isovalue).
+    let wlo = max(lo, range.x) - m;
+    let whi = min(hi, range.y) + m;
     // Most segments cross nothing: two reads decide it before any search.
     var a = 0u;
     var b = 0u;
-    if iso.count > 0u && hi + m >= surfaces[0].value.x
-        && lo - m <= surfaces[iso.count - 1u].value.x {
-        a = count_at_most(lo - m);
-        b = max(count_at_most(hi + m), a);
+    if iso.count > 0u && whi >= surfaces[0].value.x
+        && wlo <= surfaces[iso.count - 1u].value.x {
+        a = count_at_most(wlo);
+        b = max(count_at_most(whi), a);
     }
     let rising = seg.s_f <= seg.s_b;
     let blend = iso.mix == 1u;
@@ -194,7 +200,7 @@ fn fs_iso(f: VertexOut) -> FragOut {
         gb = gb / f.back.y;
     }
     var out: FragOut;
-    out.color = iso_segment(seg, gf, gb, f.snap);
+    out.color = iso_segment(seg, gf, gb, f.snap, f.range);
     out.depth = piece_depth(f.piece);
     return out;
 }

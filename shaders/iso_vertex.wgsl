@@ -23,6 +23,7 @@ struct VertexIn {
     @location(5) grad_front: vec3<f32>,
     @location(6) grad_back: vec3<f32>,
     @location(7) snap: vec2<f32>,
+    @location(8) range: vec2<f32>,
 }
 
 // Default (perspective-correct, with w = 1 screen-linear) interpolation, as
@@ -36,6 +37,7 @@ struct VertexOut {
     @location(4) grad_front: vec3<f32>,
     @location(5) grad_back: vec3<f32>,
     @location(6) snap: vec2<f32>,
+    @location(7) @interpolate(flat) range: vec2<f32>,
 }
 
 @vertex
@@ -49,5 +51,6 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.grad_front = v.grad_front;
     out.grad_back = v.grad_back;
     out.snap = v.snap;
+    out.range = v.range;
     return out;
 }

@@ -87,11 +87,24 @@ pub struct IsoVertex {
     /// How far the snap of region corners to the sub-pixel grid can move
     /// `s_f` and `s_b` here ([`snap_bound`]), normalised units.
     pub snap: [f32; 2],
+    /// The part's normalised scalar range, widened by [`RANGE_MARGIN`]
+    /// (flat): every segment of the part lies in it, so the stage searches
+    /// the isovalues only there. A rasteriser may shade lanes outside the
+    /// triangle (llvmpipe runs whole pixel blocks) with extrapolated
+    /// scalars; without the bound their crossing loops ran over every
+    /// isovalue, which made a frame's cost grow with their number.
+    pub range: [f32; 2],
 }
+
+/// How far [`IsoVertex::range`] is widened beyond the part's scalars
+/// (normalised units, relative above 1): far above the `f32` rounding of a
+/// fragment's interpolated scalars, so that the bound never changes a
+/// fragment inside the triangle.
+pub const RANGE_MARGIN: f64 = 1e-3;
 
 impl IsoVertex {
     /// Vertex attributes (`@location`s of `VertexIn`).
-    pub const ATTRIBUTES: [wgpu::VertexAttribute; 8] = wgpu::vertex_attr_array![
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 9] = wgpu::vertex_attr_array![
         0 => Float32x4,
         1 => Float32x2,
         2 => Float32x2,
@@ -100,6 +113,7 @@ impl IsoVertex {
         5 => Float32x3,
         6 => Float32x3,
         7 => Float32x2,
+        8 => Float32x2,
     ];
 
     /// The vertex buffer layout of the isosurface stages.
@@ -128,6 +142,7 @@ impl GpuVertex for IsoVertex {
             && self.grad_front.iter().all(|v| v.is_finite())
             && self.grad_back.iter().all(|v| v.is_finite())
             && self.snap.iter().all(|v| v.is_finite())
+            && self.range.iter().all(|v| !v.is_nan())
     }
     fn with_clip(self, pos: [f32; 4]) -> Self {
         IsoVertex {
@@ -141,6 +156,9 @@ impl GpuVertex for IsoVertex {
             grad_front: [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_front[k])),
             grad_back: [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_back[k])),
             snap: [0, 1].map(|k| lerp(tri, bary, |v| v.snap[k])),
+            // Flat: the first vertex's (every vertex of a part has the
+            // part's).
+            range: tri[0].range,
         }
     }
     fn transparent(self) -> Self {
@@ -400,14 +418,18 @@ pub fn iso_segment(
     gf: [f32; 3],
     gb: [f32; 3],
     e: [f32; 2],
+    range: [f32; 2],
 ) -> [f32; 4] {
     let (lo, hi) = (seg.s_f.min(seg.s_b), seg.s_f.max(seg.s_b));
     let m = e[0].max(e[1]);
     let n = stage.params.count as usize;
     let (mut a, mut b) = (0, 0);
-    if n > 0 && hi + m >= stage.surfaces[0].value[0] && lo - m <= stage.surfaces[n - 1].value[0] {
-        a = count_at_most(stage, lo - m);
-        b = count_at_most(stage, hi + m).max(a);
+    // The search window within the part's range (a no-op inside the
+    // triangle).
+    let (wlo, whi) = (lo.max(range[0]) - m, hi.min(range[1]) + m);
+    if n > 0 && whi >= stage.surfaces[0].value[0] && wlo <= stage.surfaces[n - 1].value[0] {
+        a = count_at_most(stage, wlo);
+        b = count_at_most(stage, whi).max(a);
     }
     let rising = seg.s_f <= seg.s_b;
     let blend = stage.params.mix == 1;
@@ -466,7 +488,7 @@ pub fn fs_iso(stage: &IsoTwin, tri: [&IsoVertex; 3], bary: [f64; 3]) -> Option<[
         gb = gb.map(|g| g / qb);
     }
     let e = [0, 1].map(|k| lerp(tri, bary, |v| v.snap[k]));
-    Some(iso_segment(stage, &seg, gf, gb, e))
+    Some(iso_segment(stage, &seg, gf, gb, e, tri[0].range))
 }
 
 impl CpuStage<IsoVertex> for IsoTwin {
@@ -488,8 +510,22 @@ pub struct IsoPayload {
     seg: SegmentPayload,
     grads: Vec<[DVec3; 2]>,
     snap: Vec<[f64; 2]>,
+    /// The part's [`IsoVertex::range`].
+    range: [f32; 2],
     /// Scratch: the vertices whose gradients are set.
     done: Vec<bool>,
+}
+
+/// The part's normalised scalar range widened by [`RANGE_MARGIN`]
+/// ([`IsoVertex::range`]); the whole line for a part without scalars.
+fn part_range(part: &Polyhedron, map: &ScalarMap) -> [f32; 2] {
+    let (lo, hi) = crate::render::pieces::value_range(part.scalars.iter().copied());
+    if !(lo <= hi) {
+        return [f32::NEG_INFINITY, f32::INFINITY];
+    }
+    let (lo, hi) = (map.apply(lo), map.apply(hi));
+    let widen = |v: f64, sign: f64| v + sign * RANGE_MARGIN * v.abs().max(1.0);
+    [widen(lo, -1.0) as f32, widen(hi, 1.0) as f32]
 }
 
 /// How far the scalar a fragment rebuilds on a boundary triangle can move
@@ -671,6 +707,7 @@ impl ProjectedMode for IsoMode {
     ) {
         payload.seg.set(src);
         let scale = payload.seg.map.scale;
+        payload.range = part_range(part, &payload.seg.map);
         // The snap bound of a vertex: the largest of its regions' faces'
         // (tie-quad vertices, which have no regions, are exact: 0).
         payload.snap.clear();
@@ -757,6 +794,7 @@ impl ProjectedMode for IsoMode {
             grad_front: f32x3(g[0], qf),
             grad_back: f32x3(g[1], qb),
             snap: e.map(|x| x as f32),
+            range: payload.range,
         }
     }
 }
@@ -767,9 +805,9 @@ mod tests {
 
     #[test]
     fn layout_matches_struct() {
-        assert_eq!(std::mem::size_of::<IsoVertex>(), 72);
+        assert_eq!(std::mem::size_of::<IsoVertex>(), 80);
         let offs: Vec<u64> = IsoVertex::ATTRIBUTES.iter().map(|a| a.offset).collect();
-        assert_eq!(offs, vec![0, 16, 24, 32, 36, 40, 52, 64]);
+        assert_eq!(offs, vec![0, 16, 24, 32, 36, 40, 52, 64, 72]);
         assert_eq!(std::mem::size_of::<IsoSurface>(), 48);
     }
 }
