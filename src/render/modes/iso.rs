@@ -520,7 +520,7 @@ pub struct IsoPayload {
 /// ([`IsoVertex::range`]); the whole line for a part without scalars.
 fn part_range(part: &Polyhedron, map: &ScalarMap) -> [f32; 2] {
     let (lo, hi) = crate::render::pieces::value_range(part.scalars.iter().copied());
-    if !(lo <= hi) {
+    if lo.is_nan() || hi.is_nan() || lo > hi {
         return [f32::NEG_INFINITY, f32::INFINITY];
     }
     let (lo, hi) = (map.apply(lo), map.apply(hi));
