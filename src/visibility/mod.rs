@@ -68,6 +68,16 @@
 //!    for which no order exists even along one ray, are ordered by segment
 //!    midpoint. The sort always terminates.
 //!
+//! 6. **The values, spliced in** ([`Sorter::splice`]): steps 2 to 5 make
+//!    the view's order from the geometry alone ([`Sorter::base_order`]);
+//!    then each whole cell whose nodal range strictly holds a breakpoint is
+//!    replaced, at its place, by its consistent tets sorted among
+//!    themselves, and each tet holding breakpoints by its slabs. A cell
+//!    drawn whole is convex, so a ray meets it in one interval its tets
+//!    tile, and every piece before (after) it lies behind (in front of)
+//!    that interval. A time step with new values, or a transfer function
+//!    with new breakpoints, keeps the sort and only splices.
+//!
 //! Subdivisions persist between views inside the [`Sorter`] (a pool of split
 //! cells); cells that stop needing a split are restored. [`Sorter::sanity_check`]
 //! verifies that bookkeeping.
