@@ -34,6 +34,7 @@ use crate::mesh::{Cells, Mesh, NONE};
 use crate::numeric::predicates::orient_dir;
 use crate::numeric::predicates::{orient3d, Side};
 use crate::numeric::tolerance::{FRUSTUM_MARGIN_PX, PLANE_FILTER_EPS};
+use splice::BreakpointSplit;
 
 /// Split reasons (bits of `want`).
 const PROBLEM: u8 = 1;
@@ -58,6 +59,15 @@ impl super::bsp::EyeSide for View {
 }
 
 impl View {
+    /// Where `camera`'s eye is.
+    fn of(camera: &Camera) -> View {
+        if camera.ortho {
+            View::Dir(camera.forward)
+        } else {
+            View::Eye(camera.position)
+        }
+    }
+
     /// Exact side of the eye relative to the plane of `a, b, c`.
     fn side(&self, a: DVec3, b: DVec3, c: DVec3) -> Side {
         match *self {
@@ -251,11 +261,7 @@ impl Sorter {
                 });
             }
         }
-        let view = if camera.ortho {
-            View::Dir(camera.forward)
-        } else {
-            View::Eye(camera.position)
-        };
+        let view = View::of(camera);
         let mut stats = OrderStats {
             cells: n,
             convex_boundary: self.geom.convex,
@@ -508,17 +514,10 @@ impl Sorter {
         if let (Some(s), false) = (policy.point_scalars, policy.breakpoints.is_empty()) {
             let (mut count, mut dark) = (0, 0);
             for c in 0..n {
-                let mut lo = f64::INFINITY;
-                let mut hi = f64::NEG_INFINITY;
-                for &v in self.mesh.cells.nodes(c) {
-                    let x = s[v as usize];
-                    lo = lo.min(x);
-                    hi = hi.max(x);
-                }
-                if policy.breakpoints.iter().any(|&b| lo < b && b < hi) {
-                    if policy.dark.is_some_and(|d| (d.test)(lo, hi)) {
-                        dark += 1;
-                    } else {
+                match self.breakpoint_split(c as u32, s, policy) {
+                    BreakpointSplit::No => {}
+                    BreakpointSplit::Dark => dark += 1,
+                    BreakpointSplit::Yes => {
                         self.want[c] |= BREAKPOINT;
                         count += 1;
                     }

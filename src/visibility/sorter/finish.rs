@@ -63,11 +63,7 @@ impl Sorter {
             out.pieces.extend_from_slice(&b.pieces);
             out.sliced += b.sliced;
         }
-        let view = if camera.ortho {
-            View::Dir(camera.forward)
-        } else {
-            View::Eye(camera.position)
-        };
+        let view = View::of(camera);
         let mut fragments = Vec::new();
         let mut groups = Vec::new();
         for comp in comps.into_iter().rev() {

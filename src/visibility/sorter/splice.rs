@@ -94,13 +94,16 @@ impl Sorter {
             });
         }
         let levels = super::super::slabs::order_levels(policy.breakpoints);
-        let view = if camera.ortho {
-            View::Dir(camera.forward)
-        } else {
-            View::Eye(camera.position)
-        };
+        let view = View::of(camera);
+        // The rule for every cell, once (the blocks look whole cells up;
+        // the counts are over every cell, as the one-step sort's).
+        let split: Vec<BreakpointSplit> = (0..self.mesh.cells.len() as u32)
+            .into_par_iter()
+            .map(|c| self.breakpoint_split(c, scalars, policy))
+            .collect();
         let with_counts = !base.groups.is_empty();
         let this = &*self;
+        let split_ref = &split;
         let levels_ref = &levels;
         let blocks: Vec<Block> = base
             .pieces
@@ -123,9 +126,9 @@ impl Sorter {
                 for &piece in chunk {
                     let before = b.out.pieces.len();
                     match piece {
-                        Piece::Cell(c) => match this.breakpoint_split(c, scalars, policy) {
-                            Split::No | Split::Dark => b.out.push(piece),
-                            Split::Yes => {
+                        Piece::Cell(c) => match split_ref[c as usize] {
+                            BreakpointSplit::No | BreakpointSplit::Dark => b.out.push(piece),
+                            BreakpointSplit::Yes => {
                                 b.spliced += 1;
                                 if !this.cell_tets_in_order(c, view, &mut tets) {
                                     b.cycle = true;
@@ -151,17 +154,11 @@ impl Sorter {
             return self.sort(camera, policy);
         }
         let mut stats = base.stats.clone();
-        // Counted over every cell, as the one-step sort counts them.
-        let (bp, dark) = (0..self.mesh.cells.len() as u32)
-            .into_par_iter()
-            .map(|c| match self.breakpoint_split(c, scalars, policy) {
-                Split::No => (0, 0),
-                Split::Dark => (0, 1),
-                Split::Yes => (1, 0),
-            })
-            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-        stats.breakpoint_cells = bp;
-        stats.dark_unsplit = dark;
+        stats.breakpoint_cells = split.iter().filter(|&&s| s == BreakpointSplit::Yes).count();
+        stats.dark_unsplit = split
+            .iter()
+            .filter(|&&s| s == BreakpointSplit::Dark)
+            .count();
         let total: usize = blocks.iter().map(|b| b.out.pieces.len()).sum();
         let mut pieces = Vec::with_capacity(total);
         let mut starts = Vec::with_capacity(if with_counts {
@@ -209,9 +206,15 @@ impl Sorter {
         })
     }
 
-    /// Whether whole cell `c` is split at breakpoints (the rule of the
-    /// one-step sort's policy splits).
-    fn breakpoint_split(&self, c: u32, scalars: &[f64], policy: &SplitPolicy) -> Split {
+    /// Whether cell `c` is split at breakpoints: its nodal range strictly
+    /// holds one, and it is not dark (the one rule of the one-step sort's
+    /// policy splits and of the splice).
+    pub(super) fn breakpoint_split(
+        &self,
+        c: u32,
+        scalars: &[f64],
+        policy: &SplitPolicy,
+    ) -> BreakpointSplit {
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
         for &v in self.mesh.cells.nodes(c as usize) {
@@ -220,11 +223,11 @@ impl Sorter {
             hi = hi.max(x);
         }
         if !policy.breakpoints.iter().any(|&b| lo < b && b < hi) {
-            Split::No
+            BreakpointSplit::No
         } else if policy.dark.is_some_and(|d| (d.test)(lo, hi)) {
-            Split::Dark
+            BreakpointSplit::Dark
         } else {
-            Split::Yes
+            BreakpointSplit::Yes
         }
     }
 
@@ -271,8 +274,9 @@ impl Sorter {
     }
 }
 
-/// What the breakpoints do to a whole cell.
-enum Split {
+/// What the breakpoints do to a cell.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum BreakpointSplit {
     No,
     /// Its range holds a breakpoint, but nothing is drawn for it.
     Dark,
