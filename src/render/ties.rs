@@ -59,6 +59,8 @@ use glam::{DVec2, DVec3};
 
 use crate::camera::Camera;
 use crate::gpu::{GpuVertex, SUBPIXEL};
+use crate::numeric::tolerance::{PLUCKER_FILTER_K, RASTER_FILTER_MAX_COORD_PX, RASTER_FILTER_PX};
+use crate::projection::coverage::Span;
 use crate::projection::{Polyhedron, Projected, RegionVertex};
 use crate::raycast::geometry::{bounding_sphere, Proj, RayFrame};
 
@@ -184,6 +186,10 @@ pub struct TieRays {
     /// part, so every part sees the same line.
     center: DVec3,
     radius: f64,
+    /// A bound on the world-space distance between a pixel's exact ray and
+    /// the point a part's projected position rounds to, from the
+    /// magnitudes of the eye and the mesh ([`TieRays::filter_px`]).
+    world_err: f64,
 }
 
 impl TieRays {
@@ -193,11 +199,44 @@ impl TieRays {
         let lo = DVec3::new(bounds[0], bounds[2], bounds[4]);
         let hi = DVec3::new(bounds[1], bounds[3], bounds[5]);
         let (center, radius) = bounding_sphere(lo, hi);
+        let magnitude = camera
+            .position
+            .abs()
+            .max_element()
+            .max(center.abs().max_element() + radius);
         TieRays {
             camera: *camera,
             center,
             radius,
+            world_err: PLUCKER_FILTER_K * f64::EPSILON * magnitude,
         }
+    }
+
+    /// How far (pixels) a pixel centre must be from a part's projected
+    /// edges for the float test on the projected positions to give the
+    /// exact test's answer ([`ray_through`]), for a part whose nearest
+    /// depth is `z_min` and whose projected coordinates reach `coord_max`
+    /// pixels; `None` where no margin can be trusted (coordinates beyond
+    /// [`RASTER_FILTER_MAX_COORD_PX`], or no positive depth in
+    /// perspective). The projected positions and the ray caster's rays
+    /// both round the camera transform of the same points: at most a few
+    /// ulps of the largest coordinate of the eye and the mesh (`world_err`,
+    /// with [`PLUCKER_FILTER_K`]'s margin) seen at the part's depth, and
+    /// of the pixel coordinates themselves; at least
+    /// [`RASTER_FILTER_PX`], the margin the visibility rasteriser trusts.
+    pub fn filter_px(&self, z_min: f64, coord_max: f64) -> Option<f64> {
+        let cam = &self.camera;
+        let px_per_world = if cam.ortho {
+            cam.height as f64 / (2.0 * cam.parallel_scale)
+        } else {
+            cam.height as f64 / (2.0 * z_min * cam.tan_half())
+        };
+        let m = (self.world_err * px_per_world)
+            .max(PLUCKER_FILTER_K * f64::EPSILON * coord_max)
+            .max(RASTER_FILTER_PX);
+        // False for NaN too.
+        (coord_max <= RASTER_FILTER_MAX_COORD_PX && m.is_finite() && m > 0.0 && m < TIE_BAND_PX)
+            .then_some(m)
     }
 
     /// The ray through pixel position `c` and its depth per unit of
@@ -306,8 +345,9 @@ pub struct TieDecision {
 /// Scratch of [`decide_ties`], reused from part to part.
 #[derive(Default)]
 pub struct TieScratch {
+    /// Each vertex's outgoing edges, as bits (parts of up to 64 vertices).
+    bits: Vec<u64>,
     edges: Vec<(u32, u32)>,
-    outline: Vec<(u32, u32)>,
     centres: Vec<(u32, u32)>,
     forced: Vec<(u32, u32)>,
     near: Vec<(u32, u32)>,
@@ -337,6 +377,10 @@ pub struct PartTriangles<'a> {
     pub rate: &'a dyn Fn() -> f64,
     /// A bound on `rate` for every part.
     pub rate_bound: f64,
+    /// Whether the projection is of the part clipped at the near plane
+    /// (its outline is then not the whole part's): every centre goes to
+    /// the exact test.
+    pub clipped: bool,
 }
 
 /// Decides the centres near the part's outline (see the module docs) into
@@ -353,31 +397,38 @@ pub fn decide_ties(
         DVec2::new(v.px, v.py)
     };
     // Outline candidates: edges of drawn triangles not shared by two of
-    // them, and every edge of an exact triangle that is not drawn.
-    let key = |a: u32, b: u32| if a < b { (a, b) } else { (b, a) };
-    let outline = &mut scratch.outline;
-    outline.clear();
+    // them, and every edge of an exact triangle that is not drawn. Each is
+    // tested for centres within the band as it is found.
+    let centres = &mut scratch.centres;
+    centres.clear();
+    let spans = part.proj.vertex_spans();
+    let (width, height) = (part.width, part.height);
+    let near = |ia: u32, ib: u32, out: &mut Vec<(u32, u32)>| {
+        let span = spans.map(|s| s[ia as usize].join(&s[ib as usize]));
+        near_edge(pos(ia), pos(ib), span, width, height, out);
+    };
     if part.proj.vertices.len() <= 64 {
         // Small parts (almost all): each directed edge in a bit matrix, no
         // sort. The triangles wind the same way (CCW in pixel
         // coordinates), so an edge shared by two of them appears once in
         // each direction, and an outline edge in one direction only.
-        let mut bits = [0u64; 64];
+        let bits = &mut scratch.bits;
+        bits.clear();
+        bits.resize(part.proj.vertices.len(), 0);
         for (t, _) in part.drawn {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                bits[a as usize] |= 1 << b;
-            }
+            bits[t[0] as usize] |= 1 << t[1];
+            bits[t[1] as usize] |= 1 << t[2];
+            bits[t[2] as usize] |= 1 << t[0];
         }
         for (t, _) in part.drawn {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
                 if bits[b as usize] >> a & 1 == 0 {
-                    outline.push(key(a, b));
+                    near(a, b, centres);
                 }
             }
         }
     } else {
+        let key = |a: u32, b: u32| if a < b { (a, b) } else { (b, a) };
         let edges = &mut scratch.edges;
         edges.clear();
         for (t, _) in part.drawn {
@@ -393,7 +444,7 @@ pub fn decide_ties(
                 n += 1;
             }
             if n != 2 {
-                outline.push(edges[k]);
+                near(edges[k].0, edges[k].1, centres);
             }
             k += n;
         }
@@ -402,26 +453,10 @@ pub fn decide_ties(
         for t in part.exact {
             if !part.drawn.iter().any(|(d, _)| d == t) {
                 for k in 0..3 {
-                    outline.push(key(t[k], t[(k + 1) % 3]));
+                    near(t[k], t[(k + 1) % 3], centres);
                 }
             }
         }
-    }
-    // Centres within the band of each outline edge.
-    let centres = &mut scratch.centres;
-    centres.clear();
-    // The box of an edge grown by the coverage margin (1/64 px, more than
-    // the band) holds every centre within the band of it; most short
-    // edges' boxes hold none, and the culling's spans say so at once.
-    let spans = part.proj.vertex_spans();
-    for &(ia, ib) in outline.iter() {
-        if let Some(s) = spans {
-            let s = s[ia as usize].join(&s[ib as usize]);
-            if s.x0 > s.x1 || s.y0 > s.y1 {
-                continue;
-            }
-        }
-        near_centres(pos(ia), pos(ib), part.width, part.height, centres);
     }
     // Centres next to the mode's seams: decided exactly wherever the part
     // holds them, since the two sides carry different values.
@@ -513,19 +548,37 @@ pub fn decide_ties(
     centres.sort_unstable();
     centres.dedup();
     forced.sort_unstable();
+    // The float filter's margin: only where the part has a positive
+    // thickness (a flat part's rays cross it for no length, which only
+    // the exact test sees) and its whole outline was projected.
+    let margin = if part.clipped || l_hi.is_nan() || l_hi <= 0.0 {
+        None
+    } else {
+        let (z_min, coord_max) = part
+            .proj
+            .vertices
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(z, m), v| {
+                (z.min(v.z_front), m.max(v.px.abs()).max(v.py.abs()))
+            });
+        rays.filter_px(z_min, coord_max)
+    };
     for &(i, j) in centres.iter() {
         let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
         let sub = SUBPIXEL as i64;
         let q = [i as i64 * sub + sub / 2, j as i64 * sub + sub / 2];
         let grid_in = part.drawn.iter().any(|(_, g)| covers_grid(*g, q));
         let seam = || forced.binary_search(&(i, j)).is_ok();
-        if std::env::var("TIE_PIX").ok().as_deref() == Some(&format!("{i},{j}")) {
-            eprintln!(
-                "TIE {i},{j}: {:?} grid_in {grid_in} npts {} ntris {}",
-                ray_through(poly, rays, c, &mut scratch.proj),
-                poly.points.len(),
-                poly.triangles.len()
-            );
+        // Where the float test on the exact triangles is certain and
+        // agrees with the rasteriser, there is nothing to decide (most
+        // centres in the band); a seam or sliver centre needs the exact
+        // segment whenever the part holds it.
+        if let Some(m) = margin {
+            if inside_by_float(part.exact, &pos, c, m) == Some(grid_in)
+                && (forced.is_empty() || !seam())
+            {
+                continue;
+            }
         }
         let (value, faces) = match (ray_through(poly, rays, c, &mut scratch.proj), grid_in) {
             (RayThrough::Crosses(v, f), false) => (Some(v), f),
@@ -539,6 +592,50 @@ pub fn decide_ties(
             faces,
         });
     }
+}
+
+/// Whether pixel position `c` lies in one of the triangles `tris` (of
+/// the positions `pos`), where a float test is certain: `Some(true)`
+/// when it is farther than `margin` pixels inside one of them,
+/// `Some(false)` when it is farther than that outside each of them, `None`
+/// otherwise (near an edge: the exact test decides). The triangles tile
+/// the part's exact projection up to rounding (triangles inverted by the
+/// rounding of a crossing point are left out; the gaps they leave are far
+/// narrower than the margin) and coverage culling removed only triangles
+/// farther than [`crate::numeric::tolerance::COVERAGE_MARGIN_PX`] from
+/// every centre, so the answer is the exact test's.
+fn inside_by_float(
+    tris: &[[u32; 3]],
+    pos: &impl Fn(u32) -> DVec2,
+    c: DVec2,
+    margin: f64,
+) -> Option<bool> {
+    let mut outside_all = true;
+    for t in tris {
+        let p = t.map(pos);
+        let sign = (p[1] - p[0]).perp_dot(p[2] - p[0]).signum();
+        let (mut inside, mut outside) = (true, false);
+        for k in 0..3 {
+            let (a, b) = (p[k], p[(k + 1) % 3]);
+            let d = b - a;
+            let e = sign * d.perp_dot(c - a);
+            let m = margin * d.length();
+            // NaN is neither: not certain.
+            if e < -m {
+                outside = true;
+            }
+            if e.is_nan() || e <= m {
+                inside = false;
+            }
+        }
+        if inside {
+            return Some(true);
+        }
+        if !outside {
+            outside_all = false;
+        }
+    }
+    outside_all.then_some(false)
 }
 
 /// Whether `c` is inside triangle `p` (either winding) or within
@@ -561,10 +658,63 @@ fn in_grown_triangle(p: [DVec2; 3], c: DVec2) -> bool {
     })
 }
 
+/// Appends the image's pixel centres within [`TIE_BAND_PX`] of segment
+/// `a b` whose end points' grown box is `span` (the join of their
+/// [`crate::projection::Projected::vertex_spans`], grown by
+/// [`crate::numeric::tolerance::COVERAGE_MARGIN_PX`], more than the band,
+/// so it holds every such centre), as a superset: the box is walked along
+/// the segment's major axis, and in each of its lines the one centre
+/// nearest the segment's line is taken when it is within the band (times
+/// `sqrt(2)`, the most the distance along the minor axis can exceed the
+/// distance to the line). The hot loop of the decisions (millions of
+/// outline edges a frame, nearly all with no centre that close). Without
+/// spans, [`near_centres`].
+#[inline(always)]
+fn near_edge(
+    a: DVec2,
+    b: DVec2,
+    span: Option<Span>,
+    width: u32,
+    height: u32,
+    out: &mut Vec<(u32, u32)>,
+) {
+    let Some(s) = span else {
+        return near_centres(a, b, width, height, out);
+    };
+    if s.x0 > s.x1 || s.y0 > s.y1 {
+        return;
+    }
+    let d = b - a;
+    let major_x = d.x.abs() >= d.y.abs();
+    let (a_m, a_n, d_m, d_n, k0, k1, l0, l1) = if major_x {
+        (a.x, a.y, d.x, d.y, s.x0, s.x1, s.y0, s.y1)
+    } else {
+        (a.y, a.x, d.y, d.x, s.y0, s.y1, s.x0, s.x1)
+    };
+    // A segment of no length has slope 0: its one point's row.
+    let slope = if d_m != 0.0 { d_n / d_m } else { 0.0 };
+    let reach = TIE_BAND_PX * std::f64::consts::SQRT_2;
+    for k in k0..=k1 {
+        // The line's minor coordinate at the centre line k + 1/2, minus
+        // 1/2 (centre rows at integers). Rows below 0 (r < -1/2) round
+        // towards 0 and fail the reach test or the box.
+        let r = a_n + slope * (k as f64 + 0.5 - a_m) - 0.5;
+        let l = (r + 0.5) as i32;
+        if (r - l as f64).abs() <= reach && l >= l0 && l <= l1 {
+            out.push(if major_x {
+                (k as u32, l as u32)
+            } else {
+                (l as u32, k as u32)
+            });
+        }
+    }
+}
+
 /// Appends the image's pixel centres within [`TIE_BAND_PX`] of segment `a b`
 /// (a superset: the band is walked along the segment's major axis, one
-/// candidate row per column). The hot loop of the decisions (millions of
-/// outline edges a frame), so without branches but the loop's.
+/// candidate row per column): for long edges and parts without spans
+/// ([`near_edge`] takes the short ones), so without branches but the
+/// loop's.
 #[inline]
 fn near_centres(a: DVec2, b: DVec2, width: u32, height: u32, out: &mut Vec<(u32, u32)>) {
     if !(a.is_finite() && b.is_finite()) {

@@ -277,6 +277,7 @@ fn draw_part<M: ProjectedMode>(
         height: src.camera.height,
         rate_bound: w.rate_bound,
         rate: &|| part_rate(src, part),
+        clipped: !std::ptr::eq(projected, part),
     };
     if mode.decides_ties() && src.exact_ties {
         decide_ties(&part_tris, part, &src.ties, &mut w.ties);
