@@ -40,6 +40,13 @@
 //! not count). Each piece colours a pixel once (its depth key), so the
 //! quad decides the pixel and the triangles drawn after it leave it alone.
 //!
+//! Most centres in the band are far from the outline by rounding
+//! standards (1/256 px against rounding of 1e-12 px): where the float test
+//! on the exact triangles is certain ([`TieRays::filter_px`], at least
+//! [`RASTER_FILTER_PX`] from every edge that decides it) and agrees with
+//! the rasteriser, there is nothing to decide and the exact test is not
+//! run; it decides the rest, as the visibility rasteriser does.
+//!
 //! Two more kinds of centre are decided exactly, and get the exact
 //! segment's quad wherever the part holds them (not only where the two
 //! tests disagree):
