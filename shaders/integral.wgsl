@@ -70,8 +70,20 @@ fn node(i: u32) -> Material {
 
 // Number of nodes with s_node <= s (the transfer-function piece holding s).
 fn piece_index(s: f32) -> u32 {
-    var lo = 0u;
+    return piece_index_in(s, 0u, tf.count);
+}
+
+// piece_index(s), searched from node lo_in (the caller knows every node
+// below it is <= s) up to node hi_in: when node hi_in is above s the answer
+// lies there, else (s at or above it by rounding) the search goes to the
+// last node. The same answer as piece_index, in the few steps of a
+// segment's own nodes rather than the table's.
+fn piece_index_in(s: f32, lo_in: u32, hi_in: u32) -> u32 {
+    var lo = lo_in;
     var hi = tf.count;
+    if hi_in < tf.count && node_s(hi_in) > s {
+        hi = hi_in;
+    }
     while lo < hi {
         let mid = (lo + hi) / 2u;
         if node_s(mid) <= s {
@@ -305,12 +317,13 @@ fn add_piece(acc: ptr<function, Composite>, l: f32, m0: Material, m1: Material) 
 }
 
 // The piece of the segment between fractions x0 < x1 (scalars s0, s1 there):
-// the transfer-function piece holding its midpoint scalar.
-fn add_sub(acc: ptr<function, Composite>, l: f32, x0: f32, x1: f32, s0: f32, s1: f32) {
+// the transfer-function piece holding its midpoint scalar, which lies
+// between the segment's nodes i0 and i1 (piece_index_in).
+fn add_sub(acc: ptr<function, Composite>, l: f32, x0: f32, x1: f32, s0: f32, s1: f32, i0: u32, i1: u32) {
     if x1 <= x0 {
         return;
     }
-    let idx = piece_index(0.5 * (s0 + s1));
+    let idx = piece_index_in(0.5 * (s0 + s1), i0, i1);
     add_piece(acc, l * (x1 - x0), eval_piece(idx, s0), eval_piece(idx, s1));
 }
 
@@ -355,11 +368,11 @@ fn integrate_segment(l_in: f32, sf_in: f32, sb_in: f32) -> vec4<f32> {
                 continue;
             }
             let x = (sk - s_f) * inv;
-            add_sub(&acc, l, x_prev, x, s_prev, sk);
+            add_sub(&acc, l, x_prev, x, s_prev, sk, i0, i1);
             x_prev = x;
             s_prev = sk;
         }
-        add_sub(&acc, l, x_prev, 1.0, s_prev, s_b);
+        add_sub(&acc, l, x_prev, 1.0, s_prev, s_b, i0, i1);
     }
     var alpha = acc.alpha;
     if acc.pieces != 1u {

@@ -149,7 +149,18 @@ impl TfBuffer {
 
     /// Number of nodes with `s_node <= s`.
     pub fn piece_index(&self, s: f32) -> u32 {
-        let (mut lo, mut hi) = (0, self.count());
+        self.piece_index_in(s, 0, self.count())
+    }
+
+    /// [`Self::piece_index`], searched from node `lo_in` (every node below
+    /// it is `<= s`) up to node `hi_in` when that node is above `s`, else
+    /// to the last (`piece_index_in`).
+    pub fn piece_index_in(&self, s: f32, lo_in: u32, hi_in: u32) -> u32 {
+        let mut lo = lo_in;
+        let mut hi = self.count();
+        if hi_in < self.count() && self.node_s(hi_in) > s {
+            hi = hi_in;
+        }
         while lo < hi {
             let mid = (lo + hi) / 2;
             if self.node_s(mid) <= s {
@@ -226,11 +237,12 @@ impl TfBuffer {
         x1: f32,
         s0: f32,
         s1: f32,
+        (i0, i1): (u32, u32),
     ) {
         if x1 <= x0 {
             return;
         }
-        let idx = self.piece_index(0.5 * (s0 + s1));
+        let idx = self.piece_index_in(0.5 * (s0 + s1), i0, i1);
         let (m0, m1) = (self.eval_piece(idx, s0), self.eval_piece(idx, s1));
         self.add_piece(consts, acc, l * (x1 - x0), m0, m1);
     }
@@ -273,11 +285,11 @@ impl TfBuffer {
                     continue;
                 }
                 let x = (sk - s_f) * inv;
-                self.add_sub(consts, &mut acc, l, x_prev, x, s_prev, sk);
+                self.add_sub(consts, &mut acc, l, x_prev, x, s_prev, sk, (i0, i1));
                 x_prev = x;
                 s_prev = sk;
             }
-            self.add_sub(consts, &mut acc, l, x_prev, 1.0, s_prev, s_b);
+            self.add_sub(consts, &mut acc, l, x_prev, 1.0, s_prev, s_b, (i0, i1));
         }
         let alpha = if acc.pieces != 1 {
             neg_expm1(acc.depth)

@@ -77,7 +77,7 @@ pub fn stage_twins() -> Vec<StageTwins> {
         twins!("exptable.wgsl": exptable::log1p_, exptable::coord, ExpTable::alpha_of),
         twins!("exact_frag.wgsl": exact_frag::fs_main),
         twins!("integral.wgsl":
-            TfBuffer::node_s, TfBuffer::node, TfBuffer::piece_index, TfBuffer::eval_piece,
+            TfBuffer::node_s, TfBuffer::node, TfBuffer::piece_index, TfBuffer::piece_index_in, TfBuffer::eval_piece,
             integral::neg_expm1, integral::taylor_pq, integral::taylor_bg, integral::asym,
             integral::ends_increasing, integral::ends_decreasing,
             integral::sanitize_thickness, integral::gauss, integral::weights,
