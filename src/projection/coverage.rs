@@ -192,6 +192,7 @@ impl Projected {
         spans.clear();
         spans.extend(self.vertices.iter().map(|v| grid.span(v.pos())));
         let before = self.triangles.len();
+        self.culled.clear();
         let mut w = 0;
         for r in 0..before {
             let t = self.triangles[r];
@@ -204,6 +205,8 @@ impl Projected {
                 self.triangles[w] = t;
                 self.triangle_region[w] = self.triangle_region[r];
                 w += 1;
+            } else {
+                self.culled.push(t);
             }
         }
         self.triangles.truncate(w);

@@ -441,6 +441,8 @@ pub struct Projected {
     /// Scratch of [`Projected::cull_to_pixels`]: each vertex's
     /// [`coverage::Span`].
     spans: Vec<coverage::Span>,
+    /// The triangles [`Projected::cull_to_pixels`] dropped.
+    culled: Vec<[u32; 3]>,
 }
 
 impl Projected {
@@ -455,6 +457,7 @@ impl Projected {
         self.seams.clear();
         self.tie_faces.clear();
         self.spans.clear();
+        self.culled.clear();
     }
 
     /// Each vertex's [`coverage::Span`]: the pixel centres within
@@ -463,6 +466,15 @@ impl Projected {
     /// was not culled (or vertices were added since).
     pub fn vertex_spans(&self) -> Option<&[coverage::Span]> {
         (self.spans.len() == self.vertices.len()).then_some(&self.spans[..])
+    }
+
+    /// The triangles [`Projected::cull_to_pixels`] dropped: no pixel
+    /// centre lies within
+    /// [`crate::numeric::tolerance::COVERAGE_MARGIN_PX`] of any of them
+    /// (nor of their edges); `None` where the projection was not culled
+    /// (as [`Projected::vertex_spans`]).
+    pub fn culled_triangles(&self) -> Option<&[[u32; 3]]> {
+        self.vertex_spans().map(|_| &self.culled[..])
     }
 
     /// The front (`side` 0) or back (1) triangle of region `r`.

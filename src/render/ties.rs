@@ -354,7 +354,7 @@ pub struct TieDecision {
 pub struct TieScratch {
     /// Each vertex's outgoing edges, as bits (parts of up to 64 vertices).
     bits: Vec<u64>,
-    edges: Vec<(u32, u32)>,
+    edges: Vec<((u32, u32), bool)>,
     centres: Vec<(u32, u32)>,
     forced: Vec<(u32, u32)>,
     near: Vec<(u32, u32)>,
@@ -414,6 +414,10 @@ pub fn decide_ties(
         let span = spans.map(|s| s[ia as usize].join(&s[ib as usize]));
         near_edge(pos(ia), pos(ib), span, width, height, out);
     };
+    // Edges shared with a triangle coverage culling dropped have no centre
+    // within the band (it would be within the culling's margin of that
+    // triangle, which would then have been kept): not candidates.
+    let culled = part.proj.culled_triangles().unwrap_or(&[]);
     if part.proj.vertices.len() <= 64 {
         // Small parts (almost all): each directed edge in a bit matrix, no
         // sort. The triangles wind the same way (CCW in pixel
@@ -422,7 +426,8 @@ pub fn decide_ties(
         let bits = &mut scratch.bits;
         bits.clear();
         bits.resize(part.proj.vertices.len(), 0);
-        for (t, _) in part.drawn {
+        let tris = part.drawn.iter().map(|(t, _)| t).chain(culled);
+        for t in tris {
             bits[t[0] as usize] |= 1 << t[1];
             bits[t[1] as usize] |= 1 << t[2];
             bits[t[2] as usize] |= 1 << t[0];
@@ -435,23 +440,29 @@ pub fn decide_ties(
             }
         }
     } else {
+        // Each undirected edge with whether a drawn triangle has it.
         let key = |a: u32, b: u32| if a < b { (a, b) } else { (b, a) };
         let edges = &mut scratch.edges;
         edges.clear();
-        for (t, _) in part.drawn {
+        for (t, drawn) in part
+            .drawn
+            .iter()
+            .map(|(t, _)| (t, true))
+            .chain(culled.iter().map(|t| (t, false)))
+        {
             for k in 0..3 {
-                edges.push(key(t[k], t[(k + 1) % 3]));
+                edges.push((key(t[k], t[(k + 1) % 3]), drawn));
             }
         }
         edges.sort_unstable();
         let mut k = 0;
         while k < edges.len() {
             let mut n = 1;
-            while k + n < edges.len() && edges[k + n] == edges[k] {
+            while k + n < edges.len() && edges[k + n].0 == edges[k].0 {
                 n += 1;
             }
-            if n != 2 {
-                near(edges[k].0, edges[k].1, centres);
+            if n == 1 && edges[k].1 {
+                near(edges[k].0 .0, edges[k].0 .1, centres);
             }
             k += n;
         }
