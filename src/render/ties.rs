@@ -423,9 +423,12 @@ pub fn decide_ties(
         // sort. The triangles wind the same way (CCW in pixel
         // coordinates), so an edge shared by two of them appears once in
         // each direction, and an outline edge in one direction only.
-        let bits = &mut scratch.bits;
-        bits.clear();
-        bits.resize(part.proj.vertices.len(), 0);
+        let n = part.proj.vertices.len();
+        scratch.bits.clear();
+        scratch.bits.resize(n, 0);
+        // A slice: its pointer and length stay in registers across the
+        // stores.
+        let bits = &mut scratch.bits[..n];
         let tris = part.drawn.iter().map(|(t, _)| t).chain(culled);
         for t in tris {
             bits[t[0] as usize] |= 1 << t[1];
