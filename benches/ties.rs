@@ -1,5 +1,5 @@
 //! What the exact tie decisions cost ([`zoovr::render::ProjectedOptions::exact_ties`],
-//! `src/render/ties.rs`): the exact mode on the hex_shell scene
+//! `src/render/ties/`): the exact mode on the hex_shell scene
 //! (`synthetic/hex_shell_zlib.vtu`, bench_tf.json, azimuth 20, elevation
 //! 35, zoom 1.25, perspective; a generated 40^3 warped grid without the
 //! shared data) at 512 x 512, with the centres next to each part's outline

@@ -304,7 +304,7 @@ fn shared_datasets() {
         };
         // PentaHexa and AngularSector were up to 1.11e-2 before the pixel
         // centres next to outlines and inside slivers were decided on the
-        // ray caster's own numbers (src/render/ties.rs); now within 2.9e-3.
+        // ray caster's own numbers (src/render/ties/); now within 2.9e-3.
         let whole = if rel.starts_with("can_crush") {
             CAN_CRUSH
         } else {
@@ -404,7 +404,7 @@ fn exact_frag_single_cells_and_project_meshes() {
     const PROBLEM_CELLS: (f64, f64) = MODEL_DIFF;
     // One isolated pixel of curvilinear_4x4x4 (perspective, kinked TF,
     // pixel (193, 217)) measured 1.02e-2 here before sliver centres were
-    // decided on the exact triangles (src/render/ties.rs); now 9.7e-4.
+    // decided on the exact triangles (src/render/ties/); now 9.7e-4.
     for name in ["curvilinear_4x4x4.vtu", "ring_hole.vtu", "zoo_3x3x3.vtu"] {
         let split = (MAX, RMS);
         check_mode(
@@ -431,7 +431,7 @@ fn exact_frag_shared_datasets() {
         // can_crush's self-overlapping cells: the model difference named
         // at CAN_CRUSH (measured 0.123 here). AngularSector's tet sliver
         // whose silhouette missed a centre after snapping (1.03e-2) is
-        // decided exactly by src/render/ties.rs: now 5.75e-3.
+        // decided exactly by src/render/ties/: now 5.75e-3.
         let b = if rel.starts_with("can_crush") {
             CAN_CRUSH
         } else {

@@ -20,7 +20,7 @@ use zoovr::testdata::{mesh_file, shared_file};
 
 /// Bound over every pixel (PNG values): 2/255, every case. The seeded
 /// cases reach 6.6e-3 (CylinderLinear); tetraMesh's 8.9e-3 went with the
-/// exact decisions on the ray caster's own numbers (`src/render/ties.rs`).
+/// exact decisions on the ray caster's own numbers (`src/render/ties/`).
 const MAX: f64 = 2.0 / 255.0;
 
 fn crop(img: &Image, i: u32, j: u32, r: u32) -> Image {
@@ -112,7 +112,7 @@ fn random_views_match_the_reference_on_every_pixel() {
         // across 0.02 px, refined into slivers that collapsed on the
         // rasteriser's grid, so the centre took the neighbouring
         // triangle's values. Slivers are now found among the exact
-        // triangles (src/render/ties.rs).
+        // triangles (src/render/ties/).
         let bound = MAX;
         if d.max_abs > bound {
             let (i, j) = d.worst;

@@ -29,7 +29,7 @@ use zoovr::tf::{EmissionModel, TransferFunction};
 /// pixel: 2/255. Measured up to 3.3e-3 (eye inside the mesh; was 8.5e-3
 /// on the axis-aligned grid before pixel centres next to outlines and
 /// inside slivers were decided on the ray caster's own numbers,
-/// src/render/ties.rs).
+/// src/render/ties/).
 const SPLIT_MAX: f64 = 2.0 / 255.0;
 const P999: f64 = 1e-2;
 /// Isosurfaces against the ray caster's: a pixel is off beyond 2/255.
@@ -445,7 +445,7 @@ fn edge_on_faces_and_coincident_projections() {
     );
 }
 
-/// The exact tie decisions (src/render/ties.rs) are what puts the
+/// The exact tie decisions (src/render/ties/) are what puts the
 /// outline pixels right: on the CPU twin, the opaque warped grid (tau 1e6)
 /// seen obliquely is within SPLIT_MAX of the ray caster with them, and a
 /// whole pixel off without them (`ProjectedOptions::exact_ties`, off only to measure their
@@ -481,7 +481,7 @@ fn outline_pixels_need_the_exact_tie_decisions() {
     assert!(errors[1] > 0.1, "{errors:?}");
 }
 
-/// Centres inside slivers take the exact segment (src/render/ties.rs): on
+/// Centres inside slivers take the exact segment (src/render/ties/): on
 /// the AngularSector dataset at 128 x 128 (default field, transfer function
 /// and view; skipped without the shared data) a sliver region of a slab
 /// seen nearly edge-on holds pixel (108, 46), where the snapped corners

@@ -1,0 +1,280 @@
+//! Unit tests of the tie decisions.
+
+use super::*;
+use crate::camera::CameraParams;
+use crate::projection::ViewMap;
+
+/// A 16 x 16 camera, its rays, and the world-space point at pixel
+/// position `(px, py)` and depth `z`.
+fn setup(ortho: bool) -> (TieRays, Camera, impl Fn(f64, f64, f64) -> DVec3) {
+    let camera = Camera::fit(
+        [-1.0, 1.0, -1.0, 1.0, -1.0, 1.0],
+        &CameraParams {
+            width: 16,
+            height: 16,
+            ortho,
+            ..Default::default()
+        },
+    );
+    let view = ViewMap::of(&camera);
+    let rays = TieRays::new(&camera, [-1.0, 1.0, -1.0, 1.0, -1.0, 1.0]);
+    let c = camera;
+    let at = move |px: f64, py: f64, z: f64| {
+        let u = view.plane(DVec2::new(px, py));
+        let v = if view.ortho {
+            DVec3::new(u.x, u.y, z)
+        } else {
+            DVec3::new(u.x * z, u.y * z, z)
+        };
+        c.position + c.right * v.x + c.up * v.y + c.forward * v.z
+    };
+    (rays, camera, at)
+}
+
+fn tet(camera: &Camera, p: [DVec3; 4]) -> Polyhedron {
+    Polyhedron::from_world_tet(p, [0.0, 1.0, 2.0, 3.0], camera)
+}
+
+fn length(r: RayThrough) -> f64 {
+    match r {
+        RayThrough::Crosses(v, _) => v.l,
+        RayThrough::Misses => 0.0,
+        RayThrough::Undecided => f64::NAN,
+    }
+}
+
+/// A ray through the inside of a tet crosses it with the segment's
+/// length and scalars; one beside it misses.
+#[test]
+fn inside_and_outside() {
+    let (rays, camera, at) = setup(true);
+    let z0 = 4.0;
+    // A tet whose face at depth z0 covers pixels (2..10, 2..10) and
+    // whose apex is behind (4, 4).
+    let p = tet(
+        &camera,
+        [
+            at(2.0, 2.0, z0),
+            at(10.0, 2.0, z0),
+            at(2.0, 10.0, z0),
+            at(4.0, 4.0, z0 + 1.0),
+        ],
+    );
+    let mut scratch = Vec::new();
+    let r = ray_through(&p, &rays, DVec2::new(4.0, 4.0), &mut scratch);
+    assert!((length(r) - 1.0).abs() < 1e-12, "{r:?}");
+    let RayThrough::Crosses(v, _) = r else {
+        unreachable!()
+    };
+    assert!((v.s_back - 3.0).abs() < 1e-9, "{v:?}");
+    let r = ray_through(&p, &rays, DVec2::new(12.5, 12.5), &mut scratch);
+    assert_eq!(r, RayThrough::Misses);
+}
+
+/// Pixel centres exactly on the edges and vertices of a fan of tets
+/// seen edge-on (every tet has a face containing the view direction,
+/// as when looking down an axis of a hex split into tets): each centre
+/// is crossed by exactly one tet of each layer, so the lengths add up
+/// to the layer thickness. Orthographic and perspective.
+#[test]
+fn a_centre_on_shared_edges_is_given_to_one_part() {
+    for ortho in [true, false] {
+        let (rays, camera, at) = setup(ortho);
+        let z0 = 5.0;
+        // Four triangular prisms around the centre (8.5, 8.5), each cut
+        // into 3 tets with the consistent smallest-vertex rule; the
+        // prisms' corners sit on pixel centres, so their side faces are
+        // seen exactly edge-on and centres lie on edges and vertices.
+        let c = (8.5, 8.5);
+        let ring = [(4.5, 4.5), (12.5, 4.5), (12.5, 12.5), (4.5, 12.5)];
+        let mut parts = Vec::new();
+        for k in 0..4 {
+            let (a, b) = (ring[k], ring[(k + 1) % 4]);
+            let bottom = [c, a, b].map(|q| at(q.0, q.1, z0));
+            let top = [c, a, b].map(|q| at(q.0, q.1, z0 + 1.0));
+            parts.push(tet(&camera, [bottom[0], bottom[1], bottom[2], top[0]]));
+            parts.push(tet(&camera, [bottom[1], bottom[2], top[0], top[1]]));
+            parts.push(tet(&camera, [bottom[2], top[0], top[1], top[2]]));
+        }
+        let mut scratch = Vec::new();
+        for j in 0..16 {
+            for i in 0..16 {
+                let q = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+                let inside = (4.5..12.5).contains(&q.x) && (4.5..12.5).contains(&q.y);
+                let mut sum = 0.0;
+                for p in &parts {
+                    let r = ray_through(p, &rays, q, &mut scratch);
+                    assert_ne!(r, RayThrough::Undecided, "{i} {j}");
+                    sum += length(r);
+                }
+                // The ray's length per unit of depth (1 orthographic).
+                let want = if inside {
+                    if ortho {
+                        1.0
+                    } else {
+                        (at(q.x, q.y, 1.0) - camera.position).length()
+                    }
+                } else {
+                    0.0
+                };
+                // In perspective the corners are rounded off the eye
+                // rays, so the outer walls are not exactly edge-on: a
+                // ray through a centre on the outer outline may miss,
+                // graze a thin wedge of the wall or cross it all.
+                // Inside, on the shared edges and faces, the layers
+                // still add up exactly.
+                let outline = [4.5, 12.5].contains(&q.x) || [4.5, 12.5].contains(&q.y);
+                let d = (at(q.x, q.y, 1.0) - camera.position).length();
+                let ok = (sum - want).abs() < 1e-9
+                    || (!ortho && outline && (0.0..=d + 1e-9).contains(&sum));
+                assert!(ok, "{ortho} {i} {j} {sum} {want}");
+            }
+        }
+    }
+}
+
+#[test]
+fn band_holds_every_near_centre() {
+    let mut out = Vec::new();
+    let a = DVec2::new(0.5 - 0.002, 1.5 + 0.001);
+    let b = DVec2::new(7.9, 3.3);
+    near_centres(a, b, 10, 10, &mut out);
+    assert!(out.contains(&(0, 1)));
+    for j in 0..10u32 {
+        for i in 0..10u32 {
+            let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+            let t = ((c - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+            if (a + (b - a) * t - c).length() <= TIE_BAND_PX {
+                assert!(out.contains(&(i, j)), "{i} {j}");
+            }
+        }
+    }
+}
+
+/// The float test is certain only away from the edges: inside a square
+/// of two triangles, outside it, and undecided on its outline and on the
+/// diagonal the two triangles share (each sees the centre on its edge).
+#[test]
+fn float_test_is_certain_only_away_from_edges() {
+    let p = [
+        DVec2::new(0.0, 0.0),
+        DVec2::new(4.0, 0.0),
+        DVec2::new(4.0, 4.0),
+        DVec2::new(0.0, 4.0),
+    ];
+    let pos = |i: u32| p[i as usize];
+    let tris = [[0, 1, 2], [0, 2, 3]];
+    let m = 1e-6;
+    assert_eq!(
+        inside_by_float(&tris, &pos, DVec2::new(3.0, 1.0), m),
+        Some(true)
+    );
+    assert_eq!(
+        inside_by_float(&tris, &pos, DVec2::new(1.0, 3.0), m),
+        Some(true)
+    );
+    assert_eq!(
+        inside_by_float(&tris, &pos, DVec2::new(5.0, 1.0), m),
+        Some(false)
+    );
+    assert_eq!(
+        inside_by_float(&tris, &pos, DVec2::new(-1e-3, 2.0), m),
+        Some(false)
+    );
+    // On the outline, and within the margin of it on either side.
+    for x in [0.0, 5e-7, -5e-7] {
+        assert_eq!(
+            inside_by_float(&tris, &pos, DVec2::new(x, 2.0), m),
+            None,
+            "{x}"
+        );
+    }
+    // On the shared diagonal: inside the square, but certain in neither.
+    assert_eq!(inside_by_float(&tris, &pos, DVec2::new(2.0, 2.0), m), None);
+    // A NaN position is never certain.
+    let q = [p[0], p[1], DVec2::new(f64::NAN, 4.0)];
+    let posq = |i: u32| q[i as usize];
+    assert_eq!(
+        inside_by_float(&[[0, 1, 2]], &posq, DVec2::new(3.0, 1.0), m),
+        None
+    );
+}
+
+/// The margin grows with the magnitude of the coordinates (a mesh far
+/// from the origin rounds its projection more) and is refused where no
+/// margin can be trusted.
+#[test]
+fn filter_margin_follows_the_rounding() {
+    let (near, _, _) = setup(false);
+    let m = near.filter_px(3.0, 16.0).expect("a margin");
+    assert_eq!(m, RASTER_FILTER_PX);
+    assert_eq!(near.filter_px(0.0, 16.0), None);
+    assert_eq!(near.filter_px(f64::NAN, 16.0), None);
+    assert_eq!(near.filter_px(3.0, 1e8), None);
+    // The same view of a cube 1e9 from the origin.
+    let lo = 1e9;
+    let bounds = [lo - 1.0, lo + 1.0, lo - 1.0, lo + 1.0, lo - 1.0, lo + 1.0];
+    let camera = Camera::fit(
+        bounds,
+        &CameraParams {
+            width: 16,
+            height: 16,
+            ..Default::default()
+        },
+    );
+    let far = TieRays::new(&camera, bounds);
+    let m = far.filter_px(3.0, 16.0).expect("a margin");
+    assert!(m > 1e-6 && m < TIE_BAND_PX, "{m}");
+    // 1e11: rounding reaches the band; nothing is settled by floats.
+    let lo = 1e11;
+    let bounds = [lo - 1.0, lo + 1.0, lo - 1.0, lo + 1.0, lo - 1.0, lo + 1.0];
+    let camera = Camera::fit(bounds, &CameraParams::default());
+    assert_eq!(TieRays::new(&camera, bounds).filter_px(3.0, 16.0), None);
+}
+
+/// The edge walk over the culling's spans returns every centre within
+/// the band of the segment, for segments of every length and direction,
+/// of no length, and ending on or next to pixel centres.
+#[test]
+fn edge_walk_holds_every_near_centre() {
+    use crate::projection::coverage::PixelGrid;
+    use crate::testdata::Rng;
+    let grid = PixelGrid::new(12, 9);
+    let mut rng = Rng(7);
+    for case in 0..20000 {
+        // End points near the lattice (within a few bands of a centre)
+        // half of the time.
+        let point = |rng: &mut Rng| {
+            let p = DVec2::new(rng.range(-1.0, 13.0), rng.range(-1.0, 10.0));
+            if rng.below(2) == 0 {
+                let c = (p - 0.5).round() + 0.5;
+                c + DVec2::new(rng.range(-0.01, 0.01), rng.range(-0.01, 0.01))
+            } else {
+                p
+            }
+        };
+        let a = point(&mut rng);
+        let b = match rng.below(4) {
+            0 => a,
+            1 => a + DVec2::new(rng.range(-0.3, 0.3), rng.range(-0.3, 0.3)),
+            _ => point(&mut rng),
+        };
+        let span = grid.span(a).join(&grid.span(b));
+        let mut out = Vec::new();
+        near_edge(a, b, Some(span), 12, 9, &mut out);
+        for j in 0..9u32 {
+            for i in 0..12u32 {
+                let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+                let d = b - a;
+                let t = if d.length_squared() > 0.0 {
+                    ((c - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                if (a + d * t - c).length() <= TIE_BAND_PX {
+                    assert!(out.contains(&(i, j)), "case {case}: {a} {b} misses {i} {j}");
+                }
+            }
+        }
+    }
+}
