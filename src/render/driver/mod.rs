@@ -42,6 +42,9 @@
 //!      values. On the stress scenes' extinction-1e3 grid this took the
 //!      exact-frag mode from 4.8e-2 to 2.6e-5 against the ray caster.
 //!
+//!    One pass over the part's triangles ([`super::ties::scan_triangles`])
+//!    finds both, from the same widths and thickness changes.
+//!
 //! Pieces are processed in chunks of consecutive pieces by worker threads,
 //! handed to the GPU in order as soon as each chunk and all before it are
 //! done ([`super::workers::run_ordered`]); chunk buffers are reused, so
@@ -58,7 +61,6 @@
 
 use std::sync::Mutex;
 
-use glam::DVec2;
 use std::time::Instant;
 
 use crate::camera::Camera;
@@ -81,7 +83,7 @@ use super::pieces::{value_range, PartScratch, PieceError, PieceSource};
 use super::scene::{ScalarsRef, Scene};
 use super::stats::ProjectedStats;
 use super::ties::{
-    decide_ties, part_may_be_steep, push_steep, snap_is_steep, PartTriangles, TieRays, TieScratch,
+    decide_ties, push_steep, scan_triangles, DrawnTriangle, PartTriangles, TieRays, TieScratch,
 };
 use super::workers::run_ordered;
 use super::{Compositor, RenderError, RenderOptions};
@@ -162,7 +164,7 @@ struct Worker<P, V> {
     grid: Vec<[i64; 2]>,
     /// Triangles drawn, with their snapped corners, and the pixel quads
     /// of the centres next to the outline ([`super::ties`]).
-    drawn: Vec<([u32; 3], [[i64; 2]; 3])>,
+    drawn: Vec<DrawnTriangle>,
     ties: TieScratch,
     /// The transfer function's largest rate anywhere (a bound on every
     /// part's, [`PieceSource::max_rate`]).
@@ -254,7 +256,7 @@ fn draw_part<M: ProjectedMode>(
     }
     let drawn = &mut w.drawn;
     drawn.clear();
-    for t in &proj.triangles {
+    for (k, t) in proj.triangles.iter().enumerate() {
         let idx = t.map(|i| w.remap[i as usize]);
         if idx.contains(&u32::MAX) {
             out.degenerate += 1;
@@ -262,11 +264,27 @@ fn draw_part<M: ProjectedMode>(
         }
         let g = idx.map(|i| w.grid[(i - first) as usize]);
         if grid_area_positive(g[0], g[1], g[2]) {
-            drawn.push((*t, g));
+            drawn.push(DrawnTriangle {
+                corners: *t,
+                grid: g,
+                exact: k as u32,
+            });
         } else {
             out.degenerate += 1;
         }
     }
+    // The part's largest rate, computed once, where a bound on it does
+    // not settle a question.
+    let part_rate_once = std::cell::Cell::new(None);
+    let rate = || match part_rate_once.get() {
+        Some(r) => r,
+        None => {
+            let r = part_rate(src, part);
+            part_rate_once.set(Some(r));
+            r
+        }
+    };
+    let l_range = value_range(proj.vertices.iter().map(|v| v.l));
     // Centres next to the outline first (they decide their pixels), then
     // the triangles.
     let part_tris = PartTriangles {
@@ -276,39 +294,29 @@ fn draw_part<M: ProjectedMode>(
         width: src.camera.width,
         height: src.camera.height,
         rate_bound: w.rate_bound,
-        rate: &|| part_rate(src, part),
+        rate: &rate,
+        l_range,
         clipped: !std::ptr::eq(projected, part),
     };
-    if mode.decides_ties() && src.exact_ties {
+    // Steep triangles (`snap_is_steep`) take the exact triangle's values
+    // at their snapped corners; the others share the exact corners'. The
+    // same pass finds the slivers the tie decisions look into.
+    let ties = mode.decides_ties() && src.exact_ties;
+    scan_triangles(&part_tris, ties, &mut w.ties);
+    if ties {
         decide_ties(&part_tris, part, &src.ties, &mut w.ties);
         out.tie_pixels += emit_tie_quads(mode, src, part, piece, &mapper, w, out);
     }
-    // Steep triangles (`snap_is_steep`) take the exact triangle's values
-    // at their snapped corners; the others share the exact corners'.
-    let l_range = {
-        let (lo, hi) = value_range(w.proj.vertices.iter().map(|v| v.l));
-        hi - lo
-    };
-    let mut rate = None;
-    let may_be_steep = part_may_be_steep(l_range, w.rate_bound);
-    for (t, g) in w.drawn.iter() {
-        let idx = t.map(|i| w.remap[i as usize]);
-        if may_be_steep {
-            let p = t.map(|i| {
-                let v = &w.proj.vertices[i as usize];
-                DVec2::new(v.px, v.py)
-            });
-            let l = t.map(|i| w.proj.vertices[i as usize].l);
-            if snap_is_steep(p, l, w.rate_bound)
-                && snap_is_steep(p, l, *rate.get_or_insert_with(|| part_rate(src, part)))
-            {
-                let exact = idx.map(|i| out.vertices[i as usize]);
-                push_steep(p, *g, exact, &mut out.vertices, &mut out.indices);
-                out.steep += 1;
-                continue;
-            }
+    for d in w.drawn.iter() {
+        let idx = d.corners.map(|i| w.remap[i as usize]);
+        if w.ties.steep[d.exact as usize] {
+            let p = d.corners.map(|i| w.proj.vertices[i as usize].pos());
+            let exact = idx.map(|i| out.vertices[i as usize]);
+            push_steep(p, d.grid, exact, &mut out.vertices, &mut out.indices);
+            out.steep += 1;
+        } else {
+            out.indices.extend_from_slice(&idx);
         }
-        out.indices.extend_from_slice(&idx);
     }
     Ok(())
 }
@@ -363,7 +371,7 @@ fn emit_tie_quads<M: ProjectedMode>(
     let blocker = w
         .drawn
         .first()
-        .map(|(t, _)| out.vertices[w.remap[t[0] as usize] as usize].transparent());
+        .map(|d| out.vertices[w.remap[d.corners[0] as usize] as usize].transparent());
     let mut quads = 0;
     let mut k = 0;
     for d in &ties.decisions {

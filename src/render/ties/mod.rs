@@ -66,7 +66,7 @@ mod band;
 
 use glam::{DVec2, DVec3};
 
-use band::{centres_within, in_grown_triangle, inside_by_float, near_centres, near_edge};
+use band::{centres_within, in_grown_triangle, locate_by_float, near_centres, near_edge, ByFloat};
 
 use crate::camera::Camera;
 use crate::gpu::{GpuVertex, SUBPIXEL};
@@ -118,6 +118,13 @@ pub fn snap_is_steep(p: [DVec2; 3], l: [f64; 3], rate: f64) -> bool {
         .into_iter()
         .fold(0.0, f64::max)
         .sqrt();
+    snap_is_steep_at(area2, longest, l, rate)
+}
+
+/// [`snap_is_steep`] of a triangle with twice the area `area2` and
+/// longest edge `longest`.
+#[inline]
+fn snap_is_steep_at(area2: f64, longest: f64, l: [f64; 3], rate: f64) -> bool {
     let dl = l[0].max(l[1]).max(l[2]) - l[0].min(l[1]).min(l[2]);
     // False for NaN too.
     longest > 0.0
@@ -148,12 +155,6 @@ pub fn push_steep<V: GpuVertex>(
         vertices.push(v);
     }
     indices.extend_from_slice(&[base, base + 1, base + 2]);
-}
-
-/// Whether any triangle of a part whose thickness spans `l_range` can be
-/// [`snap_is_steep`] at rate `rate`.
-pub fn part_may_be_steep(l_range: f64, rate: f64) -> bool {
-    rate * l_range * SNAP_PX > SLIVER_DEPTH_TOL * SLIVER_TIE_PX
 }
 
 /// Whether the snapped triangle `g` (grid units) covers the centre `q`
@@ -363,7 +364,10 @@ pub struct TieScratch {
     bits: Vec<u64>,
     edges: Vec<((u32, u32), bool)>,
     centres: Vec<(u32, u32)>,
-    forced: Vec<(u32, u32)>,
+    seams: Vec<(u32, u32)>,
+    slivers: Vec<(u32, u32)>,
+    /// Whether each exact triangle is steep ([`scan_triangles`]).
+    pub steep: Vec<bool>,
     near: Vec<(u32, u32)>,
     proj: Vec<Proj>,
     pub decisions: Vec<TieDecision>,
@@ -372,12 +376,22 @@ pub struct TieScratch {
     pub values: Projected,
 }
 
+/// A triangle the GPU draws.
+#[derive(Clone, Copy, Debug)]
+pub struct DrawnTriangle {
+    /// Its corners (indices into the projection's vertices).
+    pub corners: [u32; 3],
+    /// Their snapped grid positions ([`crate::gpu::ClipMapper::ndc`]).
+    pub grid: [[i64; 2]; 3],
+    /// Its index among the exact triangles ([`PartTriangles::exact`]).
+    pub exact: u32,
+}
+
 /// What [`decide_ties`] needs of one part about to be drawn.
 pub struct PartTriangles<'a> {
     pub proj: &'a Projected,
-    /// Triangles the GPU draws (indices into `proj.vertices`), with their
-    /// snapped grid positions.
-    pub drawn: &'a [([u32; 3], [[i64; 2]; 3])],
+    /// Triangles the GPU draws.
+    pub drawn: &'a [DrawnTriangle],
     /// Every triangle of the exact part (after coverage culling, which
     /// leaves out only triangles holding no centre).
     pub exact: &'a [[u32; 3]],
@@ -386,11 +400,13 @@ pub struct PartTriangles<'a> {
     /// The largest extinction or emission rate on the part's scalar range
     /// ([`crate::render::pieces::PieceSource::max_rate`]): what a sliver's
     /// thickness error is weighed by.
-    /// Called only when the part has a sliver that [`Self::rate_bound`]
-    /// does not rule out.
+    /// Called only where [`Self::rate_bound`] does not settle a question,
+    /// possibly many times: the caller keeps the value.
     pub rate: &'a dyn Fn() -> f64,
     /// A bound on `rate` for every part.
     pub rate_bound: f64,
+    /// The least and the largest thickness at the part's vertices.
+    pub l_range: (f64, f64),
     /// Whether the projection is of the part clipped at the near plane
     /// (its outline is then not the whole part's): every centre goes to
     /// the exact test.
@@ -398,7 +414,9 @@ pub struct PartTriangles<'a> {
 }
 
 /// Decides the centres near the part's outline (see the module docs) into
-/// `scratch.decisions`: the pixels where a quad must be drawn first.
+/// `scratch.decisions`: the pixels where a quad must be drawn first. The
+/// sliver centres are those [`scan_triangles`] (with `slivers`) left in
+/// `scratch`.
 pub fn decide_ties(
     part: &PartTriangles,
     poly: &Polyhedron,
@@ -406,15 +424,85 @@ pub fn decide_ties(
     scratch: &mut TieScratch,
 ) {
     scratch.decisions.clear();
-    let pos = |i: u32| {
-        let v = &part.proj.vertices[i as usize];
-        DVec2::new(v.px, v.py)
-    };
-    // Outline candidates: edges of drawn triangles not shared by two of
-    // them, and every edge of an exact triangle that is not drawn. Each is
-    // tested for centres within the band as it is found.
+    let pos = |i: u32| part.proj.vertices[i as usize].pos();
     let centres = &mut scratch.centres;
     centres.clear();
+    outline_centres(part, centres, &mut scratch.bits, &mut scratch.edges);
+    // Centres next to the mode's seams: decided exactly wherever the part
+    // holds them, since the two sides carry different values.
+    let seams = &mut scratch.seams;
+    seams.clear();
+    for &(ia, ib) in &part.proj.seams {
+        near_centres(pos(ia), pos(ib), part.width, part.height, seams);
+    }
+    let slivers = &mut scratch.slivers;
+    centres.extend_from_slice(seams);
+    centres.extend_from_slice(slivers);
+    if centres.is_empty() {
+        return;
+    }
+    centres.sort_unstable();
+    centres.dedup();
+    seams.sort_unstable();
+    slivers.sort_unstable();
+    // The float filter's margin: only where the part has a positive
+    // thickness (a flat part's rays cross it for no length, which only
+    // the exact test sees) and its whole outline was projected.
+    let margin = if part.clipped || part.l_range.1.is_nan() || part.l_range.1 <= 0.0 {
+        None
+    } else {
+        let (z_min, coord_max) = part
+            .proj
+            .vertices
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(z, m), v| {
+                (z.min(v.z_front), m.max(v.px.abs()).max(v.py.abs()))
+            });
+        rays.filter_px(z_min, coord_max)
+    };
+    for &(i, j) in centres.iter() {
+        let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+        let sub = SUBPIXEL as i64;
+        let q = [i as i64 * sub + sub / 2, j as i64 * sub + sub / 2];
+        let grid_in = part.drawn.iter().any(|d| covers_grid(d.grid, q));
+        // A seam or sliver centre needs the exact segment wherever the part
+        // holds it.
+        let forced = (!seams.is_empty() && seams.binary_search(&(i, j)).is_ok())
+            || (!slivers.is_empty() && slivers.binary_search(&(i, j)).is_ok());
+        // Elsewhere, where the float test on the exact triangles is
+        // certain and agrees with the rasteriser, there is nothing to
+        // decide (most centres in the band).
+        if let (Some(m), false) = (margin, forced) {
+            match (locate_by_float(part.exact, &pos, c, m), grid_in) {
+                (ByFloat::Inside(_), true) | (ByFloat::Outside, false) => continue,
+                _ => {}
+            }
+        }
+        let (value, faces) = match (ray_through(poly, rays, c, &mut scratch.proj), grid_in) {
+            (RayThrough::Crosses(v, f), false) => (Some(v), f),
+            (RayThrough::Crosses(v, f), true) if forced => (Some(v), f),
+            (RayThrough::Misses, true) => (None, [0; 2]),
+            _ => continue,
+        };
+        scratch.decisions.push(TieDecision {
+            pixel: (i, j),
+            value,
+            faces,
+        });
+    }
+}
+
+/// Appends the centres within the band of the part's outline: edges of
+/// drawn triangles not shared by two of them, and every edge of an exact
+/// triangle that is not drawn. Each is tested for centres within the band
+/// as it is found.
+fn outline_centres(
+    part: &PartTriangles,
+    centres: &mut Vec<(u32, u32)>,
+    bits: &mut Vec<u64>,
+    edges: &mut Vec<((u32, u32), bool)>,
+) {
+    let pos = |i: u32| part.proj.vertices[i as usize].pos();
     let spans = part.proj.vertex_spans();
     let (width, height) = (part.width, part.height);
     let near = |ia: u32, ib: u32, out: &mut Vec<(u32, u32)>| {
@@ -431,18 +519,19 @@ pub fn decide_ties(
         // coordinates), so an edge shared by two of them appears once in
         // each direction, and an outline edge in one direction only.
         let n = part.proj.vertices.len();
-        scratch.bits.clear();
-        scratch.bits.resize(n, 0);
+        bits.clear();
+        bits.resize(n, 0);
         // A slice: its pointer and length stay in registers across the
         // stores.
-        let bits = &mut scratch.bits[..n];
-        let tris = part.drawn.iter().map(|(t, _)| t).chain(culled);
+        let bits = &mut bits[..n];
+        let tris = part.drawn.iter().map(|d| &d.corners).chain(culled);
         for t in tris {
             bits[t[0] as usize] |= 1 << t[1];
             bits[t[1] as usize] |= 1 << t[2];
             bits[t[2] as usize] |= 1 << t[0];
         }
-        for (t, _) in part.drawn {
+        for d in part.drawn {
+            let t = d.corners;
             for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
                 if bits[b as usize] >> a & 1 == 0 {
                     near(a, b, centres);
@@ -452,12 +541,11 @@ pub fn decide_ties(
     } else {
         // Each undirected edge with whether a drawn triangle has it.
         let key = |a: u32, b: u32| if a < b { (a, b) } else { (b, a) };
-        let edges = &mut scratch.edges;
         edges.clear();
         for (t, drawn) in part
             .drawn
             .iter()
-            .map(|(t, _)| (t, true))
+            .map(|d| (&d.corners, true))
             .chain(culled.iter().map(|t| (t, false)))
         {
             for k in 0..3 {
@@ -479,56 +567,78 @@ pub fn decide_ties(
     }
     if part.drawn.len() != part.exact.len() {
         for t in part.exact {
-            if !part.drawn.iter().any(|(d, _)| d == t) {
+            if !part.drawn.iter().any(|d| d.corners == *t) {
                 for k in 0..3 {
                     near(t[k], t[(k + 1) % 3], centres);
                 }
             }
         }
     }
-    // Centres next to the mode's seams: decided exactly wherever the part
-    // holds them, since the two sides carry different values.
-    let forced = &mut scratch.forced;
-    forced.clear();
-    for &(ia, ib) in &part.proj.seams {
-        near_centres(pos(ia), pos(ib), part.width, part.height, forced);
-    }
-    // Centres inside (or next to) sliver triangles: across a triangle
-    // narrower than SLIVER_TIE_PX the values change fast, and the snap of
-    // its corners shifts them by up to its gradient times 1/256 pixel; the
-    // exact segment is taken there instead.
-    let mut rate = None;
+}
+
+/// One pass over the part's exact triangles for what the snap of their
+/// corners can do: marks the [`snap_is_steep`] ones (`scratch.steep[k]`
+/// for `part.exact[k]`), and with `slivers` (the tie decisions, which
+/// read them) collects the centres inside (or within the band of) the
+/// sliver triangles where the snap could move the thickness by more than
+/// [`SLIVER_DEPTH_TOL`] over the rate. One pass serves both: the same
+/// widths and thickness changes decide them.
+pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScratch) {
+    let pos = |i: u32| part.proj.vertices[i as usize].pos();
+    let (out, near, steep) = (&mut scratch.slivers, &mut scratch.near, &mut scratch.steep);
+    out.clear();
+    steep.clear();
+    steep.resize(part.exact.len(), false);
     // A triangle's thickness changes by at most the part's, so the bound
     // on the rate and the part's thickness range bound the width below
-    // which the snap can matter; a part where no triangle can be that
-    // narrow (most parts of a fine mesh: thin, or optically thin) has no
-    // sliver to decide.
-    let (l_lo, l_hi) = part
-        .proj
-        .vertices
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(v.l), hi.max(v.l))
-        });
-    let widest = (part.rate_bound * (l_hi - l_lo) * SNAP_PX / SLIVER_DEPTH_TOL).min(SLIVER_TIE_PX);
-    // False for NaN too: no sliver test where the bound is not a number.
-    let slivers = if widest > 0.0 { part.exact } else { &[] };
+    // which the snap can matter in a sliver, and whether a wider
+    // triangle can be steep; most parts of a fine mesh (thin, or
+    // optically thin) have neither.
+    let (l_lo, l_hi) = part.l_range;
+    let reach = part.rate_bound * (l_hi - l_lo) * SNAP_PX / SLIVER_DEPTH_TOL;
+    // NaN stays NaN: no triangle is narrower.
+    let widest = if slivers {
+        reach.clamp(0.0, SLIVER_TIE_PX)
+    } else {
+        0.0
+    };
+    // False for NaN too.
+    let may_be_steep = reach > SLIVER_TIE_PX;
+    if !(widest > 0.0 || may_be_steep) {
+        return;
+    }
     // Every exact triangle, also those whose snapped corners collapse (a
     // sliver a few thousandths of a pixel wide on the steep side of a face
     // seen nearly edge-on, dropped as flat on the grid, whose centres the
     // neighbouring triangle then takes with its own, far different,
     // values).
-    for t in slivers {
-        let p = t.map(&pos);
-        // Cheap tests first: narrow (twice the area against the longest
-        // edge, squared), then what the snap can do to the optical depth
-        // or colour there (the rate times the thickness's change across
-        // the sliver times the snap over the width), with the bound on the
-        // rate, then the part's own rate.
-        let area2 = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+    for (n, t) in part.exact.iter().enumerate() {
+        let p = t.map(pos);
+        // Cheap tests first: narrow or wide (twice the area against the
+        // longest edge, squared), then what the snap can do to the optical
+        // depth or colour there (the rate times the thickness's change
+        // across the triangle times the snap over the width), with the
+        // bound on the rate, then the part's own rate.
+        let area2 = (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
         let d2 = [0, 1, 2].map(|k| (p[(k + 1) % 3] - p[k]).length_squared());
         let longest = d2[0].max(d2[1]).max(d2[2]);
-        if !(longest > 0.0 && area2 * area2 < widest * widest * longest) {
+        let narrow = area2 * area2 < widest * widest * longest;
+        let wide = may_be_steep && area2 * area2 >= SLIVER_TIE_PX * SLIVER_TIE_PX * longest;
+        if !(longest > 0.0 && (narrow || wide)) {
+            continue;
+        }
+        let l = t.map(|i| part.proj.vertices[i as usize].l);
+        let long = longest.sqrt();
+        if wide {
+            steep[n] = snap_is_steep_at(area2, long, l, part.rate_bound)
+                && snap_is_steep_at(area2, long, l, (part.rate)());
+            continue;
+        }
+        let dl = l[0].max(l[1]).max(l[2]) - l[0].min(l[1]).min(l[2]);
+        let w = area2 / long;
+        // False for NaN too.
+        let matters = |r: f64| r * dl * SNAP_PX > SLIVER_DEPTH_TOL * w;
+        if !matters(part.rate_bound) || !matters((part.rate)()) {
             continue;
         }
         let k = if d2[0] == longest {
@@ -538,87 +648,19 @@ pub fn decide_ties(
         } else {
             2
         };
-        let l = t.map(|i| part.proj.vertices[i as usize].l);
-        let dl = l[0].max(l[1]).max(l[2]) - l[0].min(l[1]).min(l[2]);
-        let long = d2[k].sqrt();
-        let w = area2.abs() / long;
-        // False for NaN too.
-        let matters = |r: f64| r * dl * SNAP_PX > SLIVER_DEPTH_TOL * w;
-        if !matters(part.rate_bound) || !matters(*rate.get_or_insert_with(|| (part.rate)())) {
-            continue;
-        }
         let (a, b) = (p[k], p[(k + 1) % 3]);
-        let near = &mut scratch.near;
         near.clear();
-        centres_within(
-            a,
-            b,
-            area2.abs() / long + TIE_BAND_PX,
-            part.width,
-            part.height,
-            near,
-        );
+        centres_within(a, b, w + TIE_BAND_PX, part.width, part.height, near);
         // Only the centres in the exact sliver grown by the band (which
         // holds every centre its snapped triangle can cover): coverage
         // culling keeps every triangle within COVERAGE_MARGIN_PX (1/64 px)
         // of a centre, so it drops no sliver that has such a centre, and
         // changes no decision.
-        forced.extend(
+        out.extend(
             near.iter()
                 .copied()
                 .filter(|&(i, j)| in_grown_triangle(p, DVec2::new(i as f64 + 0.5, j as f64 + 0.5))),
         );
-    }
-    centres.extend_from_slice(forced);
-    if centres.is_empty() {
-        return;
-    }
-    centres.sort_unstable();
-    centres.dedup();
-    forced.sort_unstable();
-    // The float filter's margin: only where the part has a positive
-    // thickness (a flat part's rays cross it for no length, which only
-    // the exact test sees) and its whole outline was projected.
-    let margin = if part.clipped || l_hi.is_nan() || l_hi <= 0.0 {
-        None
-    } else {
-        let (z_min, coord_max) = part
-            .proj
-            .vertices
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(z, m), v| {
-                (z.min(v.z_front), m.max(v.px.abs()).max(v.py.abs()))
-            });
-        rays.filter_px(z_min, coord_max)
-    };
-    for &(i, j) in centres.iter() {
-        let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
-        let sub = SUBPIXEL as i64;
-        let q = [i as i64 * sub + sub / 2, j as i64 * sub + sub / 2];
-        let grid_in = part.drawn.iter().any(|(_, g)| covers_grid(*g, q));
-        let seam = || forced.binary_search(&(i, j)).is_ok();
-        // Where the float test on the exact triangles is certain and
-        // agrees with the rasteriser, there is nothing to decide (most
-        // centres in the band); a seam or sliver centre needs the exact
-        // segment whenever the part holds it.
-        if let Some(m) = margin {
-            if inside_by_float(part.exact, &pos, c, m) == Some(grid_in)
-                && (forced.is_empty() || !seam())
-            {
-                continue;
-            }
-        }
-        let (value, faces) = match (ray_through(poly, rays, c, &mut scratch.proj), grid_in) {
-            (RayThrough::Crosses(v, f), false) => (Some(v), f),
-            (RayThrough::Crosses(v, f), true) if seam() => (Some(v), f),
-            (RayThrough::Misses, true) => (None, [0; 2]),
-            _ => continue,
-        };
-        scratch.decisions.push(TieDecision {
-            pixel: (i, j),
-            value,
-            faces,
-        });
     }
 }
 

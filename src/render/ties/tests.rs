@@ -1,5 +1,6 @@
 //! Unit tests of the tie decisions.
 
+use super::band::ByFloat::{Inside, Outside, Unsure};
 use super::*;
 use crate::camera::CameraParams;
 use crate::projection::ViewMap;
@@ -166,37 +167,40 @@ fn float_test_is_certain_only_away_from_edges() {
     let tris = [[0, 1, 2], [0, 2, 3]];
     let m = 1e-6;
     assert_eq!(
-        inside_by_float(&tris, &pos, DVec2::new(3.0, 1.0), m),
-        Some(true)
+        locate_by_float(&tris, &pos, DVec2::new(3.0, 1.0), m),
+        Inside(0)
     );
     assert_eq!(
-        inside_by_float(&tris, &pos, DVec2::new(1.0, 3.0), m),
-        Some(true)
+        locate_by_float(&tris, &pos, DVec2::new(1.0, 3.0), m),
+        Inside(1)
     );
     assert_eq!(
-        inside_by_float(&tris, &pos, DVec2::new(5.0, 1.0), m),
-        Some(false)
+        locate_by_float(&tris, &pos, DVec2::new(5.0, 1.0), m),
+        Outside
     );
     assert_eq!(
-        inside_by_float(&tris, &pos, DVec2::new(-1e-3, 2.0), m),
-        Some(false)
+        locate_by_float(&tris, &pos, DVec2::new(-1e-3, 2.0), m),
+        Outside
     );
     // On the outline, and within the margin of it on either side.
     for x in [0.0, 5e-7, -5e-7] {
         assert_eq!(
-            inside_by_float(&tris, &pos, DVec2::new(x, 2.0), m),
-            None,
+            locate_by_float(&tris, &pos, DVec2::new(x, 2.0), m),
+            Unsure,
             "{x}"
         );
     }
     // On the shared diagonal: inside the square, but certain in neither.
-    assert_eq!(inside_by_float(&tris, &pos, DVec2::new(2.0, 2.0), m), None);
+    assert_eq!(
+        locate_by_float(&tris, &pos, DVec2::new(2.0, 2.0), m),
+        Unsure
+    );
     // A NaN position is never certain.
     let q = [p[0], p[1], DVec2::new(f64::NAN, 4.0)];
     let posq = |i: u32| q[i as usize];
     assert_eq!(
-        inside_by_float(&[[0, 1, 2]], &posq, DVec2::new(3.0, 1.0), m),
-        None
+        locate_by_float(&[[0, 1, 2]], &posq, DVec2::new(3.0, 1.0), m),
+        Unsure
     );
 }
 
