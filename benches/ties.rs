@@ -12,6 +12,7 @@
 //! wall and process CPU time of each and of their ratio: the figure to
 //! quote on a shared, noisy machine. `TIES_ONLY=on` (or `off`) renders
 //! `TIES_PAIRS` frames of that kind only and exits, for a profiler.
+//! `TIES_SIZE=1024` renders 1024 x 1024 instead.
 //!
 //! Run: `cargo bench --bench ties`.
 
@@ -22,9 +23,14 @@ use zoovr::render::{Mode, ProjectedOptions, RenderOptions, Renderer, Scene, Scen
 use zoovr::testdata::hex_shell_scene;
 
 fn scene() -> (&'static str, Scene, CameraParams) {
+    // `TIES_SIZE` (default 512) sets the image's width and height.
+    let size = std::env::var("TIES_SIZE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(512);
     let camera = CameraParams {
-        width: 512,
-        height: 512,
+        width: size,
+        height: size,
         azimuth: 20.0,
         elevation: 35.0,
         zoom: 1.25,
