@@ -282,3 +282,112 @@ fn edge_walk_holds_every_near_centre() {
         }
     }
 }
+
+/// The one pass over a part's triangles ([`scan_triangles`]) marks as
+/// steep exactly the triangles [`snap_is_steep`] calls steep at both the
+/// bound and the part's rate, and collects every centre within the band
+/// of a sliver whose snap matters (brute force over the image), only
+/// where asked: random triangles from slivers to wide ones, thickness
+/// steep or flat, on a 12 x 10 image.
+#[test]
+fn one_pass_finds_the_steep_triangles_and_the_sliver_centres() {
+    use crate::testdata::Rng;
+    let mut rng = Rng(11);
+    let (width, height) = (12u32, 10u32);
+    let (mut steep_seen, mut sliver_seen) = (0, 0);
+    for _ in 0..3000 {
+        let mut proj = Projected::default();
+        let n = 3 + rng.below(4);
+        let o = DVec2::new(rng.range(0.0, 12.0), rng.range(0.0, 10.0));
+        for _ in 0..n {
+            // Sub-pixel to a few pixels; some vertices nearly collinear.
+            let d = DVec2::new(rng.range(-3.0, 3.0), rng.range(-3.0, 3.0)) * rng.f64();
+            proj.vertices.push(RegionVertex {
+                px: o.x + d.x,
+                py: o.y + d.y * [1.0, 1e-3][rng.below(2)],
+                l: rng.range(0.0, 0.3) * [1.0, 1e-4][rng.below(2)],
+                ..Default::default()
+            });
+        }
+        for k in 1..n - 1 {
+            proj.triangles.push([0, k as u32, k as u32 + 1]);
+        }
+        let l_range = (
+            proj.vertices
+                .iter()
+                .map(|v| v.l)
+                .fold(f64::INFINITY, f64::min),
+            proj.vertices
+                .iter()
+                .map(|v| v.l)
+                .fold(f64::NEG_INFINITY, f64::max),
+        );
+        let rate_bound = [1.0, 50.0, 1e3][rng.below(3)];
+        let part_rate = rate_bound * [1.0, 0.3, 0.01][rng.below(3)];
+        let rate = || part_rate;
+        let part = PartTriangles {
+            proj: &proj,
+            drawn: &[],
+            exact: &proj.triangles,
+            width,
+            height,
+            rate: &rate,
+            rate_bound,
+            l_range,
+            clipped: false,
+        };
+        let slivers = rng.below(2) == 0;
+        let mut scratch = TieScratch::default();
+        scan_triangles(&part, slivers, &mut scratch);
+        let pos = |i: u32| proj.vertices[i as usize].pos();
+        let may_be_steep =
+            rate_bound * (l_range.1 - l_range.0) * SNAP_PX > SLIVER_DEPTH_TOL * SLIVER_TIE_PX;
+        let mut expected = Vec::new();
+        for (k, t) in proj.triangles.iter().enumerate() {
+            let p = t.map(pos);
+            let l = t.map(|i| proj.vertices[i as usize].l);
+            let steep =
+                may_be_steep && snap_is_steep(p, l, rate_bound) && snap_is_steep(p, l, part_rate);
+            assert_eq!(
+                scratch.steep[k], steep,
+                "{p:?} {l:?} {rate_bound} {part_rate}"
+            );
+            steep_seen += steep as usize;
+            // A sliver: narrower than the widest width the part's
+            // thickness range allows, with a snap that matters.
+            let area2 = (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
+            let long = [0, 1, 2]
+                .map(|k| (p[(k + 1) % 3] - p[k]).length())
+                .into_iter()
+                .fold(0.0, f64::max);
+            let widest = (rate_bound * (l_range.1 - l_range.0) * SNAP_PX / SLIVER_DEPTH_TOL)
+                .min(SLIVER_TIE_PX);
+            let w = area2 / long;
+            let dl = l.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                - l.iter().copied().fold(f64::INFINITY, f64::min);
+            let matters = |r: f64| r * dl * SNAP_PX > SLIVER_DEPTH_TOL * w;
+            if slivers && long > 0.0 && w < widest && matters(rate_bound) && matters(part_rate) {
+                for j in 0..height {
+                    for i in 0..width {
+                        let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+                        if band::in_grown_triangle(p, c) {
+                            expected.push((i, j));
+                        }
+                    }
+                }
+            }
+        }
+        expected.sort_unstable();
+        expected.dedup();
+        let mut got = scratch.slivers.clone();
+        got.sort_unstable();
+        got.dedup();
+        assert_eq!(got, expected);
+        sliver_seen += got.len();
+    }
+    // Both kinds are exercised.
+    assert!(
+        steep_seen > 100 && sliver_seen > 100,
+        "{steep_seen} {sliver_seen}"
+    );
+}
