@@ -275,15 +275,8 @@ fn draw_part<M: ProjectedMode>(
     }
     // The part's largest rate, computed once, where a bound on it does
     // not settle a question.
-    let part_rate_once = std::cell::Cell::new(None);
-    let rate = || match part_rate_once.get() {
-        Some(r) => r,
-        None => {
-            let r = part_rate(src, part);
-            part_rate_once.set(Some(r));
-            r
-        }
-    };
+    let part_rate_once = std::cell::OnceCell::new();
+    let rate = || *part_rate_once.get_or_init(|| part_rate(src, part));
     let l_range = value_range(proj.vertices.iter().map(|v| v.l));
     // Centres next to the outline first (they decide their pixels), then
     // the triangles.

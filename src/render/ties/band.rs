@@ -8,36 +8,24 @@ use glam::DVec2;
 use super::TIE_BAND_PX;
 use crate::projection::coverage::Span;
 
-/// What the float test says of a pixel position and a part's triangles
-/// ([`locate_by_float`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum ByFloat {
-    /// Farther than the margin inside this triangle (an index into the
-    /// triangles tested).
-    Inside(usize),
-    /// Farther than the margin outside every triangle.
-    Outside,
-    /// Near an edge (or not a number): the exact test decides.
-    Unsure,
-}
-
-/// Where pixel position `c` lies among the triangles `tris` (of the
-/// positions `pos`), where a float test is certain: inside one of them, or
-/// outside all of them, by more than `margin` pixels (see [`ByFloat`]).
-/// The triangles tile the part's exact projection up to rounding
-/// (triangles inverted by the rounding of a crossing point are left out;
-/// the gaps they leave are far narrower than the margin) and coverage
-/// culling removed only triangles farther than
-/// [`crate::numeric::tolerance::COVERAGE_MARGIN_PX`] from every centre,
-/// so the answer is the exact test's.
-pub(super) fn locate_by_float(
+/// Whether pixel position `c` lies in one of the triangles `tris` (of
+/// the positions `pos`), where a float test is certain: `Some(true)`
+/// when it is farther than `margin` pixels inside one of them,
+/// `Some(false)` when it is farther than that outside each of them, `None`
+/// otherwise (near an edge: the exact test decides). The triangles tile
+/// the part's exact projection up to rounding (triangles inverted by the
+/// rounding of a crossing point are left out; the gaps they leave are far
+/// narrower than the margin) and coverage culling removed only triangles
+/// farther than [`crate::numeric::tolerance::COVERAGE_MARGIN_PX`] from
+/// every centre, so the answer is the exact test's.
+pub(super) fn inside_by_float(
     tris: &[[u32; 3]],
     pos: &impl Fn(u32) -> DVec2,
     c: DVec2,
     margin: f64,
-) -> ByFloat {
+) -> Option<bool> {
     let mut outside_all = true;
-    for (n, t) in tris.iter().enumerate() {
+    for t in tris {
         let p = t.map(pos);
         let sign = (p[1] - p[0]).perp_dot(p[2] - p[0]).signum();
         let (mut inside, mut outside) = (true, false);
@@ -55,17 +43,13 @@ pub(super) fn locate_by_float(
             }
         }
         if inside {
-            return ByFloat::Inside(n);
+            return Some(true);
         }
         if !outside {
             outside_all = false;
         }
     }
-    if outside_all {
-        ByFloat::Outside
-    } else {
-        ByFloat::Unsure
-    }
+    outside_all.then_some(false)
 }
 
 /// Whether `c` is inside triangle `p` (either winding) or within

@@ -66,7 +66,7 @@ mod band;
 
 use glam::{DVec2, DVec3};
 
-use band::{centres_within, in_grown_triangle, locate_by_float, near_centres, near_edge, ByFloat};
+use band::{centres_within, in_grown_triangle, inside_by_float, near_centres, near_edge};
 
 use crate::camera::Camera;
 use crate::gpu::{GpuVertex, SUBPIXEL};
@@ -364,8 +364,8 @@ pub struct TieScratch {
     bits: Vec<u64>,
     edges: Vec<((u32, u32), bool)>,
     centres: Vec<(u32, u32)>,
-    seams: Vec<(u32, u32)>,
-    slivers: Vec<(u32, u32)>,
+    /// Sliver centres ([`scan_triangles`]), then seam centres.
+    forced: Vec<(u32, u32)>,
     /// Whether each exact triangle is steep ([`scan_triangles`]).
     pub steep: Vec<bool>,
     near: Vec<(u32, u32)>,
@@ -430,21 +430,19 @@ pub fn decide_ties(
     outline_centres(part, centres, &mut scratch.bits, &mut scratch.edges);
     // Centres next to the mode's seams: decided exactly wherever the part
     // holds them, since the two sides carry different values.
-    let seams = &mut scratch.seams;
-    seams.clear();
+    // With the sliver centres ([`scan_triangles`]): both take the exact
+    // segment wherever the part holds them.
+    let forced = &mut scratch.forced;
     for &(ia, ib) in &part.proj.seams {
-        near_centres(pos(ia), pos(ib), part.width, part.height, seams);
+        near_centres(pos(ia), pos(ib), part.width, part.height, forced);
     }
-    let slivers = &mut scratch.slivers;
-    centres.extend_from_slice(seams);
-    centres.extend_from_slice(slivers);
+    centres.extend_from_slice(forced);
     if centres.is_empty() {
         return;
     }
     centres.sort_unstable();
     centres.dedup();
-    seams.sort_unstable();
-    slivers.sort_unstable();
+    forced.sort_unstable();
     // The float filter's margin: only where the part has a positive
     // thickness (a flat part's rays cross it for no length, which only
     // the exact test sees) and its whole outline was projected.
@@ -467,15 +465,13 @@ pub fn decide_ties(
         let grid_in = part.drawn.iter().any(|d| covers_grid(d.grid, q));
         // A seam or sliver centre needs the exact segment wherever the part
         // holds it.
-        let forced = (!seams.is_empty() && seams.binary_search(&(i, j)).is_ok())
-            || (!slivers.is_empty() && slivers.binary_search(&(i, j)).is_ok());
+        let forced = !forced.is_empty() && forced.binary_search(&(i, j)).is_ok();
         // Elsewhere, where the float test on the exact triangles is
         // certain and agrees with the rasteriser, there is nothing to
         // decide (most centres in the band).
         if let (Some(m), false) = (margin, forced) {
-            match (locate_by_float(part.exact, &pos, c, m), grid_in) {
-                (ByFloat::Inside(_), true) | (ByFloat::Outside, false) => continue,
-                _ => {}
+            if inside_by_float(part.exact, &pos, c, m) == Some(grid_in) {
+                continue;
             }
         }
         let (value, faces) = match (ray_through(poly, rays, c, &mut scratch.proj), grid_in) {
@@ -585,7 +581,7 @@ fn outline_centres(
 /// widths and thickness changes decide them.
 pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScratch) {
     let pos = |i: u32| part.proj.vertices[i as usize].pos();
-    let (out, near, steep) = (&mut scratch.slivers, &mut scratch.near, &mut scratch.steep);
+    let (out, near, steep) = (&mut scratch.forced, &mut scratch.near, &mut scratch.steep);
     out.clear();
     steep.clear();
     steep.resize(part.exact.len(), false);

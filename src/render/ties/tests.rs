@@ -1,6 +1,5 @@
 //! Unit tests of the tie decisions.
 
-use super::band::ByFloat::{Inside, Outside, Unsure};
 use super::*;
 use crate::camera::CameraParams;
 use crate::projection::ViewMap;
@@ -167,40 +166,37 @@ fn float_test_is_certain_only_away_from_edges() {
     let tris = [[0, 1, 2], [0, 2, 3]];
     let m = 1e-6;
     assert_eq!(
-        locate_by_float(&tris, &pos, DVec2::new(3.0, 1.0), m),
-        Inside(0)
+        inside_by_float(&tris, &pos, DVec2::new(3.0, 1.0), m),
+        Some(true)
     );
     assert_eq!(
-        locate_by_float(&tris, &pos, DVec2::new(1.0, 3.0), m),
-        Inside(1)
+        inside_by_float(&tris, &pos, DVec2::new(1.0, 3.0), m),
+        Some(true)
     );
     assert_eq!(
-        locate_by_float(&tris, &pos, DVec2::new(5.0, 1.0), m),
-        Outside
+        inside_by_float(&tris, &pos, DVec2::new(5.0, 1.0), m),
+        Some(false)
     );
     assert_eq!(
-        locate_by_float(&tris, &pos, DVec2::new(-1e-3, 2.0), m),
-        Outside
+        inside_by_float(&tris, &pos, DVec2::new(-1e-3, 2.0), m),
+        Some(false)
     );
     // On the outline, and within the margin of it on either side.
     for x in [0.0, 5e-7, -5e-7] {
         assert_eq!(
-            locate_by_float(&tris, &pos, DVec2::new(x, 2.0), m),
-            Unsure,
+            inside_by_float(&tris, &pos, DVec2::new(x, 2.0), m),
+            None,
             "{x}"
         );
     }
     // On the shared diagonal: inside the square, but certain in neither.
-    assert_eq!(
-        locate_by_float(&tris, &pos, DVec2::new(2.0, 2.0), m),
-        Unsure
-    );
+    assert_eq!(inside_by_float(&tris, &pos, DVec2::new(2.0, 2.0), m), None);
     // A NaN position is never certain.
     let q = [p[0], p[1], DVec2::new(f64::NAN, 4.0)];
     let posq = |i: u32| q[i as usize];
     assert_eq!(
-        locate_by_float(&[[0, 1, 2]], &posq, DVec2::new(3.0, 1.0), m),
-        Unsure
+        inside_by_float(&[[0, 1, 2]], &posq, DVec2::new(3.0, 1.0), m),
+        None
     );
 }
 
@@ -379,7 +375,7 @@ fn one_pass_finds_the_steep_triangles_and_the_sliver_centres() {
         }
         expected.sort_unstable();
         expected.dedup();
-        let mut got = scratch.slivers.clone();
+        let mut got = scratch.forced.clone();
         got.sort_unstable();
         got.dedup();
         assert_eq!(got, expected);
