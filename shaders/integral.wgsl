@@ -68,22 +68,11 @@ fn node(i: u32) -> Material {
     return Material(tf.nodes[2u * i].y, tf.nodes[2u * i + 1u].xyz);
 }
 
-// Number of nodes with s_node <= s (the transfer-function piece holding s).
+// Number of nodes with s_node <= s (the transfer-function piece holding s):
+// a binary search.
 fn piece_index(s: f32) -> u32 {
-    return piece_index_in(s, 0u, tf.count);
-}
-
-// piece_index(s), searched from node lo_in (the caller knows every node
-// below it is <= s) up to node hi_in: when node hi_in is above s the answer
-// lies there, else (s at or above it by rounding) the search goes to the
-// last node. The same answer as piece_index, in the few steps of a
-// segment's own nodes rather than the table's.
-fn piece_index_in(s: f32, lo_in: u32, hi_in: u32) -> u32 {
-    var lo = lo_in;
+    var lo = 0u;
     var hi = tf.count;
-    if hi_in < tf.count && node_s(hi_in) > s {
-        hi = hi_in;
-    }
     while lo < hi {
         let mid = (lo + hi) / 2u;
         if node_s(mid) <= s {
@@ -316,17 +305,6 @@ fn add_piece(acc: ptr<function, Composite>, l: f32, m0: Material, m1: Material) 
     (*acc).pieces += 1u;
 }
 
-// The piece of the segment between fractions x0 < x1 (scalars s0, s1 there):
-// the transfer-function piece holding its midpoint scalar, which lies
-// between the segment's nodes i0 and i1 (piece_index_in).
-fn add_sub(acc: ptr<function, Composite>, l: f32, x0: f32, x1: f32, s0: f32, s1: f32, i0: u32, i1: u32) {
-    if x1 <= x0 {
-        return;
-    }
-    let idx = piece_index_in(0.5 * (s0 + s1), i0, i1);
-    add_piece(acc, l * (x1 - x0), eval_piece(idx, s0), eval_piece(idx, s1));
-}
-
 // Premultiplied colour and opacity of a segment of length `l` over which the
 // scalar goes linearly from `s_f` (front) to `s_b` (back), sliced at every
 // node strictly between them (twin: integral::integrate_segment; the f64
@@ -348,31 +326,38 @@ fn integrate_segment(l_in: f32, sf_in: f32, sb_in: f32) -> vec4<f32> {
     while i1 < tf.count && node_s(i1) < hi {
         i1++;
     }
-    if i1 == i0 {
-        // One transfer-function piece (also s_f == s_b).
-        add_piece(&acc, l, eval_piece(i0, s_f), eval_piece(i0, s_b));
-    } else {
-        let inv = 1.0 / (s_b - s_f);
-        var x_prev = 0.0;
-        var s_prev = s_f;
-        let count = i1 - i0;
-        for (var n = 0u; n < count; n++) {
-            // Front to back: ascending nodes when the scalar grows.
-            var k = i0 + n;
-            if s_b < s_f {
-                k = i1 - 1u - n;
-            }
-            let sk = node_s(k);
-            // A jump is two nodes at one scalar: one breakpoint.
-            if n > 0u && sk == s_prev {
-                continue;
-            }
-            let x = (sk - s_f) * inv;
-            add_sub(&acc, l, x_prev, x, s_prev, sk, i0, i1);
-            x_prev = x;
-            s_prev = sk;
+    // Front to back, count + 1 spans: piece i0 from lo to node i0, the
+    // whole pieces between the crossed nodes, piece i1 from node i1 - 1 to
+    // hi (one span, piece i0 == i1, when no node lies between); in
+    // ascending order where the scalar grows, descending where it falls. At
+    // each crossed node k the span in front ends and the next begins with
+    // node k's own material, so a jump (two nodes at one scalar) is an empty
+    // span between its two materials. One loop with one call of add_piece
+    // keeps the shader small (every lane of a SIMD group runs the loop as
+    // often as its longest segment).
+    let up = s_b > s_f;
+    let count = i1 - i0;
+    var inv = 0.0;
+    if count > 0u {
+        inv = 1.0 / (s_b - s_f);
+    }
+    var m_prev = eval_piece(select(i1, i0, up), s_f);
+    var x_prev = 0.0;
+    for (var n = 0u; n <= count; n++) {
+        var m: Material;
+        var x = 1.0;
+        if n < count {
+            let k = select(i1 - 1u - n, i0 + n, up);
+            m = node(k);
+            x = (node_s(k) - s_f) * inv;
+        } else {
+            m = eval_piece(select(i0, i1, up), s_b);
         }
-        add_sub(&acc, l, x_prev, 1.0, s_prev, s_b, i0, i1);
+        if x > x_prev {
+            add_piece(&acc, l * (x - x_prev), m_prev, m);
+        }
+        m_prev = m;
+        x_prev = x;
     }
     var alpha = acc.alpha;
     if acc.pieces != 1u {

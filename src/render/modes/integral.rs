@@ -147,20 +147,10 @@ impl TfBuffer {
         }
     }
 
-    /// Number of nodes with `s_node <= s`.
+    /// Number of nodes with `s_node <= s`: a binary search
+    /// (`piece_index`).
     pub fn piece_index(&self, s: f32) -> u32 {
-        self.piece_index_in(s, 0, self.count())
-    }
-
-    /// [`Self::piece_index`], searched from node `lo_in` (every node below
-    /// it is `<= s`) up to node `hi_in` when that node is above `s`, else
-    /// to the last (`piece_index_in`).
-    pub fn piece_index_in(&self, s: f32, lo_in: u32, hi_in: u32) -> u32 {
-        let mut lo = lo_in;
-        let mut hi = self.count();
-        if hi_in < self.count() && self.node_s(hi_in) > s {
-            hi = hi_in;
-        }
+        let (mut lo, mut hi) = (0, self.count());
         while lo < hi {
             let mid = (lo + hi) / 2;
             if self.node_s(mid) <= s {
@@ -226,27 +216,6 @@ impl TfBuffer {
         acc.pieces += 1;
     }
 
-    /// The piece between fractions `x0 < x1` (`add_sub`).
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn add_sub(
-        &self,
-        consts: &[[f32; 4]],
-        acc: &mut Composite,
-        l: f32,
-        x0: f32,
-        x1: f32,
-        s0: f32,
-        s1: f32,
-        (i0, i1): (u32, u32),
-    ) {
-        if x1 <= x0 {
-            return;
-        }
-        let idx = self.piece_index_in(0.5 * (s0 + s1), i0, i1);
-        let (m0, m1) = (self.eval_piece(idx, s0), self.eval_piece(idx, s1));
-        self.add_piece(consts, acc, l * (x1 - x0), m0, m1);
-    }
-
     /// Premultiplied colour and opacity of a segment of length `l` over
     /// which the (normalised) scalar goes linearly from `s_f` to `s_b`
     /// (`integrate_segment`).
@@ -271,25 +240,25 @@ impl TfBuffer {
         while i1 < self.count() && self.node_s(i1) < hi {
             i1 += 1;
         }
-        if i1 == i0 {
-            let (m0, m1) = (self.eval_piece(i0, s_f), self.eval_piece(i0, s_b));
-            self.add_piece(consts, &mut acc, l, m0, m1);
-        } else {
-            let inv = 1.0 / (s_b - s_f);
-            let (mut x_prev, mut s_prev) = (0.0f32, s_f);
-            let count = i1 - i0;
-            for n in 0..count {
-                let k = if s_b < s_f { i1 - 1 - n } else { i0 + n };
-                let sk = self.node_s(k);
-                if n > 0 && sk == s_prev {
-                    continue;
-                }
-                let x = (sk - s_f) * inv;
-                self.add_sub(consts, &mut acc, l, x_prev, x, s_prev, sk, (i0, i1));
-                x_prev = x;
-                s_prev = sk;
+        // Front to back, `count + 1` spans from node to node (see the
+        // shader's comment); an empty span (a jump) adds nothing.
+        let up = s_b > s_f;
+        let count = i1 - i0;
+        let inv = if count > 0 { 1.0 / (s_b - s_f) } else { 0.0 };
+        let mut m_prev = self.eval_piece(if up { i0 } else { i1 }, s_f);
+        let mut x_prev = 0.0f32;
+        for n in 0..=count {
+            let (m, x) = if n < count {
+                let k = if up { i0 + n } else { i1 - 1 - n };
+                (self.node(k), (self.node_s(k) - s_f) * inv)
+            } else {
+                (self.eval_piece(if up { i1 } else { i0 }, s_b), 1.0)
+            };
+            if x > x_prev {
+                self.add_piece(consts, &mut acc, l * (x - x_prev), m_prev, m);
             }
-            self.add_sub(consts, &mut acc, l, x_prev, 1.0, s_prev, s_b, (i0, i1));
+            m_prev = m;
+            x_prev = x;
         }
         let alpha = if acc.pieces != 1 {
             neg_expm1(acc.depth)

@@ -77,11 +77,11 @@ pub fn stage_twins() -> Vec<StageTwins> {
         twins!("exptable.wgsl": exptable::log1p_, exptable::coord, ExpTable::alpha_of),
         twins!("exact_frag.wgsl": exact_frag::fs_main),
         twins!("integral.wgsl":
-            TfBuffer::node_s, TfBuffer::node, TfBuffer::piece_index, TfBuffer::piece_index_in, TfBuffer::eval_piece,
+            TfBuffer::node_s, TfBuffer::node, TfBuffer::piece_index, TfBuffer::eval_piece,
             integral::neg_expm1, integral::taylor_pq, integral::taylor_bg, integral::asym,
             integral::ends_increasing, integral::ends_decreasing,
             integral::sanitize_thickness, integral::gauss, integral::weights,
-            TfBuffer::add_piece, TfBuffer::add_sub, TfBuffer::integrate_segment),
+            TfBuffer::add_piece, TfBuffer::integrate_segment),
         twins!("iso.wgsl":
             iso::count_at_most, iso::iso_light, iso::iso_surface, iso::iso_over,
             iso::iso_crosses, iso::iso_segment, iso::fs_iso),
