@@ -11,9 +11,11 @@
 //    src/render/modes/segment.rs `ScalarMap` says);
 // 2: the constants of the closed form (`consts`): the Taylor centres of the
 //    special functions (129 entries: P, Q, B, G at x = k/16) followed by the
-//    Gauss-Legendre rules on [0, 1] (6 nodes, then 4: (x, w) pairs, two per
-//    entry). In f32 they are as good as the f64 path's 12 and 8 (error below
-//    6e-9 up to depth 2 and 5e-8 up to 1/2, tested) at half the cost.
+//    6-node Gauss-Legendre rule on [0, 1] ((x, w) pairs, two per entry). In
+//    f32 it is as good as the f64 path's 12 nodes (error below 6e-9 up to
+//    depth 2, tested) at half the cost. One rule at every depth up to 2: a
+//    second, shorter rule for small depths cost more than it saved, since
+//    the lanes of a SIMD group that straddle its threshold run both.
 
 struct TfBuffer {
     // Number of nodes (>= 1).
@@ -31,7 +33,6 @@ struct TfBuffer {
 
 const SF_CENTRES: u32 = 129u;
 const GL6_BASE: u32 = 129u;
-const GL4_BASE: u32 = 132u;
 // Terms of the Taylor series about the nearest centre (|x - x0| <= 1/32):
 // the truncation error is below 1e-9 relative (twin test).
 const TAYLOR_TERMS: u32 = 9u;
@@ -240,12 +241,7 @@ fn weights(a_in: f32, b_in: f32) -> Weights {
     if m <= 2.0 {
         let alpha = neg_expm1(d1);
         let t = 1.0 - alpha;
-        var g: vec4<f32>;
-        if m <= 0.5 {
-            g = gauss(a, b, GL4_BASE, 2u);
-        } else {
-            g = gauss(a, b, GL6_BASE, 3u);
-        }
+        let g = gauss(a, b, GL6_BASE, 3u);
         return Weights(g.z + g.w, g.z, g.w, g.x, g.y, alpha, t);
     }
     let t = exp(-d1);
@@ -342,16 +338,15 @@ fn integrate_segment(l_in: f32, sf_in: f32, sb_in: f32) -> vec4<f32> {
         inv = 1.0 / (s_b - s_f);
     }
     var m_prev = eval_piece(select(i1, i0, up), s_f);
+    let m_last = eval_piece(select(i0, i1, up), s_b);
     var x_prev = 0.0;
     for (var n = 0u; n <= count; n++) {
-        var m: Material;
+        var m = m_last;
         var x = 1.0;
         if n < count {
             let k = select(i1 - 1u - n, i0 + n, up);
             m = node(k);
             x = (node_s(k) - s_f) * inv;
-        } else {
-            m = eval_piece(select(i0, i1, up), s_b);
         }
         if x > x_prev {
             add_piece(&acc, l * (x - x_prev), m_prev, m);

@@ -27,7 +27,6 @@ use super::segment::ScalarMap;
 
 const SF_CENTRES: usize = 129;
 const GL6_BASE: usize = 129;
-const GL4_BASE: usize = 132;
 
 /// The 6-point Gauss-Legendre rule on [0, 1] `(x, w)`: in `f32` as good as
 /// the f64 path's 12 points up to depth 2 (error below 6e-9, tested).
@@ -40,13 +39,6 @@ pub const GL6: [(f64, f64); 6] = [
     (0.966234757101576, 0.08566224618958518),
 ];
 
-/// The 4-point rule on [0, 1]: error below 5e-8 up to depth 1/2 (tested).
-pub const GL4: [(f64, f64); 4] = [
-    (0.06943184420297371, 0.17392742256872692),
-    (0.33000947820757187, 0.32607257743127305),
-    (0.6699905217924281, 0.32607257743127305),
-    (0.9305681557970263, 0.17392742256872692),
-];
 /// Terms of the Taylor series about the nearest centre (`|x - x0| <=
 /// 1/32`); the truncation error is below 1e-9 relative (tested).
 const TAYLOR_TERMS: u32 = 9;
@@ -57,17 +49,15 @@ const MAX_THICKNESS: f32 = 1e30;
 const MAX_SCALAR: f32 = 1e30;
 
 /// The constants buffer of the closed form: `P, Q, B, G` at the 129 centres
-/// `k/16`, then the 6- and 4-point Gauss-Legendre rules on [0, 1] as
-/// `(x, w, x, w)` pairs.
+/// `k/16`, then the 6-point Gauss-Legendre rule on [0, 1] as `(x, w, x, w)`
+/// pairs.
 pub fn closed_form_constants() -> Vec<[f32; 4]> {
     let mut c: Vec<[f32; 4]> = SF_TABLE.iter().map(|r| r.map(|v| v as f32)).collect();
     debug_assert_eq!(c.len(), SF_CENTRES);
-    for rule in [&GL6[..], &GL4[..]] {
-        for p in rule.chunks(2) {
-            c.push([p[0].0 as f32, p[0].1 as f32, p[1].0 as f32, p[1].1 as f32]);
-        }
+    for p in GL6.chunks(2) {
+        c.push([p[0].0 as f32, p[0].1 as f32, p[1].0 as f32, p[1].1 as f32]);
     }
-    debug_assert_eq!(c.len(), GL4_BASE + 2);
+    debug_assert_eq!(c.len(), GL6_BASE + 3);
     c
 }
 
@@ -404,11 +394,7 @@ pub fn weights(consts: &[[f32; 4]], a_in: f32, b_in: f32) -> Weights {
     if m <= 2.0 {
         let alpha = neg_expm1(d1);
         let t = 1.0 - alpha;
-        let g = if m <= 0.5 {
-            gauss(consts, a, b, GL4_BASE, 2)
-        } else {
-            gauss(consts, a, b, GL6_BASE, 3)
-        };
+        let g = gauss(consts, a, b, GL6_BASE, 3);
         return Weights {
             psi: g[2] + g[3],
             phi_f: g[2],
@@ -526,14 +512,12 @@ mod tests {
         }
     }
 
-    /// The short rules integrate polynomials of degree 2n - 1 exactly.
+    /// The short rule integrates polynomials of degree 11 exactly.
     #[test]
-    fn gauss_rules_are_exact_to_their_degree() {
-        for (rule, n) in [(&GL6[..], 6), (&GL4[..], 4)] {
-            for k in 0..2 * n {
-                let got: f64 = rule.iter().map(|&(x, w)| w * x.powi(k)).sum();
-                assert!((got - 1.0 / (k + 1) as f64).abs() < 1e-15, "{n} {k}");
-            }
+    fn gauss_rule_is_exact_to_its_degree() {
+        for k in 0..12 {
+            let got: f64 = GL6.iter().map(|&(x, w)| w * x.powi(k)).sum();
+            assert!((got - 1.0 / (k + 1) as f64).abs() < 1e-15, "{k}");
         }
     }
 
