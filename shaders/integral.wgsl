@@ -118,48 +118,32 @@ fn neg_expm1(d: f32) -> f32 {
     return 1.0 - exp(-d);
 }
 
-// (P(x), Q(x)) for 0 <= x <= 8: Taylor series about the nearest centre.
-fn taylor_pq(x: f32) -> vec2<f32> {
+// (P(x), Q(x)) for sigma = -1 (increasing extinction), (B(x), G(x)) for
+// sigma = 1 (decreasing), 0 <= x <= 8: Taylor series about the nearest
+// centre. The two pairs obey one recurrence up to the sign sigma (each
+// multiplication by sigma is exact), so one loop serves both: lanes of a
+// SIMD group with rising and with falling extinction run it once.
+fn taylor_sf(x: f32, sigma: f32) -> vec2<f32> {
     let k = min(u32(x * 16.0 + 0.5), SF_CENTRES - 1u);
     let x0 = f32(k) / 16.0;
     let dl = x - x0;
     let c = consts[k];
-    var pm1 = c.x;
-    var p = -2.0 * c.y;
-    var sp = c.x + p * dl;
-    var sq = c.y + (-x0 * p - c.x) * dl;
+    let f0 = select(c.x, c.z, sigma > 0.0);
+    let f1 = select(c.y, c.w, sigma > 0.0);
+    var pm1 = f0;
+    var p = 2.0 * sigma * f1;
+    var s1 = f0 + p * dl;
+    var s2 = f1 + (-x0 * p - f0) * dl;
     var dn = dl;
     for (var n = 1u; n < TAYLOR_TERMS; n++) {
-        let pn1 = (2.0 * x0 * p + 2.0 * pm1) / f32(n + 1u);
+        let pn1 = -sigma * (2.0 * x0 * p + 2.0 * pm1) / f32(n + 1u);
         dn *= dl;
-        sp += pn1 * dn;
-        sq += (-x0 * pn1 - p) * dn;
+        s1 += pn1 * dn;
+        s2 += (-x0 * pn1 - p) * dn;
         pm1 = p;
         p = pn1;
     }
-    return vec2<f32>(sp, sq);
-}
-
-// (B(x), G(x)) for 0 <= x <= 8: Taylor series about the nearest centre.
-fn taylor_bg(x: f32) -> vec2<f32> {
-    let k = min(u32(x * 16.0 + 0.5), SF_CENTRES - 1u);
-    let x0 = f32(k) / 16.0;
-    let dl = x - x0;
-    let c = consts[k];
-    var bm1 = c.z;
-    var b = 2.0 * c.w;
-    var sb = c.z + b * dl;
-    var sg = c.w + (-x0 * b - c.z) * dl;
-    var dn = dl;
-    for (var n = 1u; n < TAYLOR_TERMS; n++) {
-        let bn1 = (-2.0 * x0 * b - 2.0 * bm1) / f32(n + 1u);
-        dn *= dl;
-        sb += bn1 * dn;
-        sg += (-x0 * bn1 - b) * dn;
-        bm1 = b;
-        b = bn1;
-    }
-    return vec2<f32>(sb, sg);
+    return vec2<f32>(s1, s2);
 }
 
 // Scaled asymptotic series: S = sum sign^k (2k-1)!! t^k,
@@ -181,27 +165,19 @@ fn asym(t: f32, sign: f32) -> vec2<f32> {
     return vec2<f32>(s, q);
 }
 
-// Increasing extinction: (P(u)/r, Q(u)/d) with u = c/r.
-fn ends_increasing(c: f32, r: f32, d: f32) -> vec2<f32> {
-    let u = c / r;
-    if u <= ASYM_X {
-        let pq = taylor_pq(u);
-        return vec2<f32>(pq.x / r, pq.y / d);
+// One end of a segment with extinction slope d = |b - a| > 0 or, with
+// r = sqrt(2 d) = 0, equal ends: (P(u)/r, Q(u)/d) for rising extinction
+// (sigma = -1), (B(u)/r, -G(u)/d) for falling (sigma = 1), u = c/r; the
+// scaled asymptotic series where u > ASYM_X (always where r = 0, which
+// gives the equal-ends closed form). Compared as c <= ASYM_X r, without
+// dividing by r.
+fn ends_sf(c: f32, r: f32, d: f32, sigma: f32) -> vec2<f32> {
+    if c <= ASYM_X * r {
+        let t = taylor_sf(c / r, sigma);
+        return vec2<f32>(t.x / r, -sigma * t.y / d);
     }
     let cc = c * c;
-    let sq = asym(d / cc, -1.0);
-    return vec2<f32>(sq.x / c, sq.y / cc);
-}
-
-// Decreasing extinction: (B(v)/r, -G(v)/e) with v = c/r.
-fn ends_decreasing(c: f32, r: f32, e: f32) -> vec2<f32> {
-    let v = c / r;
-    if v <= ASYM_X {
-        let bg = taylor_bg(v);
-        return vec2<f32>(bg.x / r, -bg.y / e);
-    }
-    let cc = c * c;
-    let sq = asym(e / cc, 1.0);
+    let sq = asym(d / cc, sigma);
     return vec2<f32>(sq.x / c, sq.y / cc);
 }
 
@@ -246,28 +222,15 @@ fn weights(a_in: f32, b_in: f32) -> Weights {
     }
     let t = exp(-d1);
     let alpha = 1.0 - t;
-    var psi: f32;
-    var phi_b: f32;
-    if a == b {
-        let ea = exp(-a);
-        let em = 1.0 - ea;
-        psi = em / a;
-        phi_b = (em - a * ea) / (a * a);
-    } else if b > a {
-        let d = b - a;
-        let r = sqrt(2.0 * d);
-        let f = ends_increasing(a, r, d);
-        let k = ends_increasing(b, r, d);
-        psi = f.x - t * k.x;
-        phi_b = f.y - t * k.y - t * k.x;
-    } else {
-        let e = a - b;
-        let r = sqrt(2.0 * e);
-        let f = ends_decreasing(a, r, e);
-        let k = ends_decreasing(b, r, e);
-        psi = f.x - t * k.x;
-        phi_b = f.y - t * k.y - t * k.x;
-    }
+    // Rising or falling extinction, one path (equal ends included, as
+    // the limit d = 0 of the asymptotic series).
+    let sigma = select(1.0, -1.0, b > a);
+    let d = abs(b - a);
+    let r = sqrt(2.0 * d);
+    let f = ends_sf(a, r, d, sigma);
+    let k = ends_sf(b, r, d, sigma);
+    let psi = f.x - t * k.x;
+    let phi_b = f.y - t * k.y - t * k.x;
     return Weights(psi, psi - phi_b, phi_b, 1.0 - psi, psi - t, alpha, t);
 }
 

@@ -277,46 +277,31 @@ pub fn neg_expm1(d: f32) -> f32 {
     1.0 - (-d).exp()
 }
 
-/// `(P(x), Q(x))` for `0 <= x <= 8` (`taylor_pq`).
-pub fn taylor_pq(consts: &[[f32; 4]], x: f32) -> [f32; 2] {
+/// `(P(x), Q(x))` for `sigma = -1`, `(B(x), G(x))` for `sigma = 1`,
+/// `0 <= x <= 8`: one recurrence up to the sign (`taylor_sf`).
+pub fn taylor_sf(consts: &[[f32; 4]], x: f32, sigma: f32) -> [f32; 2] {
     let k = ((x * 16.0 + 0.5) as u32).min(SF_CENTRES as u32 - 1);
     let x0 = k as f32 / 16.0;
     let dl = x - x0;
     let c = consts[k as usize];
-    let (mut pm1, mut p) = (c[0], -2.0 * c[1]);
-    let mut sp = c[0] + p * dl;
-    let mut sq = c[1] + (-x0 * p - c[0]) * dl;
+    let (f0, f1) = if sigma > 0.0 {
+        (c[2], c[3])
+    } else {
+        (c[0], c[1])
+    };
+    let (mut pm1, mut p) = (f0, 2.0 * sigma * f1);
+    let mut s1 = f0 + p * dl;
+    let mut s2 = f1 + (-x0 * p - f0) * dl;
     let mut dn = dl;
     for n in 1..TAYLOR_TERMS {
-        let pn1 = (2.0 * x0 * p + 2.0 * pm1) / (n + 1) as f32;
+        let pn1 = -sigma * (2.0 * x0 * p + 2.0 * pm1) / (n + 1) as f32;
         dn *= dl;
-        sp += pn1 * dn;
-        sq += (-x0 * pn1 - p) * dn;
+        s1 += pn1 * dn;
+        s2 += (-x0 * pn1 - p) * dn;
         pm1 = p;
         p = pn1;
     }
-    [sp, sq]
-}
-
-/// `(B(x), G(x))` for `0 <= x <= 8` (`taylor_bg`).
-pub fn taylor_bg(consts: &[[f32; 4]], x: f32) -> [f32; 2] {
-    let k = ((x * 16.0 + 0.5) as u32).min(SF_CENTRES as u32 - 1);
-    let x0 = k as f32 / 16.0;
-    let dl = x - x0;
-    let c = consts[k as usize];
-    let (mut bm1, mut b) = (c[2], 2.0 * c[3]);
-    let mut sb = c[2] + b * dl;
-    let mut sg = c[3] + (-x0 * b - c[2]) * dl;
-    let mut dn = dl;
-    for n in 1..TAYLOR_TERMS {
-        let bn1 = (-2.0 * x0 * b - 2.0 * bm1) / (n + 1) as f32;
-        dn *= dl;
-        sb += bn1 * dn;
-        sg += (-x0 * bn1 - b) * dn;
-        bm1 = b;
-        b = bn1;
-    }
-    [sb, sg]
+    [s1, s2]
 }
 
 /// Scaled asymptotic series (`asym`).
@@ -334,25 +319,15 @@ pub fn asym(t: f32, sign: f32) -> [f32; 2] {
     [s, q]
 }
 
-pub(crate) fn ends_increasing(consts: &[[f32; 4]], c: f32, r: f32, d: f32) -> [f32; 2] {
-    let u = c / r;
-    if u <= ASYM_X {
-        let pq = taylor_pq(consts, u);
-        return [pq[0] / r, pq[1] / d];
+/// One end of a segment with extinction slope `d = |b - a|`: the Taylor
+/// or the asymptotic form, rising (`sigma = -1`) or falling (`ends_sf`).
+pub(crate) fn ends_sf(consts: &[[f32; 4]], c: f32, r: f32, d: f32, sigma: f32) -> [f32; 2] {
+    if c <= ASYM_X * r {
+        let t = taylor_sf(consts, c / r, sigma);
+        return [t[0] / r, -sigma * t[1] / d];
     }
     let cc = c * c;
-    let sq = asym(d / cc, -1.0);
-    [sq[0] / c, sq[1] / cc]
-}
-
-pub(crate) fn ends_decreasing(consts: &[[f32; 4]], c: f32, r: f32, e: f32) -> [f32; 2] {
-    let v = c / r;
-    if v <= ASYM_X {
-        let bg = taylor_bg(consts, v);
-        return [bg[0] / r, -bg[1] / e];
-    }
-    let cc = c * c;
-    let sq = asym(e / cc, 1.0);
+    let sq = asym(d / cc, sigma);
     [sq[0] / c, sq[1] / cc]
 }
 
@@ -407,23 +382,13 @@ pub fn weights(consts: &[[f32; 4]], a_in: f32, b_in: f32) -> Weights {
     }
     let t = (-d1).exp();
     let alpha = 1.0 - t;
-    let (psi, phi_b) = if a == b {
-        let ea = (-a).exp();
-        let em = 1.0 - ea;
-        (em / a, (em - a * ea) / (a * a))
-    } else if b > a {
-        let d = b - a;
-        let r = (2.0 * d).sqrt();
-        let f = ends_increasing(consts, a, r, d);
-        let k = ends_increasing(consts, b, r, d);
-        (f[0] - t * k[0], f[1] - t * k[1] - t * k[0])
-    } else {
-        let e = a - b;
-        let r = (2.0 * e).sqrt();
-        let f = ends_decreasing(consts, a, r, e);
-        let k = ends_decreasing(consts, b, r, e);
-        (f[0] - t * k[0], f[1] - t * k[1] - t * k[0])
-    };
+    let sigma = if b > a { -1.0 } else { 1.0 };
+    let d = (b - a).abs();
+    let r = (2.0 * d).sqrt();
+    let f = ends_sf(consts, a, r, d, sigma);
+    let k = ends_sf(consts, b, r, d, sigma);
+    let psi = f[0] - t * k[0];
+    let phi_b = f[1] - t * k[1] - t * k[0];
     Weights {
         psi,
         phi_f: psi - phi_b,
@@ -447,8 +412,8 @@ mod tests {
         let mut worst = 0.0f64;
         for i in 0..=8000 {
             let x = i as f64 / 1000.0;
-            let [p, _] = taylor_pq(&c, x as f32);
-            let [b, _] = taylor_bg(&c, x as f32);
+            let [p, _] = taylor_sf(&c, x as f32, -1.0);
+            let [b, _] = taylor_sf(&c, x as f32, 1.0);
             // Compare at the f32 argument.
             let xf = x as f32 as f64;
             worst = worst.max((p as f64 / sqrtpi_erfcx(xf) - 1.0).abs());

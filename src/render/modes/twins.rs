@@ -78,8 +78,8 @@ pub fn stage_twins() -> Vec<StageTwins> {
         twins!("exact_frag.wgsl": exact_frag::fs_main),
         twins!("integral.wgsl":
             TfBuffer::node_s, TfBuffer::node, TfBuffer::piece_index, TfBuffer::eval_piece,
-            integral::neg_expm1, integral::taylor_pq, integral::taylor_bg, integral::asym,
-            integral::ends_increasing, integral::ends_decreasing,
+            integral::neg_expm1, integral::taylor_sf, integral::asym,
+            integral::ends_sf,
             integral::sanitize_thickness, integral::gauss, integral::weights,
             TfBuffer::add_piece, TfBuffer::integrate_segment),
         twins!("iso.wgsl":
