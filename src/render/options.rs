@@ -37,8 +37,8 @@ pub struct RenderOptions {
 #[serde(rename_all = "lowercase")]
 pub enum TableBuild {
     /// The GPU compute build when drawing on a hardware GPU, else the
-    /// exact CPU build (measured faster than the compute pass on the
-    /// software adapters; both are exact).
+    /// exact CPU build (in `f64`; on the software adapters it is about as
+    /// fast as their compute pass; both are exact).
     #[default]
     Auto,
     /// The exact integrals in `f64` on the CPU (all cores).
