@@ -38,6 +38,16 @@ const GL6_BASE: u32 = 129u;
 const TAYLOR_TERMS: u32 = 9u;
 // Terms of the asymptotic series (argument t <= 1/128): below 1e-10.
 const ASYM_TERMS: u32 = 9u;
+// Up to this optical thickness (both ends) the basis integrals are the
+// 6-node Gauss-Legendre rule (accurate to 6e-9 there); above it the closed
+// form of the special functions.
+const GAUSS_MAX: f32 = 2.0;
+// Whether a segment can be thicker than GAUSS_MAX. A stage whose every
+// segment is thinner (the transfer function's largest extinction times the
+// mesh's largest cell diameter, checked on the CPU) sets it to false: the
+// compiler then drops the closed form, whose mere presence slowed every
+// fragment on llvmpipe by about 9 %.
+override THICK_SEGMENTS: bool = true;
 // Above this argument the special functions use their asymptotic series.
 const ASYM_X: f32 = 8.0;
 // Optical thicknesses and lengths are clamped here (f32 range, and so that
@@ -214,7 +224,7 @@ fn weights(a_in: f32, b_in: f32) -> Weights {
     let b = sanitize_thickness(b_in);
     let d1 = 0.5 * (a + b);
     let m = max(a, b);
-    if m <= 2.0 {
+    if m <= GAUSS_MAX || !THICK_SEGMENTS {
         let alpha = neg_expm1(d1);
         let t = 1.0 - alpha;
         let g = gauss(a, b, GL6_BASE, 3u);

@@ -18,7 +18,7 @@ mod golden_util;
 use golden_util::{f, golden, rgb};
 use serde_json::Value;
 use zoovr::gpu::{AccumFormat, ClipMapper, Context, FrameOptions, GpuOptions};
-use zoovr::render::modes::exact_frag::bind_exact_frag_stage;
+use zoovr::render::modes::exact_frag::{bind_exact_frag_stage, thin_stage_holds};
 use zoovr::render::modes::integral::{closed_form_constants, TfBuffer};
 use zoovr::render::modes::segment::{SegmentVertex, SegmentView};
 
@@ -173,8 +173,14 @@ fn golden_on_the_gpu() {
         .begin_frame_with(&FrameOptions::new(w, h, AccumFormat::F32))
         .unwrap();
     let mut piece = 0u32;
+    // Each case at its own longest cell: the cases whose every segment is
+    // thinner than the closed form's threshold are drawn by the thin stage
+    // (`THICK_SEGMENTS` off), the others by the full one; both are checked.
+    let mut thin = 0;
     for (n, case) in cases.iter().enumerate() {
-        let stage = bind_exact_frag_stage(&gpu, &SegmentView::ortho(), &case.tf).unwrap();
+        let longest = case.cells.iter().map(|c| c.0 as f64).fold(0.0, f64::max);
+        thin += thin_stage_holds(&case.tf, longest) as usize;
+        let stage = bind_exact_frag_stage(&gpu, &SegmentView::ortho(), &case.tf, longest).unwrap();
         let (i, j) = (n as u32 % w, n as u32 / w);
         // Back to front: the last cell first.
         for &(l, sf, sb) in case.cells.iter().rev() {
@@ -202,7 +208,11 @@ fn golden_on_the_gpu() {
         let got = img.pixels[n];
         worst = worst.max(check(case, got, "gpu"));
     }
-    eprintln!("gpu: worst relative error {worst:.2e}");
+    eprintln!(
+        "gpu: worst relative error {worst:.2e} ({thin} of {} cases on the thin stage)",
+        cases.len()
+    );
+    assert!(thin > 0 && thin < cases.len(), "{thin} thin cases");
 }
 
 /// Independent emission (a source of its own, not extinction times colour,
@@ -308,4 +318,25 @@ fn independent_emission_matches_the_reference() {
             "{err}"
         );
     }
+}
+
+/// The thin stage is chosen only where the transfer function's largest
+/// extinction times the longest segment stays below the closed form's
+/// threshold, with its margin, and never on NaN or infinite inputs.
+#[test]
+fn thin_stage_needs_every_segment_below_the_threshold() {
+    let tf = TfBuffer {
+        model: 0,
+        nodes: [node(0.0, 0.5, [1.0; 3]), node(1.0, 1.0, [1.0; 3])].concat(),
+    };
+    assert!(thin_stage_holds(&tf, 1.9));
+    assert!(!thin_stage_holds(&tf, 2.0), "no margin");
+    assert!(!thin_stage_holds(&tf, 2.5));
+    assert!(!thin_stage_holds(&tf, f64::INFINITY));
+    assert!(!thin_stage_holds(&tf, f64::NAN));
+    let nan = TfBuffer {
+        model: 0,
+        nodes: [node(0.0, 0.5, [1.0; 3]), node(1.0, f64::NAN, [1.0; 3])].concat(),
+    };
+    assert!(!thin_stage_holds(&nan, 0.1));
 }

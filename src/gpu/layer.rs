@@ -103,6 +103,7 @@ pub static LAYER_STAGE: StageDesc = StageDesc {
         attributes: &LayerVertex::ATTRIBUTES,
     },
     bindings: &[],
+    constants: &[],
 };
 
 /// Twin of `fs_main` in `shaders/layer.wgsl`: the quad's flat colour.

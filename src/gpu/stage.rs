@@ -71,6 +71,12 @@ pub struct StageDesc {
     pub vertex: wgpu::VertexBufferLayout<'static>,
     /// Bindings of group 0, binding `k` at index `k`.
     pub bindings: &'static [Binding],
+    /// Values of the WGSL's pipeline-overridable constants (`override`
+    /// declarations) by name, for this stage's pipelines; those not named
+    /// keep their defaults. One WGSL can so make several stages (each with
+    /// its own `name`, the cache key), the compiler dropping the code a
+    /// constant switches off.
+    pub constants: &'static [(&'static str, f64)],
 }
 
 /// One resource bound to a stage for a frame, in [`StageDesc::bindings`]
@@ -352,7 +358,10 @@ impl StageCache {
                 vertex: wgpu::VertexState {
                     module: &self.module,
                     entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: self.desc.constants,
+                        ..Default::default()
+                    },
                     buffers: &[Some(self.desc.vertex.clone())],
                 },
                 primitive: wgpu::PrimitiveState {
@@ -375,7 +384,10 @@ impl StageCache {
                 fragment: Some(wgpu::FragmentState {
                     module: &self.module,
                     entry_point: Some(entry),
-                    compilation_options: Default::default(),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: self.desc.constants,
+                        ..Default::default()
+                    },
                     targets: &[Some(wgpu::ColorTargetState {
                         format,
                         blend: Some(wgpu::BlendState {

@@ -29,7 +29,8 @@ use crate::raycast::FieldModel;
 use crate::render::pieces::PieceSource;
 use crate::tf::{EmissionModel, TransferFunction};
 
-use super::integral::{closed_form_constants, TfBuffer};
+use super::integral::{closed_form_constants, TfBuffer, GAUSS_MAX};
+use super::preint_tables::TableCache;
 use super::segment::{segment_at, ScalarMap, SegmentMode, SegmentVertex, SegmentView};
 use super::{Bounds, ModeInfo};
 
@@ -62,24 +63,66 @@ pub static INFO: ModeInfo = ModeInfo {
 pub static EXACT_FRAG_STAGE: StageDesc = StageDesc {
     name: "exact_frag.wgsl",
     fragment: "fs_main",
-    wgsl: concat!(
-        include_str!("../../../shaders/segment_vertex.wgsl"),
-        include_str!("../../../shaders/segment.wgsl"),
-        include_str!("../../../shaders/integral.wgsl"),
-        include_str!("../../../shaders/exact_frag.wgsl"),
-    ),
+    wgsl: EXACT_FRAG_WGSL,
     vertex: SegmentVertex::LAYOUT,
     bindings: &[Binding::Uniform, Binding::Storage, Binding::Storage],
+    constants: &[],
 };
 
+/// The exact-frag stage's WGSL.
+const EXACT_FRAG_WGSL: &str = concat!(
+    include_str!("../../../shaders/segment_vertex.wgsl"),
+    include_str!("../../../shaders/segment.wgsl"),
+    include_str!("../../../shaders/integral.wgsl"),
+    include_str!("../../../shaders/exact_frag.wgsl"),
+);
+
+/// The exact-frag stage compiled without the closed form for optically
+/// thick segments (`THICK_SEGMENTS` false in `shaders/integral.wgsl`):
+/// drawn where no segment can be thicker than [`GAUSS_MAX`]
+/// ([`thin_stage_holds`]); the same images, about 9 % faster on llvmpipe.
+pub static EXACT_FRAG_THIN_STAGE: StageDesc = StageDesc {
+    name: "exact_frag.wgsl+thin",
+    fragment: "fs_main",
+    wgsl: EXACT_FRAG_WGSL,
+    vertex: SegmentVertex::LAYOUT,
+    bindings: &[Binding::Uniform, Binding::Storage, Binding::Storage],
+    constants: &[("THICK_SEGMENTS", 0.0)],
+};
+
+/// Whether no segment of a frame can reach the closed form's optical
+/// thickness: the largest extinction of the transfer function (its nodes'
+/// extinctions in `f32`, as the stage reads them; the function is linear
+/// between them and constant beyond) times the longest segment a piece can
+/// hold (`max_length`, the mesh's largest cell diameter), with a margin of
+/// [`THIN_MARGIN`] for the rounding of interpolated lengths.
+pub fn thin_stage_holds(tf: &TfBuffer, max_length: f64) -> bool {
+    let tau_max = tf.max_tau() as f64;
+    tau_max.is_finite()
+        && max_length.is_finite()
+        && tau_max * max_length * (1.0 + THIN_MARGIN) <= GAUSS_MAX as f64
+}
+
+/// Relative margin on a segment's length in [`thin_stage_holds`]: the
+/// rasteriser interpolates `l` (or `q_f - q_b`) in `f32`, a few ulps off.
+pub const THIN_MARGIN: f64 = 1e-3;
+
 /// Binds the exact-frag stage for one frame: its view and transfer
-/// function (normalised as the vertices' scalars are).
+/// function (normalised as the vertices' scalars are), the thin stage
+/// where no segment can be longer than `max_length` times too thick
+/// ([`thin_stage_holds`]).
 pub fn bind_exact_frag_stage(
     gpu: &Context,
     view: &SegmentView,
     tf: &TfBuffer,
+    max_length: f64,
 ) -> Result<Stage, GpuError> {
-    bind_integral_stage(gpu, &EXACT_FRAG_STAGE, view, tf, &[])
+    let stage = if thin_stage_holds(tf, max_length) {
+        &EXACT_FRAG_THIN_STAGE
+    } else {
+        &EXACT_FRAG_STAGE
+    };
+    bind_integral_stage(gpu, stage, view, tf, &[])
 }
 
 /// Binds `stage`, a stage on the segment payload with the closed-form
@@ -181,7 +224,8 @@ pub struct ExactFragMode;
 impl SegmentMode for ExactFragMode {
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         let tf = TfBuffer::new(src.tf, &ScalarMap::of(src.tf));
-        bind_exact_frag_stage(gpu, &SegmentView::of(src.camera), &tf)
+        let lengths = TableCache::of(gpu)?.lengths(src.whole);
+        bind_exact_frag_stage(gpu, &SegmentView::of(src.camera), &tf, lengths.max_diameter)
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {

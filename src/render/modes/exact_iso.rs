@@ -170,6 +170,7 @@ pub static EXACT_ISO_STAGE: StageDesc = StageDesc {
         attributes: &ExactIsoVertex::ATTRIBUTES,
     },
     bindings: &[Binding::Uniform, Binding::Table2d, Binding::Uniform],
+    constants: &[],
 };
 
 /// The stage's bindings on the CPU, for its twin [`fs_main`].

@@ -27,6 +27,9 @@ use super::segment::ScalarMap;
 
 const SF_CENTRES: usize = 129;
 const GL6_BASE: usize = 129;
+/// Up to this optical thickness (both ends) the basis integrals are the
+/// 6-node Gauss-Legendre rule; above it the closed form (`GAUSS_MAX`).
+pub const GAUSS_MAX: f32 = 2.0;
 
 /// The 6-point Gauss-Legendre rule on [0, 1] `(x, w)`: in `f32` as good as
 /// the f64 path's 12 points up to depth 2 (error below 6e-9, tested).
@@ -123,6 +126,22 @@ impl TfBuffer {
 
     fn count(&self) -> u32 {
         (self.nodes.len() / 2) as u32
+    }
+
+    /// The largest extinction of the nodes (the transfer function's, linear
+    /// between them and constant beyond); NaN where one is NaN.
+    pub fn max_tau(&self) -> f32 {
+        self.nodes
+            .iter()
+            .step_by(2)
+            .map(|n| n[1])
+            .fold(0.0, |m, t| {
+                if t.is_nan() || m.is_nan() {
+                    f32::NAN
+                } else {
+                    m.max(t)
+                }
+            })
     }
 
     pub(crate) fn node_s(&self, i: u32) -> f32 {
@@ -366,7 +385,7 @@ pub fn weights(consts: &[[f32; 4]], a_in: f32, b_in: f32) -> Weights {
     let b = sanitize_thickness(b_in);
     let d1 = 0.5 * (a + b);
     let m = a.max(b);
-    if m <= 2.0 {
+    if m <= GAUSS_MAX {
         let alpha = neg_expm1(d1);
         let t = 1.0 - alpha;
         let g = gauss(consts, a, b, GL6_BASE, 3);

@@ -35,10 +35,10 @@ use crate::render::iso::{IsoMix, IsoSet, Lighting, AMBIENT, DIFFUSE};
 use crate::render::pieces::PieceSource;
 use crate::tf::{EmissionModel, TransferFunction};
 
-use super::exact_frag::{bind_integral_stage, ExactFragTwin};
+use super::exact_frag::{bind_integral_stage, thin_stage_holds, ExactFragTwin};
 use super::integral::TfBuffer;
 use super::preint::{PreintMode, PreintTwin};
-use super::preint_tables::{TableKind, TableStats};
+use super::preint_tables::{TableCache, TableKind, TableStats};
 use super::segment::{segment_at, ScalarMap, Seg, SegmentPayload, SegmentVertex, SegmentView};
 use super::{Bounds, ModeInfo};
 use crate::raycast::FieldModel;
@@ -240,6 +240,9 @@ pub fn gpu_level(v: f64) -> f32 {
 
 macro_rules! iso_stage {
     ($name:literal, [$($file:literal),*], $glue:literal, $bindings:expr) => {
+        iso_stage!($name, [$($file),*], $glue, $bindings, &[])
+    };
+    ($name:literal, [$($file:literal),*], $glue:literal, $bindings:expr, $constants:expr) => {
         StageDesc {
             name: $name,
             fragment: "fs_iso",
@@ -252,6 +255,7 @@ macro_rules! iso_stage {
             ),
             vertex: IsoVertex::LAYOUT,
             bindings: $bindings,
+            constants: $constants,
         }
     };
 }
@@ -278,6 +282,16 @@ pub static ISO_EXACT_FRAG_STAGE: StageDesc = iso_stage!(
     ["integral.wgsl"],
     "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return integrate_segment(l, sf, sb);\n}\n",
     INTEGRAL_BINDINGS
+);
+
+/// `--iso` with `exact-frag` where no segment can be optically thick
+/// (`THICK_SEGMENTS` off, [`super::exact_frag::thin_stage_holds`]).
+pub static ISO_EXACT_FRAG_THIN_STAGE: StageDesc = iso_stage!(
+    "iso.wgsl+exact_frag+thin",
+    ["integral.wgsl"],
+    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return integrate_segment(l, sf, sb);\n}\n",
+    INTEGRAL_BINDINGS,
+    &[("THICK_SEGMENTS", 0.0)]
 );
 
 /// `--iso` with `preint3d`.
@@ -677,9 +691,19 @@ impl ProjectedMode for IsoMode {
         ];
         let view = SegmentView::of(src.camera);
         match &self.volume {
-            Volume::None | Volume::Integral => {
+            Volume::None => {
                 let tf = TfBuffer::new(src.tf, &map);
                 bind_integral_stage(gpu, self.stage(), &view, &tf, &extra)
+            }
+            Volume::Integral => {
+                let tf = TfBuffer::new(src.tf, &map);
+                let longest = TableCache::of(gpu)?.lengths(src.whole).max_diameter;
+                let stage = if thin_stage_holds(&tf, longest) {
+                    &ISO_EXACT_FRAG_THIN_STAGE
+                } else {
+                    self.stage()
+                };
+                bind_integral_stage(gpu, stage, &view, &tf, &extra)
             }
             Volume::Table(p) => p.bind_stage(
                 gpu,

@@ -68,6 +68,7 @@ pub static PREINT2D_STAGE: StageDesc = StageDesc {
     ),
     vertex: SegmentVertex::LAYOUT,
     bindings: &[Binding::Uniform, Binding::Table2d, Binding::Uniform],
+    constants: &[],
 };
 
 /// Twin of `table_rgba` in `shaders/preint2d.wgsl`.

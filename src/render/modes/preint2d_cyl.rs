@@ -69,6 +69,7 @@ pub static PREINT2D_CYL_STAGE: StageDesc = StageDesc {
     ),
     vertex: SegmentVertex::LAYOUT,
     bindings: &[Binding::Uniform, Binding::Table2dArray, Binding::Uniform],
+    constants: &[],
 };
 
 /// Equation 10 in `f32`, as the shader computes it: `(a, u)` of the

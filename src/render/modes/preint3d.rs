@@ -64,6 +64,7 @@ pub static PREINT3D_STAGE: StageDesc = StageDesc {
     ),
     vertex: SegmentVertex::LAYOUT,
     bindings: &[Binding::Uniform, Binding::Table3d, Binding::Uniform],
+    constants: &[],
 };
 
 /// Twin of `table_rgba` in `shaders/preint3d.wgsl`.

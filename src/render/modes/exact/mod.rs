@@ -174,6 +174,7 @@ pub static EXACT_STAGE: StageDesc = StageDesc {
         attributes: &ExactVertex::ATTRIBUTES,
     },
     bindings: &[Binding::Uniform, Binding::Table2d],
+    constants: &[],
 };
 
 fn check_unit(length_unit: f32) -> Result<(), GpuError> {
