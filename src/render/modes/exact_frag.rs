@@ -106,21 +106,40 @@ pub fn thin_stage_holds(tf: &TfBuffer, max_length: f64) -> bool {
 /// rasteriser interpolates `l` (or `q_f - q_b`) in `f32`, a few ulps off.
 pub const THIN_MARGIN: f64 = 1e-3;
 
+/// `thin` (the stage's WGSL with `THICK_SEGMENTS` off) where no segment
+/// of length up to `max_length` can be optically thick for `tf`
+/// ([`thin_stage_holds`]), else `full`: the one choice of every stage that
+/// includes `shaders/integral.wgsl` for its volume.
+pub fn integral_stage(
+    tf: &TfBuffer,
+    max_length: f64,
+    full: &'static StageDesc,
+    thin: &'static StageDesc,
+) -> &'static StageDesc {
+    if thin_stage_holds(tf, max_length) {
+        thin
+    } else {
+        full
+    }
+}
+
+/// The longest segment a piece of `src`'s mesh can hold: its largest cell
+/// diameter, computed once per mesh on the device's table cache.
+pub fn longest_segment(gpu: &Context, src: &PieceSource) -> Result<f64, GpuError> {
+    Ok(TableCache::of(gpu)?.lengths(src.whole).max_diameter)
+}
+
 /// Binds the exact-frag stage for one frame: its view and transfer
 /// function (normalised as the vertices' scalars are), the thin stage
-/// where no segment can be longer than `max_length` times too thick
-/// ([`thin_stage_holds`]).
+/// where no segment up to `max_length` can be optically thick
+/// ([`integral_stage`]).
 pub fn bind_exact_frag_stage(
     gpu: &Context,
     view: &SegmentView,
     tf: &TfBuffer,
     max_length: f64,
 ) -> Result<Stage, GpuError> {
-    let stage = if thin_stage_holds(tf, max_length) {
-        &EXACT_FRAG_THIN_STAGE
-    } else {
-        &EXACT_FRAG_STAGE
-    };
+    let stage = integral_stage(tf, max_length, &EXACT_FRAG_STAGE, &EXACT_FRAG_THIN_STAGE);
     bind_integral_stage(gpu, stage, view, tf, &[])
 }
 
@@ -223,8 +242,8 @@ pub struct ExactFragMode;
 impl SegmentMode for ExactFragMode {
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         let tf = TfBuffer::new(src.tf, &ScalarMap::of(src.tf));
-        let lengths = TableCache::of(gpu)?.lengths(src.whole);
-        bind_exact_frag_stage(gpu, &SegmentView::of(src.camera), &tf, lengths.max_diameter)
+        let longest = longest_segment(gpu, src)?;
+        bind_exact_frag_stage(gpu, &SegmentView::of(src.camera), &tf, longest)
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {

@@ -131,17 +131,11 @@ impl TfBuffer {
     /// The largest extinction of the nodes (the transfer function's, linear
     /// between them and constant beyond); NaN where one is NaN.
     pub fn max_tau(&self) -> f32 {
-        self.nodes
-            .iter()
-            .step_by(2)
-            .map(|n| n[1])
-            .fold(0.0, |m, t| {
-                if t.is_nan() || m.is_nan() {
-                    f32::NAN
-                } else {
-                    m.max(t)
-                }
-            })
+        let taus = || self.nodes.iter().step_by(2).map(|n| n[1]);
+        if taus().any(f32::is_nan) {
+            return f32::NAN;
+        }
+        taus().fold(0.0, f32::max)
     }
 
     pub(crate) fn node_s(&self, i: u32) -> f32 {
@@ -255,13 +249,14 @@ impl TfBuffer {
         let count = i1 - i0;
         let inv = if count > 0 { 1.0 / (s_b - s_f) } else { 0.0 };
         let mut m_prev = self.eval_piece(if up { i0 } else { i1 }, s_f);
+        let m_last = self.eval_piece(if up { i1 } else { i0 }, s_b);
         let mut x_prev = 0.0f32;
         for n in 0..=count {
             let (m, x) = if n < count {
                 let k = if up { i0 + n } else { i1 - 1 - n };
                 (self.node(k), (self.node_s(k) - s_f) * inv)
             } else {
-                (self.eval_piece(if up { i1 } else { i0 }, s_b), 1.0)
+                (m_last, 1.0)
             };
             if x > x_prev {
                 self.add_piece(consts, &mut acc, l * (x - x_prev), m_prev, m);

@@ -35,10 +35,10 @@ use crate::render::iso::{IsoMix, IsoSet, Lighting, AMBIENT, DIFFUSE};
 use crate::render::pieces::PieceSource;
 use crate::tf::{EmissionModel, TransferFunction};
 
-use super::exact_frag::{bind_integral_stage, thin_stage_holds, ExactFragTwin};
+use super::exact_frag::{bind_integral_stage, integral_stage, longest_segment, ExactFragTwin};
 use super::integral::TfBuffer;
 use super::preint::{PreintMode, PreintTwin};
-use super::preint_tables::{TableCache, TableKind, TableStats};
+use super::preint_tables::{TableKind, TableStats};
 use super::segment::{segment_at, ScalarMap, Seg, SegmentPayload, SegmentVertex, SegmentView};
 use super::{Bounds, ModeInfo};
 use crate::raycast::FieldModel;
@@ -697,12 +697,8 @@ impl ProjectedMode for IsoMode {
             }
             Volume::Integral => {
                 let tf = TfBuffer::new(src.tf, &map);
-                let longest = TableCache::of(gpu)?.lengths(src.whole).max_diameter;
-                let stage = if thin_stage_holds(&tf, longest) {
-                    &ISO_EXACT_FRAG_THIN_STAGE
-                } else {
-                    self.stage()
-                };
+                let longest = longest_segment(gpu, src)?;
+                let stage = integral_stage(&tf, longest, self.stage(), &ISO_EXACT_FRAG_THIN_STAGE);
                 bind_integral_stage(gpu, stage, &view, &tf, &extra)
             }
             Volume::Table(p) => p.bind_stage(
