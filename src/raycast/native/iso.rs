@@ -43,8 +43,8 @@
 use glam::DVec3;
 
 use super::{
-    integrate_cuts, monotone_nodes, node_crossings, piece_root, shape, Interval, IsoRay,
-    NativeStats,
+    integrate_cuts, monotone_nodes, node_crossings, piece_root, shape, ClippedInterval, Interval,
+    IsoRay, NativeStats,
 };
 use crate::camera::Ray;
 use crate::integrate::{RayMaterial, SegmentValue};
@@ -215,30 +215,22 @@ pub fn interval_iso<M: RayMaterial>(
     flat: DVec3,
     stats: &mut NativeStats,
 ) -> SegmentValue {
-    let c = iv.cell as usize;
-    let (mut ta, tb) = (iv.t_a, iv.t_b);
-    let mut sa = iv.s_a;
-    let clipped = ta < t_near;
-    if clipped {
-        let x = (t_near - ta) / (tb - ta);
-        sa += x * (iv.s_b - sa);
-        ta = t_near;
-    }
-    let l = tb - ta;
-    if l.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+    let Some(cut) = ClippedInterval::new(scene, vals, iv, t_near, stats) else {
         return SegmentValue::default();
-    }
-    stats.intervals += 1;
-    let cells = &scene.mesh.cells;
-    let nodes = cells.nodes(c);
-    let x: Vec<DVec3> = nodes
-        .iter()
-        .map(|&n| scene.mesh.points[n as usize])
-        .collect();
-    let s: Vec<f64> = nodes.iter().map(|&n| vals[n as usize]).collect();
-    let a = (ta, (!clipped).then_some(iv.s_a));
-    let value = IsoRay::new(cells.kinds[c], &x, &s, ray).and_then(|mut f| {
-        let r = composite(&mut f, material, sh, nodes, flat, a, (tb, iv.s_b), stats);
+    };
+    let (l, sa) = (iv.t_b - cut.ta, cut.sa);
+    let a = (cut.ta, (!cut.clipped).then_some(iv.s_a));
+    let value = IsoRay::new(cut.kind, &cut.x, &cut.s, ray).and_then(|mut f| {
+        let r = composite(
+            &mut f,
+            material,
+            sh,
+            cut.nodes,
+            flat,
+            a,
+            (iv.t_b, iv.s_b),
+            stats,
+        );
         stats.newton_failures += f.failures;
         r
     });

@@ -693,35 +693,75 @@ pub fn interval_value<M: RayMaterial>(
     t_near: f64,
     stats: &mut NativeStats,
 ) -> SegmentValue {
-    let c = iv.cell as usize;
-    let (mut ta, tb) = (iv.t_a, iv.t_b);
-    let mut sa = iv.s_a;
-    if ta < t_near {
-        let x = (t_near - ta) / (tb - ta);
-        sa += x * (iv.s_b - sa);
-        ta = t_near;
-    }
-    let l = tb - ta;
-    if l.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+    let Some(cut) = ClippedInterval::new(scene, vals, iv, t_near, stats) else {
         return SegmentValue::default();
-    }
-    stats.intervals += 1;
-    let cells = &scene.mesh.cells;
-    let nodes = cells.nodes(c);
-    let x: Vec<DVec3> = nodes
-        .iter()
-        .map(|&n| scene.mesh.points[n as usize])
-        .collect();
-    let s: Vec<f64> = nodes.iter().map(|&n| vals[n as usize]).collect();
-    let value = IsoRay::new(cells.kinds[c], &x, &s, ray).and_then(|mut f| {
+    };
+    let (ta, tb) = (cut.ta, iv.t_b);
+    let value = IsoRay::new(cut.kind, &cut.x, &cut.s, ray).and_then(|mut f| {
         let r = integrate(&mut f, material, ta, tb, stats);
         stats.newton_failures += f.failures;
         r
     });
     value.unwrap_or_else(|| {
         stats.fallback_intervals += 1;
-        material.segment(l, sa, iv.s_b)
+        material.segment(tb - ta, cut.sa, iv.s_b)
     })
+}
+
+/// One native interval clipped to `t >= t_near`, with its cell's corners:
+/// what [`interval_value`] and [`iso::interval_iso`] start from.
+pub(super) struct ClippedInterval<'a> {
+    /// The entry, moved to `t_near` when the interval starts before it.
+    pub ta: f64,
+    /// The scalar at `ta` (interpolated linearly when moved).
+    pub sa: f64,
+    /// Whether the entry was moved.
+    pub clipped: bool,
+    /// The cell's kind, nodes, corner points and corner scalars.
+    pub kind: CellKind,
+    pub nodes: &'a [u32],
+    pub x: Vec<DVec3>,
+    pub s: Vec<f64>,
+}
+
+impl<'a> ClippedInterval<'a> {
+    /// `None` when nothing of positive length is left; otherwise counted
+    /// in [`NativeStats::intervals`].
+    pub(super) fn new(
+        scene: &Scene<'a>,
+        vals: &[f64],
+        iv: &Interval,
+        t_near: f64,
+        stats: &mut NativeStats,
+    ) -> Option<ClippedInterval<'a>> {
+        let c = iv.cell as usize;
+        let (mut ta, tb) = (iv.t_a, iv.t_b);
+        let mut sa = iv.s_a;
+        let clipped = ta < t_near;
+        if clipped {
+            let x = (t_near - ta) / (tb - ta);
+            sa += x * (iv.s_b - sa);
+            ta = t_near;
+        }
+        if (tb - ta).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return None;
+        }
+        stats.intervals += 1;
+        let cells = &scene.mesh.cells;
+        let nodes = cells.nodes(c);
+        Some(ClippedInterval {
+            ta,
+            sa,
+            clipped,
+            kind: cells.kinds[c],
+            nodes,
+            x: nodes
+                .iter()
+                .map(|&n| scene.mesh.points[n as usize])
+                .collect(),
+            s: nodes.iter().map(|&n| vals[n as usize]).collect(),
+        })
+    }
 }
 
 /// Point scalars of a scene (the native model's field), if any.
