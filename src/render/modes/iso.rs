@@ -276,23 +276,27 @@ pub static ISO_STAGE: StageDesc = iso_stage!(
     INTEGRAL_BINDINGS
 );
 
+/// The isosurface stage with exact-frag's volume, as `name` with the
+/// integral's `constants`.
+macro_rules! iso_exact_frag_stage {
+    ($name:literal, $constants:expr) => {
+        iso_stage!(
+            $name,
+            ["integral.wgsl"],
+            "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return integrate_segment(l, sf, sb);\n}\n",
+            INTEGRAL_BINDINGS,
+            $constants
+        )
+    };
+}
+
 /// `--iso` with `exact-frag`: the closed-form integral between crossings.
-pub static ISO_EXACT_FRAG_STAGE: StageDesc = iso_stage!(
-    "iso.wgsl+exact_frag",
-    ["integral.wgsl"],
-    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return integrate_segment(l, sf, sb);\n}\n",
-    INTEGRAL_BINDINGS
-);
+pub static ISO_EXACT_FRAG_STAGE: StageDesc = iso_exact_frag_stage!("iso.wgsl+exact_frag", &[]);
 
 /// `--iso` with `exact-frag` where no segment can be optically thick
 /// (`THICK_SEGMENTS` off, [`super::exact_frag::thin_stage_holds`]).
-pub static ISO_EXACT_FRAG_THIN_STAGE: StageDesc = iso_stage!(
-    "iso.wgsl+exact_frag+thin",
-    ["integral.wgsl"],
-    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return integrate_segment(l, sf, sb);\n}\n",
-    INTEGRAL_BINDINGS,
-    &[("THICK_SEGMENTS", 0.0)]
-);
+pub static ISO_EXACT_FRAG_THIN_STAGE: StageDesc =
+    iso_exact_frag_stage!("iso.wgsl+exact_frag+thin", &[("THICK_SEGMENTS", 0.0)]);
 
 /// `--iso` with `preint3d`.
 pub static ISO_PREINT3D_STAGE: StageDesc = iso_stage!(
