@@ -124,6 +124,29 @@ fn usage_errors_exit_2() {
     }
 }
 
+/// `-o` writes PNG and `--float` OpenEXR: a name with the other format's
+/// extension is refused (exit 2, naming the flag to use), and nothing is
+/// written.
+#[test]
+fn output_names_must_match_their_formats() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = mesh_file("tetra.vtk");
+    let mesh = mesh.to_str().unwrap();
+    let exr = dir.path().join("out.EXR");
+    let png = dir.path().join("out.png");
+    let (exr, png) = (exr.to_str().unwrap(), png.to_str().unwrap());
+    for (args, flag) in [
+        (vec!["render", mesh, "-o", exr], "--float"),
+        (vec!["render", mesh, "-o", png, "--float", png], "-o"),
+    ] {
+        let o = zoovr(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains(flag) && e.contains("out."), "{e}");
+    }
+    assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none());
+}
+
 #[test]
 fn usage_errors_say_what_is_wrong() {
     let mesh = mesh_file("tetra.vtk");

@@ -315,10 +315,39 @@ pub fn print_stats_json(stats: &RenderStats, load_s: f64, ghost_cells: usize) ->
     Ok(())
 }
 
+/// `-o` writes PNG and `--float` OpenEXR whatever the names say; a name
+/// whose extension says the other format is a usage error rather than a
+/// file whose contents belie its name.
+fn check_extensions(png: Option<&std::path::Path>, exr: Option<&std::path::Path>) -> Result<()> {
+    let ext = |p: &std::path::Path, e: &str| {
+        p.extension()
+            .and_then(|x| x.to_str())
+            .is_some_and(|x| x.eq_ignore_ascii_case(e))
+    };
+    if let Some(p) = png.filter(|p| ext(p, "exr")) {
+        return Err(super::UsageError(format!(
+            "-o writes PNG, but '{}' names an OpenEXR file: use --float {} for the float image",
+            p.display(),
+            p.display()
+        ))
+        .into());
+    }
+    if let Some(p) = exr.filter(|p| ext(p, "png")) {
+        return Err(super::UsageError(format!(
+            "--float writes OpenEXR, but '{}' names a PNG file: use -o {} for the 8-bit image",
+            p.display(),
+            p.display()
+        ))
+        .into());
+    }
+    Ok(())
+}
+
 pub fn run(args: &RenderArgs) -> Result<()> {
     if args.output.is_none() && args.float.is_none() {
         bail!("nothing to write: give -o out.png and/or --float out.exr");
     }
+    check_extensions(args.output.as_deref(), args.float.as_deref())?;
     let opts = args.view.render_options();
     // The exact mode's GPU device opens while the file is read and sorted.
     let pending = opts
