@@ -3,7 +3,7 @@
 //!
 //! - Round trips: a small mixed mesh is written by an encoder in this file
 //!   (independent of the reader) in every encoding (ascii, inline base64,
-//!   appended raw and base64; no compression, zlib, LZ4; UInt32/UInt64
+//!   appended raw and base64; no compression, zlib, LZ4, LZMA; UInt32/UInt64
 //!   headers; little/big endian; several integer widths) and read back.
 //! - Hand-written `.vti`, `.vtr`, `.vts`, polyhedron and multi-piece files.
 //! - Every `meshes/corrupt/xml_*` file fails with an error naming it, and a
@@ -37,6 +37,7 @@ enum Comp {
     None,
     Zlib,
     Lz4,
+    Lzma,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -104,6 +105,13 @@ impl Enc {
                     e.write_all(b).unwrap();
                     e.finish().unwrap()
                 }
+                Comp::Lzma => {
+                    // As VTK's `vtkLZMADataCompressor`: one `.xz` stream
+                    // per block (liblzma's easy encoder).
+                    let mut e = xz2::write::XzEncoder::new(Vec::new(), 6);
+                    e.write_all(b).unwrap();
+                    e.finish().unwrap()
+                }
                 _ => lz4_flex::block::compress(b),
             };
             hdr.extend(self.word(c.len()));
@@ -167,6 +175,7 @@ impl Enc {
                 Comp::None => "",
                 Comp::Zlib => " compressor=\"vtkZLibDataCompressor\"",
                 Comp::Lz4 => " compressor=\"vtkLZ4DataCompressor\"",
+                Comp::Lzma => " compressor=\"vtkLZMADataCompressor\"",
             }
         )
         .into_bytes();
@@ -316,7 +325,7 @@ fn check_sample(m: &Mesh, what: &str) {
 fn every_encoding_round_trips() {
     let mut n = 0;
     for fmt in [Fmt::Ascii, Fmt::Binary, Fmt::AppRaw, Fmt::AppB64] {
-        for comp in [Comp::None, Comp::Zlib, Comp::Lz4] {
+        for comp in [Comp::None, Comp::Zlib, Comp::Lz4, Comp::Lzma] {
             if fmt == Fmt::Ascii && comp != Comp::None {
                 continue;
             }
@@ -351,7 +360,66 @@ fn every_encoding_round_trips() {
             }
         }
     }
-    assert_eq!(n, 16 + 3 * 3 * 2 * 2 * 4);
+    assert_eq!(n, 16 + 3 * 4 * 2 * 2 * 4);
+}
+
+/// LZMA blocks: a corrupt stream, a truncated one and one that decodes to
+/// fewer bytes than its header says each fail naming the file, the array
+/// and the block; a whole real-sized array of zeros (the best case of the
+/// ratio) still reads.
+#[test]
+fn lzma_blocks_are_checked() {
+    let enc = Enc {
+        fmt: Fmt::AppRaw,
+        comp: Comp::Lzma,
+        h64: false,
+        be: false,
+        block: 1 << 15,
+        joined: false,
+    };
+    let np = 40_000;
+    let points = |h: &[u8], b: &[u8]| {
+        let body = format!(
+            "<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"0\"><Points>\
+             <DataArray type=\"Float32\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points></Piece>"
+        );
+        let app = [h, b].concat();
+        xml::read_bytes(
+            Path::new("lzma.vtu"),
+            &enc.file(&body, &app),
+            Format::XmlUnstructured,
+        )
+    };
+    let (h, b) = enc.payload(&vec![0u8; np * 12]);
+    let m = points(&h, &b).unwrap();
+    assert_eq!(m.points.len(), np);
+    assert!(m.points.iter().all(|p| *p == glam::DVec3::ZERO));
+    // 480 kB of zeros in 15 blocks of at most 32 KiB: the ratio stays far
+    // below the bound the reader allows.
+    assert!(b.len() * 100 < np * 12, "{} compressed bytes", b.len());
+    let fails = |h: &[u8], b: &[u8], what: &str| {
+        let e = points(h, b).unwrap_err().to_string();
+        assert!(
+            e.contains("lzma.vtu") && e.contains("Points") && e.contains("block"),
+            "{what}: {e}"
+        );
+    };
+    // A flipped byte in the middle of the first block's stream.
+    let mut bad = b.clone();
+    bad[30] ^= 0x55;
+    fails(&h, &bad, "flipped byte");
+    // The first block's stream cut short (its size in the header too).
+    let first = u32::from_le_bytes(h[12..16].try_into().unwrap()) as usize;
+    let mut hc = h.clone();
+    hc[12..16].copy_from_slice(&((first - 8) as u32).to_le_bytes());
+    let bc = [&b[..first - 8], &b[first..]].concat();
+    fails(&hc, &bc, "truncated stream");
+    // A header claiming a larger last block than its stream holds.
+    let mut hl = h.clone();
+    let last = u32::from_le_bytes(hl[8..12].try_into().unwrap());
+    hl[8..12].copy_from_slice(&(last + 12).to_le_bytes());
+    let e = points(&hl, &b).unwrap_err().to_string();
+    assert!(e.contains("lzma.vtu"), "{e}");
 }
 
 #[test]
@@ -771,6 +839,18 @@ fn mutations_never_panic() {
             },
             "Int32",
             "Int8",
+        ),
+        write_sample(
+            &Enc {
+                fmt: Fmt::AppRaw,
+                comp: Comp::Lzma,
+                h64: true,
+                be: true,
+                block: 56,
+                joined: false,
+            },
+            "Int32",
+            "UInt8",
         ),
         write_sample(
             &Enc {

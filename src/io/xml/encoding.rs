@@ -9,15 +9,18 @@
 //! Binary payloads start with a header of `header_type` words (UInt32 or
 //! UInt64, in the file's `byte_order`). Uncompressed: one word, the payload
 //! size in bytes, then the bytes (in base64 both share one stream). Compressed
-//! (`vtkZLibDataCompressor`, `vtkLZ4DataCompressor`): `[nblocks, block_size,
-//! last_block_size, compressed_size_0 ..]`, then the compressed blocks; in
-//! base64 the header and the blocks are two separately padded streams.
+//! (`vtkZLibDataCompressor`, `vtkLZ4DataCompressor`, `vtkLZMADataCompressor`):
+//! `[nblocks, block_size, last_block_size, compressed_size_0 ..]`, then the
+//! compressed blocks (zlib streams, raw LZ4 blocks, or `.xz` streams, as
+//! liblzma's `lzma_easy_buffer_encode` writes them); in base64 the header and
+//! the blocks are two separately padded streams.
 //!
 //! Hostile input: every size read from a header is checked before anything
 //! is allocated from it. Uncompressed sizes must fit in the bytes present;
 //! compressed blocks must be present, and each block's uncompressed size may
 //! not exceed its compressed size times the format's maximum ratio (1032:1
-//! for deflate, 255:1 for LZ4). When the caller knows how many values the
+//! for deflate, 255:1 for LZ4, [`LZMA_MAX_RATIO`] for LZMA). When the caller
+//! knows how many values the
 //! array must hold (from `NumberOfPoints` and friends), the decoded size must
 //! match it exactly.
 //!
@@ -43,6 +46,13 @@ use crate::io::IoError;
 const ZLIB_MAX_RATIO: u64 = 1032;
 /// LZ4's maximum compression ratio (one 255-extension byte per 255 bytes).
 const LZ4_MAX_RATIO: u64 = 255;
+/// A bound on LZMA's compression ratio for one block. LZMA has no small
+/// hard limit (a long run costs a fraction of a bit per 273-byte match);
+/// `xz` makes about 7000:1 of a gigabyte of zeros, and VTK's blocks (32 KiB
+/// by default) reach a few hundred to one, the stream's own framing being
+/// some 60 bytes. 2^14:1 admits every real file; the memory budget
+/// ([`IoError`] on exceeding it) bounds what a hostile header can claim.
+pub const LZMA_MAX_RATIO: u64 = 1 << 14;
 /// Slack per block on top of the ratio bound (stream headers, tiny blocks).
 const BLOCK_SLACK: u64 = 64;
 /// Base64 characters decoded per parallel task (a multiple of 4).
@@ -61,6 +71,7 @@ pub enum Compressor {
     None,
     Zlib,
     Lz4,
+    Lzma,
 }
 
 /// File-wide encoding settings from the `<VTKFile>` attributes.
@@ -400,10 +411,10 @@ impl<'a> Source<'a> {
         expected: Option<usize>,
     ) -> Result<Vec<T>, String> {
         let c = self.codec;
-        let ratio = if c.compressor == Compressor::Lz4 {
-            LZ4_MAX_RATIO
-        } else {
-            ZLIB_MAX_RATIO
+        let ratio = match c.compressor {
+            Compressor::Lz4 => LZ4_MAX_RATIO,
+            Compressor::Lzma => LZMA_MAX_RATIO,
+            _ => ZLIB_MAX_RATIO,
         };
         let mut blocks = Vec::with_capacity(hdr.csizes.len());
         let mut at = 0u64;
@@ -527,6 +538,38 @@ fn inflate_block(
             if n != dst.len() {
                 return Err(format!(
                     "LZ4 block gives {n} bytes, header says {}",
+                    dst.len()
+                ));
+            }
+            Ok(())
+        }
+        Compressor::Lzma => {
+            // One `.xz` stream per block; its check (CRC32 or CRC64, as
+            // the writer chose) is verified by the decoder.
+            let mut d = xz2::stream::Stream::new_stream_decoder(u64::MAX, 0)
+                .map_err(|e| format!("cannot start the LZMA decoder: {e}"))?;
+            // The decoder may stop with the output full before it has
+            // read the stream's index and footer: go on while it moves.
+            let status = loop {
+                let (i, o) = (d.total_in() as usize, d.total_out() as usize);
+                let status = d
+                    .process(&src[i..], &mut dst[o..], xz2::stream::Action::Finish)
+                    .map_err(|e| format!("corrupt LZMA stream: {e}"))?;
+                let moved = d.total_in() as usize != i || d.total_out() as usize != o;
+                if status != xz2::stream::Status::Ok || !moved {
+                    break status;
+                }
+            };
+            if status != xz2::stream::Status::StreamEnd
+                || d.total_out() != dst.len() as u64
+                || d.total_in() != src.len() as u64
+            {
+                return Err(format!(
+                    "LZMA stream gives {} bytes from {} of {} compressed bytes (stream end: {}), header says {}",
+                    d.total_out(),
+                    d.total_in(),
+                    src.len(),
+                    status == xz2::stream::Status::StreamEnd,
                     dst.len()
                 ));
             }

@@ -5,7 +5,8 @@
 //!    (no entity expansion) and locates the `<AppendedData>` block by byte
 //!    offset, without parsing it.
 //! 2. The `<VTKFile>` attributes give the [`encoding::Codec`]: `byte_order`,
-//!    `header_type` (UInt32 default, UInt64) and `compressor` (zlib, LZ4).
+//!    `header_type` (UInt32 default, UInt64) and `compressor` (zlib, LZ4,
+//!    LZMA).
 //! 3. Each `<Piece>` is read by [`unstructured`] or [`structured`]: its
 //!    `<DataArray>`s are decoded by [`encoding::Source::decode`] straight into
 //!    typed vectors (ascii, inline base64, appended raw or base64, compressed
@@ -142,6 +143,7 @@ fn codec(path: &Path, root: &dom::Element) -> Result<Codec, IoError> {
         "" => Compressor::None,
         "vtkZLibDataCompressor" => Compressor::Zlib,
         "vtkLZ4DataCompressor" => Compressor::Lz4,
+        "vtkLZMADataCompressor" => Compressor::Lzma,
         v => return Err(bad("compressor", v)),
     };
     Ok(Codec {
