@@ -12,11 +12,11 @@
 mod xml_util;
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use base64::engine::general_purpose::STANDARD as B64;
 use base64::Engine;
-use xml_util::{array, by_type, check_mesh};
+use xml_util::{array, by_type, check_mesh, tmp, write, POLY};
 use zoovr::field::ArrayData;
 use zoovr::io::{self, collection, xml, Format, ReadOptions};
 use zoovr::mesh::{CellKind, Mesh};
@@ -559,17 +559,6 @@ fn rectilinear_and_structured_grids() {
     assert_eq!(array(&m, "c").tuples(), 0);
 }
 
-const POLY: &str = r#"<VTKFile type="UnstructuredGrid" version="0.1"><UnstructuredGrid><Piece NumberOfPoints="9" NumberOfCells="2">
-<Points><DataArray type="Float64" NumberOfComponents="3" format="ascii">
--1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1  1 1 1  -1 1 1  0 0 3</DataArray></Points>
-<Cells>
-<DataArray type="Int64" Name="connectivity" format="ascii">0 1 2 3 4 5 6 7  4 5 6 8</DataArray>
-<DataArray type="Int64" Name="offsets" format="ascii">8 12</DataArray>
-<DataArray type="UInt8" Name="types" format="ascii">42 10</DataArray>
-<DataArray type="Int64" Name="faces" format="ascii">6 4 0 3 2 1 4 0 4 7 3 4 4 5 6 7 4 5 1 2 6 4 0 1 5 4 4 2 3 7 6</DataArray>
-<DataArray type="Int64" Name="faceoffsets" format="ascii">31 -1</DataArray>
-</Cells></Piece></UnstructuredGrid></VTKFile>"#;
-
 #[test]
 fn polyhedron_from_faces() {
     let m = read_str("poly.vtu", POLY, Format::XmlUnstructured).unwrap();
@@ -626,16 +615,6 @@ fn several_pieces_are_merged() {
 
 // ---------------------------------------------------------------- collections
 
-fn tmp() -> tempfile::TempDir {
-    tempfile::tempdir().unwrap()
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
 #[test]
 fn pvd_and_series_resolve_sort_and_refuse() {
     let d = tmp();
@@ -686,91 +665,6 @@ fn pvd_and_series_resolve_sort_and_refuse() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("s.pvd") && e.contains("itself"), "{e}");
-}
-
-/// A `.pvtu` step's time is its pieces' `TimeValue`; pieces that disagree
-/// leave it unset with a note.
-#[test]
-fn pvtu_time_value_from_its_pieces() {
-    let d = tmp();
-    let timed = |t: f64| {
-        POLY.replace(
-            "<UnstructuredGrid><Piece",
-            &format!(
-                "<UnstructuredGrid><FieldData><DataArray type=\"Float64\" Name=\"TimeValue\" \
-                 NumberOfTuples=\"1\" format=\"ascii\">{t}</DataArray></FieldData><Piece"
-            ),
-        )
-    };
-    write(d.path(), "a.vtu", &timed(1.5));
-    write(d.path(), "b.vtu", &timed(1.5));
-    write(d.path(), "c.vtu", &timed(2.0));
-    let pvtu = |name: &str, pieces: &[&str]| {
-        let body: String = pieces
-            .iter()
-            .map(|p| format!("<Piece Source=\"{p}\"/>"))
-            .collect();
-        write(
-            d.path(),
-            name,
-            &format!(
-                "<VTKFile type=\"PUnstructuredGrid\"><PUnstructuredGrid>{body}</PUnstructuredGrid></VTKFile>"
-            ),
-        )
-    };
-    let same = io::read(
-        &pvtu("s.pvtu", &["a.vtu", "b.vtu"]),
-        &ReadOptions::default(),
-    )
-    .unwrap();
-    assert_eq!(same.source.time_value, Some(1.5));
-    let differ = io::read(
-        &pvtu("d.pvtu", &["a.vtu", "c.vtu"]),
-        &ReadOptions::default(),
-    )
-    .unwrap();
-    assert_eq!(differ.source.time_value, None);
-    assert!(
-        differ.source.notes.iter().any(|n| n.contains("TimeValue")),
-        "{:?}",
-        differ.source.notes
-    );
-    let single = io::read(&d.path().join("c.vtu"), &ReadOptions::default()).unwrap();
-    assert_eq!(single.source.time_value, Some(2.0));
-}
-
-#[test]
-fn pvtu_missing_and_self_pieces() {
-    let d = tmp();
-    let p = write(
-        d.path(),
-        "p.pvtu",
-        r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="p.pvtu"/></PUnstructuredGrid></VTKFile>"#,
-    );
-    let e = io::read(&p, &ReadOptions::default())
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("p.pvtu") && e.contains("itself"), "{e}");
-    let q = write(
-        d.path(),
-        "q.pvtu",
-        r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="a.vtu"/><Piece Source="gone.vtu"/></PUnstructuredGrid></VTKFile>"#,
-    );
-    write(d.path(), "a.vtu", POLY);
-    let e = io::read(&q, &ReadOptions::default())
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("q.pvtu") && e.contains("piece 1") && e.contains("gone.vtu"),
-        "{e}"
-    );
-    // A piece that is itself a .pvtu pointing back.
-    let r = write(
-        d.path(),
-        "r.pvtu",
-        r#"<VTKFile type="PUnstructuredGrid"><PUnstructuredGrid><Piece Source="p.pvtu"/></PUnstructuredGrid></VTKFile>"#,
-    );
-    assert!(io::read(&r, &ReadOptions::default()).is_err());
 }
 
 // ---------------------------------------------------------------- corrupt files

@@ -48,6 +48,12 @@ pub enum Format {
     XmlRectilinear,
     XmlImage,
     XmlParallelUnstructured,
+    /// `.pvts`: structured pieces.
+    XmlParallelStructured,
+    /// `.pvtr`: rectilinear pieces.
+    XmlParallelRectilinear,
+    /// `.pvti`: image-data pieces.
+    XmlParallelImage,
     Pvd,
     Series,
     Plot3d,
@@ -70,6 +76,9 @@ pub fn detect_format(path: &Path) -> Result<Format, IoError> {
         "vtr" => Some(Format::XmlRectilinear),
         "vti" => Some(Format::XmlImage),
         "pvtu" => Some(Format::XmlParallelUnstructured),
+        "pvts" => Some(Format::XmlParallelStructured),
+        "pvtr" => Some(Format::XmlParallelRectilinear),
+        "pvti" => Some(Format::XmlParallelImage),
         "pvd" => Some(Format::Pvd),
         "series" => Some(Format::Series),
         "xyz" | "p3d" | "x" | "g" => Some(Format::Plot3d),
@@ -98,6 +107,9 @@ fn sniff(path: &Path) -> Result<Format, IoError> {
         ("\"RectilinearGrid\"", Format::XmlRectilinear),
         ("\"ImageData\"", Format::XmlImage),
         ("\"PUnstructuredGrid\"", Format::XmlParallelUnstructured),
+        ("\"PStructuredGrid\"", Format::XmlParallelStructured),
+        ("\"PRectilinearGrid\"", Format::XmlParallelRectilinear),
+        ("\"PImageData\"", Format::XmlParallelImage),
         ("\"Collection\"", Format::Pvd),
     ] {
         if text.contains("<VTKFile") && text.contains(tag) {
@@ -138,7 +150,10 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Mesh, IoError> {
         | Format::XmlStructured
         | Format::XmlRectilinear
         | Format::XmlImage
-        | Format::XmlParallelUnstructured => xml::read(path, format),
+        | Format::XmlParallelUnstructured
+        | Format::XmlParallelStructured
+        | Format::XmlParallelRectilinear
+        | Format::XmlParallelImage => xml::read(path, format),
         Format::Plot3d => plot3d::read(path, opts.q_file.as_deref()),
         Format::Pvd | Format::Series => {
             // A collection given where one dataset is expected: its first step.

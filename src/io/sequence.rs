@@ -3,7 +3,9 @@
 //!
 //! [`list_steps`] decides in this order:
 //! 1. an existing folder: its dataset files (`.vtk`, `.vtu`, `.vts`, `.vtr`,
-//!    `.vti`, `.pvtu`), hidden files left out;
+//!    `.vti`, `.pvtu`, `.pvts`, `.pvtr`, `.pvti`), hidden files left out;
+//!    where it holds parallel files (`.pvt*`), only those, since the serial
+//!    files beside them are their pieces;
 //! 2. an existing file: a `.pvd` or `.series` collection lists its steps
 //!    with their times ([`super::read_series`]); any other file is one step
 //!    at time 0;
@@ -23,7 +25,9 @@ use std::path::{Path, PathBuf};
 use super::{read_series, IoError, Location, TimeStep};
 
 /// File extensions (lower case) of the datasets a folder is searched for.
-const DATASET_EXTENSIONS: [&str; 6] = ["vtk", "vtu", "vts", "vtr", "vti", "pvtu"];
+const DATASET_EXTENSIONS: [&str; 9] = [
+    "vtk", "vtu", "vts", "vtr", "vti", "pvtu", "pvts", "pvtr", "pvti",
+];
 
 /// Whether `path` looks like a glob pattern.
 fn is_pattern(path: &Path) -> bool {
@@ -47,10 +51,18 @@ pub fn list_steps(path: &Path) -> Result<Vec<TimeStep>, IoError> {
                 files.push(p);
             }
         }
+        // Serial files next to parallel ones are their pieces.
+        let parallel = |p: &PathBuf| {
+            p.extension()
+                .is_some_and(|e| e.to_string_lossy().to_lowercase().starts_with("pvt"))
+        };
+        if files.iter().any(parallel) {
+            files.retain(parallel);
+        }
         return numbered(
             path,
             files,
-            "the folder holds no dataset files (.vtk, .vtu, .vts, .vtr, .vti, .pvtu)",
+            "the folder holds no dataset files (.vtk, .vtu, .vts, .vtr, .vti, .pvtu, .pvts, .pvtr, .pvti)",
         );
     }
     if path.exists() || !is_pattern(path) {
@@ -163,5 +175,27 @@ mod tests {
         );
         let empty = tempfile::tempdir().unwrap();
         assert!(list_steps(empty.path()).is_err());
+    }
+
+    /// A folder of parallel steps with their pieces beside them lists the
+    /// parallel files only.
+    #[test]
+    fn folder_of_parallel_steps_leaves_their_pieces_out() {
+        let dir = tempfile::tempdir().unwrap();
+        for n in [
+            "s_1.pvts",
+            "s_1_0.vts",
+            "s_1_1.vts",
+            "s_0.PVTS",
+            "s_0_0.vts",
+        ] {
+            std::fs::write(dir.path().join(n), "x").unwrap();
+        }
+        let names: Vec<_> = list_steps(dir.path())
+            .unwrap()
+            .iter()
+            .map(|s| s.path.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names, ["s_0.PVTS", "s_1.pvts"]);
     }
 }

@@ -7,7 +7,7 @@
 //! not use (`String`, `Bit`) are skipped with a note.
 //!
 //! A dataset split into pieces (several `<Piece>` elements, or the files of a
-//! `.pvtu`) is read piece by piece into [`Mesh`]es and merged: points and
+//! parallel file) is read piece by piece into [`Mesh`]es and merged: points and
 //! cells are concatenated with point ids offset per piece; arrays present in
 //! every piece (same name and component count) are concatenated, others are
 //! dropped with a note.

@@ -1,4 +1,5 @@
-//! VTK XML readers: `.vtu`, `.vts`, `.vtr`, `.vti` and `.pvtu`.
+//! VTK XML readers: `.vtu`, `.vts`, `.vtr`, `.vti` and the parallel
+//! `.pvtu`, `.pvts`, `.pvtr` and `.pvti`.
 //!
 //! How a file is read:
 //! 1. [`dom::parse`] pulls the element tree out of the file with quick-xml
@@ -12,8 +13,8 @@
 //!    typed vectors (ascii, inline base64, appended raw or base64, compressed
 //!    or not), checked against the declared counts before anything large is
 //!    allocated.
-//! 4. Pieces (several `<Piece>`s in one file, or the files of a `.pvtu`, see
-//!    [`parallel`]) are merged by [`arrays::merge`].
+//! 4. Pieces (several `<Piece>`s in one file, or the files of a parallel
+//!    file, see [`parallel`]) are merged by [`arrays::merge`].
 //!
 //! vtkio is not used for XML: it cannot read appended raw data, Int8 cell
 //! types or pentagonal prisms (vtkio 0.7.0-rc2 fails on all three, measured
@@ -43,14 +44,14 @@ pub fn read(path: &Path, format: Format) -> Result<Mesh, IoError> {
 }
 
 /// Reads a VTK XML dataset from memory; `path` names the file in errors and
-/// locates the pieces of a `.pvtu`. The dataset type comes from the file's
+/// locates the pieces of a parallel file. The dataset type comes from the file's
 /// `<VTKFile type=...>`; `format` is only checked against it when the file
 /// does not say.
 pub fn read_bytes(path: &Path, bytes: &[u8], format: Format) -> Result<Mesh, IoError> {
     read_nested(path, bytes, format, 0)
 }
 
-/// [`read_bytes`], `depth` levels of `.pvtu` deep.
+/// [`read_bytes`], `depth` levels of parallel files deep.
 fn read_nested(path: &Path, bytes: &[u8], format: Format, depth: usize) -> Result<Mesh, IoError> {
     let doc = dom::parse(path, bytes)?;
     let root = &doc.root;
@@ -60,6 +61,9 @@ fn read_nested(path: &Path, bytes: &[u8], format: Format, depth: usize) -> Resul
             Format::XmlRectilinear => "RectilinearGrid",
             Format::XmlImage => "ImageData",
             Format::XmlParallelUnstructured => "PUnstructuredGrid",
+            Format::XmlParallelStructured => "PStructuredGrid",
+            Format::XmlParallelRectilinear => "PRectilinearGrid",
+            Format::XmlParallelImage => "PImageData",
             _ => "UnstructuredGrid",
         }
         .to_string()
@@ -80,12 +84,17 @@ fn read_nested(path: &Path, bytes: &[u8], format: Format, depth: usize) -> Resul
         "StructuredGrid" => structured::read(&src, grid, Lattice::Structured)?,
         "RectilinearGrid" => structured::read(&src, grid, Lattice::Rectilinear)?,
         "ImageData" => structured::read(&src, grid, Lattice::Image)?,
-        "PUnstructuredGrid" => return parallel::read(path, grid, depth),
+        "PUnstructuredGrid" => {
+            return parallel::read(path, grid, depth, Format::XmlUnstructured)
+        }
+        "PStructuredGrid" => return parallel::read(path, grid, depth, Format::XmlStructured),
+        "PRectilinearGrid" => return parallel::read(path, grid, depth, Format::XmlRectilinear),
+        "PImageData" => return parallel::read(path, grid, depth, Format::XmlImage),
         other => {
             return Err(IoError::parse(
                 path,
                 root.location(),
-                format!("unsupported VTK XML dataset type '{other}' (expected UnstructuredGrid, StructuredGrid, RectilinearGrid, ImageData or PUnstructuredGrid)"),
+                format!("unsupported VTK XML dataset type '{other}' (expected UnstructuredGrid, StructuredGrid, RectilinearGrid, ImageData, or one of their parallel forms PUnstructuredGrid, PStructuredGrid, PRectilinearGrid, PImageData)"),
             ))
         }
     };

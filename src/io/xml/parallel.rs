@@ -1,13 +1,21 @@
-//! `.pvtu`: a `PUnstructuredGrid` whose `<Piece Source="...">` elements name
-//! `.vtu` files (relative to the `.pvtu`'s folder). The pieces are read in
-//! parallel and merged (point ids offset per piece). The `PPointData` /
+//! The parallel files: `.pvtu` (`PUnstructuredGrid`), `.pvts`
+//! (`PStructuredGrid`), `.pvtr` (`PRectilinearGrid`) and `.pvti`
+//! (`PImageData`), whose `<Piece Source="...">` elements name the serial
+//! files of one kind (`.vtu`, `.vts`, `.vtr`, `.vti`; relative to the
+//! parallel file's folder). The pieces are read in parallel and merged
+//! (point ids offset per piece). Structured pieces carry their own `Extent`
+//! (and `.vti` pieces their `Origin` and `Spacing`), so each becomes its
+//! hexahedra as a serial file would; neighbouring pieces repeat the points
+//! of their shared layer, which the topology merges as it merges any
+//! coincident points, so the cells meet face to face. The `PPointData` /
 //! `PCellData` `Scalars` attribute marks the active scalars. The step's time
 //! is the pieces' `TimeValue` (ParaView writes it into every piece); pieces
 //! that disagree leave it unset, with a note.
 //!
-//! Refused with a clean error naming the `.pvtu` and the piece: a missing or
-//! unreadable piece, a piece that is the `.pvtu` itself, and a piece that is
-//! itself a parallel file (which could otherwise recurse forever).
+//! Refused with a clean error naming the parallel file and the piece: a
+//! missing or unreadable piece, a piece that is the parallel file itself,
+//! and a piece that is itself a parallel file (which could otherwise recurse
+//! forever).
 
 use std::path::{Path, PathBuf};
 
@@ -17,15 +25,22 @@ use super::dom::Element;
 use crate::io::{Format, IoError, Location};
 use crate::mesh::Mesh;
 
-/// Deepest nesting of parallel files (a piece may not be a `.pvtu`).
+/// Deepest nesting of parallel files (a piece may not be one).
 const MAX_DEPTH: usize = 1;
 
-pub fn read(path: &Path, grid: &Element, depth: usize) -> Result<Mesh, IoError> {
+/// Reads the parallel file `path` whose pieces are files of `piece_format`
+/// (what a piece that does not name its own type is read as).
+pub fn read(
+    path: &Path,
+    grid: &Element,
+    depth: usize,
+    piece_format: Format,
+) -> Result<Mesh, IoError> {
     if depth >= MAX_DEPTH {
         return Err(IoError::parse(
             path,
             grid.location(),
-            "a piece of a .pvtu is itself a parallel file",
+            "a piece of a parallel file is itself a parallel file",
         ));
     }
     let dir = path.parent().unwrap_or(Path::new("."));
@@ -69,7 +84,7 @@ pub fn read(path: &Path, grid: &Element, depth: usize) -> Result<Mesh, IoError> 
                 return Err(IoError::parse(
                     path,
                     at(),
-                    "the piece is the .pvtu file itself",
+                    "the piece is the parallel file itself",
                 ));
             }
             if !canon.is_file() {
@@ -86,7 +101,7 @@ pub fn read(path: &Path, grid: &Element, depth: usize) -> Result<Mesh, IoError> 
                     format!("piece file {} cannot be read: {e}", file.display()),
                 )
             })?;
-            super::read_nested(file, &bytes, Format::XmlUnstructured, depth + 1)
+            super::read_nested(file, &bytes, piece_format, depth + 1)
                 .map_err(|e| IoError::parse(path, at(), format!("piece failed: {e}")))
         })
         .collect::<Result<Vec<Mesh>, IoError>>()?;
