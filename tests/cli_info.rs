@@ -290,3 +290,57 @@ fn malformed_ghost_arrays_are_named() {
         }
     }
 }
+
+/// What a reader repaired or left out reaches the user: `info` lists the
+/// notes (`notes` in `--json`), `render` says them on stderr. Here a
+/// multiblock file whose second block lacks the first block's array.
+#[test]
+fn reader_notes_are_shown() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut a = warped_hex_grid(2, &Warp::default());
+    let mut b = a.clone();
+    for p in &mut b.points {
+        p.x += 10.0;
+    }
+    b.point_data.clear();
+    a.active_point_scalars = a.point_data.first().map(|x| x.name.clone());
+    write_vtu(&d.join("a.vtu"), &a, Compression::None).unwrap();
+    write_vtu(&d.join("b.vtu"), &b, Compression::None).unwrap();
+    let vtm = d.join("m.vtm");
+    std::fs::write(
+        &vtm,
+        r#"<VTKFile type="vtkMultiBlockDataSet"><vtkMultiBlockDataSet><DataSet index="0" file="a.vtu"/><DataSet index="1" file="b.vtu"/></vtkMultiBlockDataSet></VTKFile>"#,
+    )
+    .unwrap();
+    let v = info_json(&vtm);
+    assert_eq!(v["cells3d"], 16);
+    let notes = v["notes"].as_array().expect("notes");
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.as_str().unwrap().contains("missing from some pieces")),
+        "{notes:?}"
+    );
+    let text = String::from_utf8(zoovr(&["info", vtm.to_str().unwrap()]).stdout).unwrap();
+    assert!(text.contains("notes:"), "{text}");
+    let png = d.join("m.png");
+    let o = zoovr(&[
+        "render",
+        vtm.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--size",
+        "32x32",
+        "--mode",
+        "raycast",
+    ]);
+    assert!(o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("zoovr: note:") && e.contains("m.vtm"), "{e}");
+    // Files without notes: an empty list.
+    assert_eq!(
+        info_json(&mesh_file("tetra.vtk"))["notes"],
+        serde_json::json!([])
+    );
+}

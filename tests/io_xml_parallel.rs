@@ -299,3 +299,117 @@ fn pvtu_missing_and_self_pieces() {
     );
     assert!(io::read(&r, &ReadOptions::default()).is_err());
 }
+
+/// A `.vtm` tree: an unstructured block, a nested structured block split
+/// into a parallel file, an empty leaf, a polygonal patch and a surface
+/// block: the blocks with 3D cells are merged, the others named in a note.
+#[test]
+fn multiblock_merges_its_volume_blocks() {
+    let d = tmp();
+    std::fs::create_dir_all(d.path().join("case/zone2")).unwrap();
+    write(d.path(), "case/poly.vtu", POLY);
+    write(d.path(), "case/zone2/a.vts", &serial("vts", &[(0, 1)]));
+    write(d.path(), "case/zone2/b.vts", &serial("vts", &[(1, 3)]));
+    write(
+        d.path(),
+        "case/zone2.pvts",
+        r#"<VTKFile type="PStructuredGrid"><PStructuredGrid WholeExtent="0 3 0 2 0 2"><Piece Extent="0 1 0 2 0 2" Source="zone2/a.vts"/><Piece Extent="1 3 0 2 0 2" Source="zone2/b.vts"/></PStructuredGrid></VTKFile>"#,
+    );
+    write(d.path(), "case/inlet.vtp", "<VTKFile type=\"PolyData\"/>");
+    // Only a triangle: no 3D cells.
+    write(
+        d.path(),
+        "case/wall.vtu",
+        r#"<VTKFile type="UnstructuredGrid"><UnstructuredGrid><Piece NumberOfPoints="3" NumberOfCells="1">
+        <Points><DataArray type="Float64" NumberOfComponents="3" format="ascii">0 0 0 1 0 0 0 1 0</DataArray></Points>
+        <Cells><DataArray type="Int32" Name="connectivity" format="ascii">0 1 2</DataArray>
+        <DataArray type="Int32" Name="offsets" format="ascii">3</DataArray><DataArray type="UInt8" Name="types" format="ascii">5</DataArray></Cells>
+        </Piece></UnstructuredGrid></VTKFile>"#,
+    );
+    let vtm = write(
+        d.path(),
+        "case.vtm",
+        r#"<?xml version="1.0"?>
+<VTKFile type="vtkMultiBlockDataSet" version="1.0" byte_order="LittleEndian">
+  <vtkMultiBlockDataSet>
+    <Block index="0" name="internal">
+      <DataSet index="0" name="poly" file="case/poly.vtu"/>
+      <Block index="1" name="zones"><Piece index="0"><DataSet index="0" file="case/zone2.pvts"/></Piece></Block>
+      <DataSet index="2" name="nothing"/>
+    </Block>
+    <Block index="1" name="boundary">
+      <DataSet index="0" name="inlet" file="case/inlet.vtp"/>
+      <DataSet index="1" name="wall" file="case/wall.vtu"/>
+    </Block>
+  </vtkMultiBlockDataSet>
+</VTKFile>"#,
+    );
+    let m = io::read(&vtm, &ReadOptions::default()).unwrap();
+    check_mesh(&m);
+    assert_eq!(m.cells.len(), 2 + 12);
+    let notes = m.source.notes.join(" | ");
+    assert!(
+        notes.contains("boundary/inlet") && notes.contains("polygonal"),
+        "{notes}"
+    );
+    assert!(
+        notes.contains("boundary/wall") && notes.contains("no 3D cells"),
+        "{notes}"
+    );
+    // Detected by content as well.
+    let renamed = d.path().join("case_vtm.xml");
+    std::fs::copy(&vtm, &renamed).unwrap();
+    assert_eq!(
+        io::read(&renamed, &ReadOptions::default())
+            .unwrap()
+            .cells
+            .len(),
+        14
+    );
+}
+
+#[test]
+fn bad_multiblocks_name_the_file_and_the_block() {
+    let d = tmp();
+    write(d.path(), "poly.vtu", POLY);
+    let vtm = |name: &str, leaves: &str| {
+        write(
+            d.path(),
+            name,
+            &format!(
+                r#"<VTKFile type="vtkMultiBlockDataSet"><vtkMultiBlockDataSet>{leaves}</vtkMultiBlockDataSet></VTKFile>"#
+            ),
+        )
+    };
+    let read = |p: &std::path::Path| {
+        io::read(p, &ReadOptions::default())
+            .unwrap_err()
+            .to_string()
+    };
+    let e = read(&vtm(
+        "a.vtm",
+        r#"<DataSet index="0" name="ok" file="poly.vtu"/><Block name="zones"><DataSet index="0" name="gone" file="gone.vtu"/></Block>"#,
+    ));
+    assert!(
+        e.contains("a.vtm") && e.contains("zones/gone") && e.contains("gone.vtu"),
+        "{e}"
+    );
+    let e = read(&vtm("b.vtm", r#"<DataSet index="0" file="b.vtm"/>"#));
+    assert!(e.contains("b.vtm") && e.contains("itself"), "{e}");
+    let e = read(&vtm("c.vtm", r#"<DataSet index="0" file="a.vtm"/>"#));
+    assert!(e.contains("c.vtm") && e.contains("multiblock"), "{e}");
+    let e = read(&vtm(
+        "e.vtm",
+        r#"<Block name="x"><DataSet index="0"/></Block>"#,
+    ));
+    assert!(e.contains("e.vtm") && e.contains("no block files"), "{e}");
+    write(d.path(), "s.vtp", "<VTKFile type=\"PolyData\"/>");
+    let e = read(&vtm(
+        "f.vtm",
+        r#"<DataSet index="0" name="skin" file="s.vtp"/>"#,
+    ));
+    assert!(
+        e.contains("f.vtm") && e.contains("no block holds 3D cells"),
+        "{e}"
+    );
+}

@@ -104,6 +104,7 @@ pub(crate) fn describe(mesh: &Mesh, timesteps: usize) -> Result<Value> {
         "coincident_points": r.coincident_points,
         "hidden_cells": ghosts.hidden,
         "duplicate_cells": ghosts.duplicate,
+        "notes": mesh.source.notes,
     }))
 }
 
@@ -146,6 +147,12 @@ fn print_text(file: &std::path::Path, v: &Value, ghost_array: bool) {
             "ghost cells: {} hidden, {} duplicate (vtkGhostType; not drawn without --show-hidden)",
             v["hidden_cells"], v["duplicate_cells"]
         );
+    }
+    if let Some(notes) = v["notes"].as_array().filter(|n| !n.is_empty()) {
+        println!("notes:");
+        for n in notes {
+            println!("  {}", n.as_str().unwrap_or(""));
+        }
     }
     if let Some(arrs) = v["arrays"].as_array() {
         println!("arrays:");

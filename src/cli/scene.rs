@@ -66,6 +66,12 @@ impl SceneArgs {
     /// Reads `file` and builds its geometry and shading.
     pub fn load(&self, file: &Path) -> Result<(Geometry, Shading)> {
         let mesh = io::read(file, &self.read_options())?;
+        // What the reader repaired or left out (arrays missing from some
+        // pieces, blocks without 3D cells, quadratic cells read by their
+        // corners): said once, on stderr.
+        for n in &mesh.source.notes {
+            eprintln!("zoovr: note: {}: {n}", file.display());
+        }
         let spec = self.spec();
         let geometry = Geometry::build(mesh, spec.show_hidden)
             .with_context(|| format!("{}", file.display()))?;

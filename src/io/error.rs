@@ -43,7 +43,7 @@ pub enum IoError {
         location: Location,
         msg: String,
     },
-    #[error("{}: unknown file format (expected VTK legacy .vtk, VTK XML .vtu/.vts/.vtr/.vti/.pvtu/.pvts/.pvtr/.pvti, .pvd, .series or a PLOT3D grid)", path.display())]
+    #[error("{}: unknown file format (expected VTK legacy .vtk, VTK XML .vtu/.vts/.vtr/.vti/.pvtu/.pvts/.pvtr/.pvti/.vtm, .pvd, .series or a PLOT3D grid)", path.display())]
     UnknownFormat { path: PathBuf },
 }
 

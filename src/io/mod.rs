@@ -54,6 +54,8 @@ pub enum Format {
     XmlParallelRectilinear,
     /// `.pvti`: image-data pieces.
     XmlParallelImage,
+    /// `.vtm`: blocks in files of their own.
+    XmlMultiBlock,
     Pvd,
     Series,
     Plot3d,
@@ -79,6 +81,7 @@ pub fn detect_format(path: &Path) -> Result<Format, IoError> {
         "pvts" => Some(Format::XmlParallelStructured),
         "pvtr" => Some(Format::XmlParallelRectilinear),
         "pvti" => Some(Format::XmlParallelImage),
+        "vtm" => Some(Format::XmlMultiBlock),
         "pvd" => Some(Format::Pvd),
         "series" => Some(Format::Series),
         "xyz" | "p3d" | "x" | "g" => Some(Format::Plot3d),
@@ -110,6 +113,7 @@ fn sniff(path: &Path) -> Result<Format, IoError> {
         ("\"PStructuredGrid\"", Format::XmlParallelStructured),
         ("\"PRectilinearGrid\"", Format::XmlParallelRectilinear),
         ("\"PImageData\"", Format::XmlParallelImage),
+        ("\"vtkMultiBlockDataSet\"", Format::XmlMultiBlock),
         ("\"Collection\"", Format::Pvd),
     ] {
         if text.contains("<VTKFile") && text.contains(tag) {
@@ -153,7 +157,8 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Mesh, IoError> {
         | Format::XmlParallelUnstructured
         | Format::XmlParallelStructured
         | Format::XmlParallelRectilinear
-        | Format::XmlParallelImage => xml::read(path, format),
+        | Format::XmlParallelImage
+        | Format::XmlMultiBlock => xml::read(path, format),
         Format::Plot3d => plot3d::read(path, opts.q_file.as_deref()),
         Format::Pvd | Format::Series => {
             // A collection given where one dataset is expected: its first step.

@@ -3,9 +3,9 @@
 //!
 //! [`list_steps`] decides in this order:
 //! 1. an existing folder: its dataset files (`.vtk`, `.vtu`, `.vts`, `.vtr`,
-//!    `.vti`, `.pvtu`, `.pvts`, `.pvtr`, `.pvti`), hidden files left out;
-//!    where it holds parallel files (`.pvt*`), only those, since the serial
-//!    files beside them are their pieces;
+//!    `.vti`, `.pvtu`, `.pvts`, `.pvtr`, `.pvti`, `.vtm`), hidden files left
+//!    out; where it holds parallel or multiblock files (`.pvt*`, `.vtm`),
+//!    only those, since the serial files beside them are their pieces;
 //! 2. an existing file: a `.pvd` or `.series` collection lists its steps
 //!    with their times ([`super::read_series`]); any other file is one step
 //!    at time 0;
@@ -25,8 +25,8 @@ use std::path::{Path, PathBuf};
 use super::{read_series, IoError, Location, TimeStep};
 
 /// File extensions (lower case) of the datasets a folder is searched for.
-const DATASET_EXTENSIONS: [&str; 9] = [
-    "vtk", "vtu", "vts", "vtr", "vti", "pvtu", "pvts", "pvtr", "pvti",
+const DATASET_EXTENSIONS: [&str; 10] = [
+    "vtk", "vtu", "vts", "vtr", "vti", "pvtu", "pvts", "pvtr", "pvti", "vtm",
 ];
 
 /// Whether `path` looks like a glob pattern.
@@ -51,10 +51,13 @@ pub fn list_steps(path: &Path) -> Result<Vec<TimeStep>, IoError> {
                 files.push(p);
             }
         }
-        // Serial files next to parallel ones are their pieces.
+        // Serial files next to parallel or multiblock ones are their
+        // pieces.
         let parallel = |p: &PathBuf| {
-            p.extension()
-                .is_some_and(|e| e.to_string_lossy().to_lowercase().starts_with("pvt"))
+            p.extension().is_some_and(|e| {
+                let e = e.to_string_lossy().to_lowercase();
+                e.starts_with("pvt") || e == "vtm"
+            })
         };
         if files.iter().any(parallel) {
             files.retain(parallel);
@@ -62,7 +65,7 @@ pub fn list_steps(path: &Path) -> Result<Vec<TimeStep>, IoError> {
         return numbered(
             path,
             files,
-            "the folder holds no dataset files (.vtk, .vtu, .vts, .vtr, .vti, .pvtu, .pvts, .pvtr, .pvti)",
+            "the folder holds no dataset files (.vtk, .vtu, .vts, .vtr, .vti, .pvtu, .pvts, .pvtr, .pvti, .vtm)",
         );
     }
     if path.exists() || !is_pattern(path) {

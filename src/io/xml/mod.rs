@@ -1,5 +1,5 @@
-//! VTK XML readers: `.vtu`, `.vts`, `.vtr`, `.vti` and the parallel
-//! `.pvtu`, `.pvts`, `.pvtr` and `.pvti`.
+//! VTK XML readers: `.vtu`, `.vts`, `.vtr`, `.vti`, the parallel `.pvtu`,
+//! `.pvts`, `.pvtr` and `.pvti`, and multiblock `.vtm` ([`multiblock`]).
 //!
 //! How a file is read:
 //! 1. [`dom::parse`] pulls the element tree out of the file with quick-xml
@@ -25,6 +25,7 @@
 mod arrays;
 pub(crate) mod dom;
 mod encoding;
+mod multiblock;
 mod parallel;
 mod scalar;
 mod structured;
@@ -64,6 +65,7 @@ fn read_nested(path: &Path, bytes: &[u8], format: Format, depth: usize) -> Resul
             Format::XmlParallelStructured => "PStructuredGrid",
             Format::XmlParallelRectilinear => "PRectilinearGrid",
             Format::XmlParallelImage => "PImageData",
+            Format::XmlMultiBlock => "vtkMultiBlockDataSet",
             _ => "UnstructuredGrid",
         }
         .to_string()
@@ -90,11 +92,12 @@ fn read_nested(path: &Path, bytes: &[u8], format: Format, depth: usize) -> Resul
         "PStructuredGrid" => return parallel::read(path, grid, depth, Format::XmlStructured),
         "PRectilinearGrid" => return parallel::read(path, grid, depth, Format::XmlRectilinear),
         "PImageData" => return parallel::read(path, grid, depth, Format::XmlImage),
+        "vtkMultiBlockDataSet" => return multiblock::read(path, grid),
         other => {
             return Err(IoError::parse(
                 path,
                 root.location(),
-                format!("unsupported VTK XML dataset type '{other}' (expected UnstructuredGrid, StructuredGrid, RectilinearGrid, ImageData, or one of their parallel forms PUnstructuredGrid, PStructuredGrid, PRectilinearGrid, PImageData)"),
+                format!("unsupported VTK XML dataset type '{other}' (expected UnstructuredGrid, StructuredGrid, RectilinearGrid, ImageData, one of their parallel forms PUnstructuredGrid, PStructuredGrid, PRectilinearGrid, PImageData, or vtkMultiBlockDataSet)"),
             ))
         }
     };
