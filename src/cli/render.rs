@@ -319,24 +319,28 @@ pub fn print_stats_json(stats: &RenderStats, load_s: f64, ghost_cells: usize) ->
 /// whose extension says the other format is a usage error rather than a
 /// file whose contents belie its name.
 fn check_extensions(png: Option<&std::path::Path>, exr: Option<&std::path::Path>) -> Result<()> {
-    let ext = |p: &std::path::Path, e: &str| {
-        p.extension()
-            .and_then(|x| x.to_str())
-            .is_some_and(|x| x.eq_ignore_ascii_case(e))
-    };
-    if let Some(p) = png.filter(|p| ext(p, "exr")) {
+    let cases = [
+        (
+            png,
+            "exr",
+            "-o writes PNG",
+            "an OpenEXR",
+            "--float",
+            "float",
+        ),
+        (exr, "png", "--float writes OpenEXR", "a PNG", "-o", "8-bit"),
+    ];
+    for (path, ext, writes, names, flag, image) in cases {
+        let Some(p) = path.filter(|p| {
+            p.extension()
+                .and_then(|x| x.to_str())
+                .is_some_and(|x| x.eq_ignore_ascii_case(ext))
+        }) else {
+            continue;
+        };
+        let p = p.display();
         return Err(super::UsageError(format!(
-            "-o writes PNG, but '{}' names an OpenEXR file: use --float {} for the float image",
-            p.display(),
-            p.display()
-        ))
-        .into());
-    }
-    if let Some(p) = exr.filter(|p| ext(p, "png")) {
-        return Err(super::UsageError(format!(
-            "--float writes OpenEXR, but '{}' names a PNG file: use -o {} for the 8-bit image",
-            p.display(),
-            p.display()
+            "{writes}, but '{p}' names {names} file: use {flag} {p} for the {image} image"
         ))
         .into());
     }

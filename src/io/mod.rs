@@ -126,9 +126,36 @@ fn sniff(path: &Path) -> Result<Format, IoError> {
     if plot3d::looks_like_grid(&head[..n]) {
         return Ok(Format::Plot3d);
     }
+    if let Some(why) = not_read(path, &text) {
+        return Err(IoError::parse(path, Location::None, why));
+    }
     Err(IoError::UnknownFormat {
         path: path.to_path_buf(),
     })
+}
+
+/// Why a file of a kind zoovr knows but does not read is refused, with what
+/// to do instead: polygonal data holds no volume, and the binary formats of
+/// some solvers need converting first.
+fn not_read(path: &Path, head: &str) -> Option<&'static str> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    if matches!(ext.as_str(), "vtp" | "pvtp") || head.contains("\"PolyData\"") {
+        return Some(
+            "VTK PolyData holds surfaces, not 3D cells: there is no volume to render              (a volume mesh is a .vtu, .vts, .vtr, .vti, their parallel forms, a .vtm or a legacy .vtk)",
+        );
+    }
+    if matches!(
+        ext.as_str(),
+        "e" | "exo" | "ex2" | "cgns" | "h5" | "hdf5" | "cas" | "msh"
+    ) {
+        return Some(
+            "Exodus II, CGNS, HDF5, Fluent and Gmsh files are not read: save the volume as VTK              (.vtu, .vts or .vtm; in ParaView: File > Save Data) and render that",
+        );
+    }
+    None
 }
 
 /// Reads one dataset (not a collection: see [`read_series`]).
@@ -183,5 +210,42 @@ pub fn read_series(path: &Path) -> Result<Vec<TimeStep>, IoError> {
             time: 0.0,
             path: path.to_path_buf(),
         }]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Kinds zoovr knows but does not read get a reason and what to do;
+    /// anything else is an unknown format.
+    #[test]
+    fn known_unread_kinds_say_why() {
+        let dir = tempfile::tempdir().unwrap();
+        let write = |name: &str, text: &str| {
+            let p = dir.path().join(name);
+            std::fs::write(&p, text).unwrap();
+            p
+        };
+        let surface = write("skin.vtp", "<VTKFile type=\"PolyData\"></VTKFile>");
+        let e = read(&surface, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("skin.vtp") && e.contains("PolyData"), "{e}");
+        let by_content = write("skin.xml", "<VTKFile type=\"PolyData\"></VTKFile>");
+        let e = read(&by_content, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("skin.xml") && e.contains("surfaces"), "{e}");
+        let exodus = write("case.exo", "CDF\u{1}");
+        let e = read(&exodus, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("case.exo") && e.contains("Save Data"), "{e}");
+        let other = write("notes.txt", "hello");
+        assert!(matches!(
+            read(&other, &ReadOptions::default()),
+            Err(IoError::UnknownFormat { .. })
+        ));
     }
 }

@@ -33,7 +33,7 @@ mod unstructured;
 
 use std::path::Path;
 
-use super::{Format, IoError};
+use super::{Format, IoError, Location};
 use crate::mesh::Mesh;
 use encoding::{Codec, Compressor, Source};
 use structured::Lattice;
@@ -121,6 +121,57 @@ fn time_value(src: &Source, grid: &dom::Element) -> Option<f64> {
     let ty = scalar::Scalar::parse(arr.attr("type").unwrap_or(""))?;
     let values: Vec<f64> = src.decode(arr, ty, None).ok()?;
     values.first().copied().filter(|t| t.is_finite())
+}
+
+/// Checks a file that a parallel or multiblock file `path` names (`what`:
+/// "piece" or "block"; `at` the place of the reference): it opens, is a
+/// regular file, and is not `path` itself (`me`, canonical).
+fn referenced_file(
+    path: &Path,
+    me: Option<&Path>,
+    file: &Path,
+    what: &str,
+    at: impl Fn() -> Location,
+) -> Result<(), IoError> {
+    let fail = |msg: String| IoError::parse(path, at(), msg);
+    let canon = std::fs::canonicalize(file).map_err(|e| {
+        fail(format!(
+            "{what} file {} cannot be opened: {e}",
+            file.display()
+        ))
+    })?;
+    if Some(canon.as_path()) == me {
+        return Err(fail(format!("the {what} is the file itself")));
+    }
+    if !canon.is_file() {
+        return Err(fail(format!(
+            "{what} {} is not a regular file",
+            file.display()
+        )));
+    }
+    Ok(())
+}
+
+/// Merges the parts (pieces or blocks, `what`) of a parallel or multiblock
+/// file, with the `TimeValue` they agree on (ParaView writes the step's
+/// time into every part); parts that disagree leave it unset, with a note.
+fn merge_parts(
+    path: &Path,
+    grid: &dom::Element,
+    parts: Vec<Mesh>,
+    what: &str,
+) -> Result<Mesh, IoError> {
+    let times: Vec<f64> = parts.iter().filter_map(|m| m.source.time_value).collect();
+    let mut mesh = merge_checked(path, grid, parts)?;
+    match times.first() {
+        Some(&t) if times.iter().all(|&u| u == t) => mesh.source.time_value = Some(t),
+        Some(_) => mesh
+            .source
+            .notes
+            .push(format!("the {what}' TimeValues differ: no time value")),
+        None => {}
+    }
+    Ok(mesh)
 }
 
 /// Merges pieces after checking the total point count fits `u32` ids.

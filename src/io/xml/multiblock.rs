@@ -109,14 +109,7 @@ pub fn read(path: &Path, tree: &Element) -> Result<Mesh, IoError> {
             ),
         ));
     }
-    let times: Vec<Option<f64>> = kept.iter().map(|m| m.source.time_value).collect();
-    let mut mesh = super::merge_checked(path, tree, kept)?;
-    let first = times.iter().flatten().next().copied();
-    if times.iter().flatten().all(|t| Some(*t) == first) {
-        mesh.source.time_value = first;
-    } else {
-        notes.push("the blocks' TimeValues differ: no time value".into());
-    }
+    let mut mesh = super::merge_parts(path, tree, kept, "blocks")?;
     for n in notes {
         if !mesh.source.notes.contains(&n) {
             mesh.source.notes.push(n);
@@ -137,21 +130,7 @@ fn read_leaf(path: &Path, me: Option<&Path>, leaf: &Leaf) -> Result<Option<Mesh>
     };
     let fail = |msg: String| IoError::parse(path, at(), msg);
     let file = &leaf.file;
-    let canon = std::fs::canonicalize(file).map_err(|e| {
-        fail(format!(
-            "block file {} cannot be opened: {e}",
-            file.display()
-        ))
-    })?;
-    if Some(canon.as_path()) == me {
-        return Err(fail("the block is the .vtm file itself".into()));
-    }
-    if !canon.is_file() {
-        return Err(fail(format!(
-            "block {} is not a regular file",
-            file.display()
-        )));
-    }
+    super::referenced_file(path, me, file, "block", at)?;
     let ext = file
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())

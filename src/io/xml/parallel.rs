@@ -73,27 +73,7 @@ pub fn read(
                     p.pos
                 ))
             };
-            let canon = std::fs::canonicalize(file).map_err(|e| {
-                IoError::parse(
-                    path,
-                    at(),
-                    format!("piece file {} cannot be opened: {e}", file.display()),
-                )
-            })?;
-            if Some(&canon) == me.as_ref() {
-                return Err(IoError::parse(
-                    path,
-                    at(),
-                    "the piece is the parallel file itself",
-                ));
-            }
-            if !canon.is_file() {
-                return Err(IoError::parse(
-                    path,
-                    at(),
-                    format!("piece {} is not a regular file", file.display()),
-                ));
-            }
+            super::referenced_file(path, me.as_deref(), file, "piece", at)?;
             let bytes = std::fs::read(file).map_err(|e| {
                 IoError::parse(
                     path,
@@ -105,16 +85,7 @@ pub fn read(
                 .map_err(|e| IoError::parse(path, at(), format!("piece failed: {e}")))
         })
         .collect::<Result<Vec<Mesh>, IoError>>()?;
-    let times: Vec<Option<f64>> = meshes.iter().map(|m| m.source.time_value).collect();
-    let mut mesh = super::merge_checked(path, grid, meshes)?;
-    let first = times.iter().flatten().next().copied();
-    if times.iter().flatten().all(|t| Some(*t) == first) {
-        mesh.source.time_value = first;
-    } else {
-        mesh.source
-            .notes
-            .push("the pieces' TimeValues differ: no time value".into());
-    }
+    let mut mesh = super::merge_parts(path, grid, meshes, "pieces")?;
     let active = |el: Option<&Element>| el.and_then(|e| e.attr("Scalars")).map(str::to_string);
     if let Some(s) =
         active(grid.child("PPointData")).filter(|s| mesh.point_data.iter().any(|a| &a.name == s))
