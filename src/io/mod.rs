@@ -144,7 +144,8 @@ fn not_read(path: &Path, head: &str) -> Option<&'static str> {
         .unwrap_or_default();
     if matches!(ext.as_str(), "vtp" | "pvtp") || head.contains("\"PolyData\"") {
         return Some(
-            "VTK PolyData holds surfaces, not 3D cells: there is no volume to render              (a volume mesh is a .vtu, .vts, .vtr, .vti, their parallel forms, a .vtm or a legacy .vtk)",
+            "VTK PolyData holds surfaces, not 3D cells: there is no volume to render \
+             (a volume mesh is a .vtu, .vts, .vtr, .vti, their parallel forms, a .vtm or a legacy .vtk)",
         );
     }
     if matches!(
@@ -152,7 +153,8 @@ fn not_read(path: &Path, head: &str) -> Option<&'static str> {
         "e" | "exo" | "ex2" | "cgns" | "h5" | "hdf5" | "cas" | "msh"
     ) {
         return Some(
-            "Exodus II, CGNS, HDF5, Fluent and Gmsh files are not read: save the volume as VTK              (.vtu, .vts or .vtm; in ParaView: File > Save Data) and render that",
+            "Exodus II, CGNS, HDF5, Fluent and Gmsh files are not read: save the volume as VTK \
+             (.vtu, .vts or .vtm; in ParaView: File > Save Data) and render that",
         );
     }
     None
