@@ -154,6 +154,9 @@ pub struct Renderer {
     last_visible: bool,
     gpu: Option<Context>,
     pending_gpu: Option<PendingContext>,
+    /// The last frame's triangles, with `keep_projection`
+    /// ([`driver::kept`]).
+    kept: Option<driver::kept::KeptProjection>,
 }
 
 impl Renderer {
@@ -167,6 +170,7 @@ impl Renderer {
             last_visible: false,
             gpu: None,
             pending_gpu: None,
+            kept: None,
         }
     }
 
@@ -349,6 +353,7 @@ impl Renderer {
             last_visible,
             gpu,
             pending_gpu,
+            kept,
         } = self;
         let (subset, dark_cells, checked_s) =
             if opts.projected.skip_invisible && opts.projected.dark_subset {
@@ -384,6 +389,7 @@ impl Renderer {
             opts,
             camera,
             &scene.mesh,
+            kept,
             progress,
         )?;
         stats.dark_cells_left_out = dark_cells;

@@ -134,6 +134,14 @@ pub struct ProjectedOptions {
     /// on by default, and only with [`Self::skip_invisible`]). Off to
     /// measure what leaving them out of the sort saves.
     pub dark_subset: bool,
+    /// Keep the frame's triangles, so that the next frame that differs
+    /// only in the transfer function's colours draws them again without
+    /// sorting or projecting (modes on the segment payload: exact-frag and
+    /// the table modes; [`super::driver::kept`] says when it applies). Off
+    /// by default: a kept frame holds its vertices (tens of bytes each,
+    /// at most [`super::driver::kept::KEEP_MAX_BYTES`]). For interactive
+    /// colour editing through the library.
+    pub keep_projection: bool,
 }
 
 impl Default for ProjectedOptions {
@@ -149,6 +157,7 @@ impl Default for ProjectedOptions {
             exact_ties: true,
             occlusion: Some(crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE),
             dark_subset: true,
+            keep_projection: false,
         }
     }
 }

@@ -57,6 +57,14 @@ pub trait ProjectedMode: Sync {
     }
 
     /// Binds the mode's stage for one frame (uniforms, tables) of `src`.
+    /// The part of `tf` the mode's triangles (positions and payload) depend
+    /// on, where that is not all of it: frames whose signatures are equal
+    /// may draw the same triangles ([`super::driver::kept`]). `None` (the
+    /// default): every change of the transfer function projects again.
+    fn stream_signature(&self, _tf: &TransferFunction) -> Option<Vec<u64>> {
+        None
+    }
+
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError>;
 
     /// The CPU twin of the stage's fragment shader, for one frame of `src`.

@@ -52,6 +52,11 @@ pub struct ProjectedStats {
     /// values in: a time step or a transfer function that changed only the
     /// values' splits.
     pub sort_reused: bool,
+    /// The frame drew the triangles the renderer kept from its last frame,
+    /// which differed only in the transfer function's colours
+    /// ([`super::ProjectedOptions::keep_projection`]): no sort, no
+    /// projection.
+    pub projection_reused: bool,
     /// Time spent opening (or waiting for) the GPU context.
     pub gpu_open_s: f64,
     /// Projection, payloads and the draw calls, which overlap (workers
@@ -121,8 +126,19 @@ impl fmt::Display for ProjectedStats {
         )?;
         writeln!(
             f,
-            "project+draw {:.3} s  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles, {} tie pixels, {} steep triangles)",
-            e.project_s, e.triangles, e.culled_pieces, e.slabs, e.refined_triangles, e.tie_pixels, e.steep_triangles
+            "project+draw {:.3} s{}  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles, {} tie pixels, {} steep triangles)",
+            e.project_s,
+            if e.projection_reused {
+                ", kept triangles drawn again"
+            } else {
+                ""
+            },
+            e.triangles,
+            e.culled_pieces,
+            e.slabs,
+            e.refined_triangles,
+            e.tie_pixels,
+            e.steep_triangles
         )?;
         if let Some(t) = &e.table {
             writeln!(

@@ -87,6 +87,7 @@ use super::ties::{
 };
 use super::workers::run_ordered;
 use super::{Compositor, RenderError, RenderOptions};
+use kept::{KeepKey, KeptCounts, KeptProjection};
 
 /// Pieces processed per chunk (one worker's unit of work).
 const CHUNK: usize = 2048;
@@ -548,6 +549,7 @@ fn push_out<V: GpuVertex>(
     out: &mut ChunkOut<V>,
     stats: &mut ProjectedStats,
     next_piece: &mut u32,
+    record: Option<&mut KeptProjection>,
 ) -> Result<(), RenderError> {
     if let Some(e) = out.error.take() {
         return Err(e.into());
@@ -565,6 +567,9 @@ fn push_out<V: GpuVertex>(
     stats.steep_triangles += out.steep;
     stats.triangles += out.indices.len() / 3;
     sink.push(&out.vertices, &out.indices)?;
+    if let Some(r) = record {
+        r.record(&out.vertices, &out.indices);
+    }
     Ok(())
 }
 
@@ -586,6 +591,7 @@ pub fn render_projected<M: ProjectedMode>(
     opts: &RenderOptions,
     camera: &Camera,
     whole: &crate::mesh::Mesh,
+    kept_frame: &mut Option<KeptProjection>,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<(Image, ProjectedStats), RenderError> {
     let mut stats = ProjectedStats::default();
@@ -669,6 +675,52 @@ pub fn render_projected<M: ProjectedMode>(
     };
     stats.gpu_open_s = t_open.elapsed().as_secs_f64();
     let t_gpu = Instant::now();
+    // The frame's triangles, kept for (or taken from) a frame that differs
+    // only in the transfer function's colours ([`kept`]).
+    let keep_key = (opts.projected.keep_projection
+        && matches!(sink, Sink::Gpu { .. })
+        && opts.projected.draw == DrawKind::Composite
+        && order.groups.is_empty()
+        && mode.isosurfaces().is_none())
+    .then(|| mode.stream_signature(&scene.tf))
+    .flatten()
+    .map(|tf| KeepKey {
+        mode: std::any::type_name::<M>(),
+        order: order.clone(),
+        mesh: scene.mesh.clone(),
+        field: scene.field.clone(),
+        camera: *camera,
+        options: opts.projected,
+        unit_distance: scene.unit_distance.to_bits(),
+        tf,
+    });
+    if let Some(key) = &keep_key {
+        let batches = kept_frame
+            .as_ref()
+            .and_then(|k| k.batches_for::<M::Vertex>(key));
+        if let Some(batches) = batches {
+            let tp = Instant::now();
+            for (v, i) in batches {
+                sink.push(v, i)?;
+            }
+            let c = kept_frame.as_ref().map(|k| k.counts).unwrap_or_default();
+            stats.culled_pieces = c.culled_pieces;
+            stats.slabs = c.slabs;
+            stats.refined_triangles = c.refined_triangles;
+            stats.tie_pixels = c.tie_pixels;
+            stats.steep_triangles = c.steep_triangles;
+            stats.triangles = c.triangles;
+            stats.hidden_pieces = c.hidden_pieces;
+            stats.projection_reused = true;
+            progress(order.pieces.len(), order.pieces.len());
+            return finish(sink, stats, tp.elapsed().as_secs_f64(), t_gpu);
+        }
+    }
+    let mut record = keep_key.map(KeptProjection::new);
+    if record.is_none() {
+        // Nothing to keep: free what an earlier frame kept.
+        *kept_frame = None;
+    }
     let total = order.pieces.len();
     let mut done = 0;
     // Stretches of ordinary pieces, each followed by at most one group.
@@ -713,7 +765,13 @@ pub fn render_projected<M: ProjectedMode>(
         };
         let mut handed = 0;
         pipeline(mode, &src, pieces, CHUNK, workers, &pool, |mut out| {
-            push_out(&mut sink, &mut out, &mut stats, &mut next_piece)?;
+            push_out(
+                &mut sink,
+                &mut out,
+                &mut stats,
+                &mut next_piece,
+                record.as_mut(),
+            )?;
             pool.put(out);
             handed += CHUNK;
             progress(done + handed.min(pieces.len()), total);
@@ -737,7 +795,29 @@ pub fn render_projected<M: ProjectedMode>(
             progress(done, total);
         }
     }
-    let project_s = tp.elapsed().as_secs_f64();
+    if let Some(mut r) = record {
+        r.counts = KeptCounts {
+            culled_pieces: stats.culled_pieces,
+            slabs: stats.slabs,
+            refined_triangles: stats.refined_triangles,
+            tie_pixels: stats.tie_pixels,
+            steep_triangles: stats.steep_triangles,
+            triangles: stats.triangles,
+            hidden_pieces: stats.hidden_pieces,
+        };
+        *kept_frame = r.complete();
+    }
+    finish(sink, stats, tp.elapsed().as_secs_f64(), t_gpu)
+}
+
+/// Finishes the frame of `sink`: the image, and the GPU's figures in
+/// `stats` (`project_s` spent projecting and drawing since `t_gpu`).
+fn finish<V: GpuVertex>(
+    sink: Sink<V>,
+    mut stats: ProjectedStats,
+    project_s: f64,
+    t_gpu: Instant,
+) -> Result<(Image, ProjectedStats), RenderError> {
     let (image, fstats) = match sink {
         Sink::Gpu { frame, .. } => frame.finish_with_stats()?,
         Sink::Cpu { frame, .. } => {
@@ -754,6 +834,8 @@ pub fn render_projected<M: ProjectedMode>(
     stats.gpu_total_s = t_gpu.elapsed().as_secs_f64() - project_s;
     Ok((image, stats))
 }
+
+pub mod kept;
 
 #[cfg(test)]
 mod tests;

@@ -316,6 +316,10 @@ impl<M: SegmentMode> ProjectedMode for M {
         SegmentVertex::needs_perspective_refinement()
     }
 
+    fn stream_signature(&self, tf: &TransferFunction) -> Option<Vec<u64>> {
+        crate::render::driver::kept::stream_signature(tf)
+    }
+
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         SegmentMode::bind(self, gpu, src)
     }
