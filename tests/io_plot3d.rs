@@ -333,18 +333,110 @@ fn seeded_mutations_never_panic() {
     assert!(t.elapsed() < Duration::from_secs(10));
 }
 
-#[test]
-fn multi_grid_files_are_refused_clearly() {
-    let mut b = Vec::new();
-    for v in [2i32, 2, 2, 2, 3, 2, 2] {
-        b.extend_from_slice(&v.to_be_bytes());
+/// A multi-grid file (`nblocks` grids, dimensions in one record, then
+/// each grid's record; a q file: each grid's conditions and data) in
+/// every layout.
+fn write_multi(o: Opts, dims: &[[usize; 3]], q: bool) -> Vec<u8> {
+    let mut out = Vec::new();
+    record(o, int(o, dims.len() as i32).to_vec(), &mut out);
+    let mut h = Vec::new();
+    for d in dims.iter().flatten() {
+        h.extend_from_slice(&int(o, *d as i32));
     }
-    b.extend(std::iter::repeat_n(0u8, 4 * 3 * (8 + 12)));
+    record(o, h, &mut out);
+    for (g, &d) in dims.iter().enumerate() {
+        let one = if q {
+            write_q(o, d, &q_vars(d, g))
+        } else {
+            write_grid(o, d, &[g])
+        };
+        // The grid's own records, after its single-grid header.
+        let mut skip = 12 + if o.markers { 8 } else { 0 };
+        if o.nblocks {
+            skip += 4 + if o.markers { 8 } else { 0 };
+        }
+        out.extend_from_slice(&one[skip..one.len() - o.padding]);
+    }
+    out.extend(std::iter::repeat_n(0u8, o.padding));
+    out
+}
+
+fn q_vars(dims: [usize; 3], g: usize) -> Vec<[f64; 5]> {
+    (0..dims.iter().product::<usize>())
+        .map(|p| {
+            let x = (p + 7 * g) as f64;
+            [1.0 + 0.5 * x, 0.25 * x, -0.5, 0.125 * x, 4.0 + x]
+        })
+        .collect()
+}
+
+/// Multi-grid files read as their grids read one by one, merged: the same
+/// points, the same cells (point ids offset per grid), the same IBLANK and
+/// solution arrays; refused clearly where their data does not fit.
+#[test]
+fn multi_grid_files_read_as_their_grids() {
+    let dims = [[2, 3, 2], [3, 2, 2], [2, 2, 4]];
+    let mut n = 0;
+    for o in all_opts().into_iter().filter(|o| o.nblocks) {
+        let g = write_multi(o, &dims, false);
+        let q = write_multi(o, &dims, true);
+        let what = format!("{o:?}");
+        let m = read_bytes(Path::new("m.xyz"), &g, Some((Path::new("m.q"), &q)))
+            .unwrap_or_else(|e| panic!("{what}: {e}"));
+        let mut base = 0u32;
+        let (mut points, mut cells) = (0, 0);
+        for (k, &d) in dims.iter().enumerate() {
+            let single = Opts {
+                nblocks: false,
+                ..o
+            };
+            let one = read_bytes(
+                Path::new("one.xyz"),
+                &write_grid(single, d, &[k]),
+                Some((Path::new("one.q"), &write_q(single, d, &q_vars(d, k)))),
+            )
+            .unwrap();
+            assert_eq!(
+                &m.points[points..points + one.points.len()],
+                &one.points[..],
+                "{what}"
+            );
+            for c in 0..one.cells.len() {
+                let want: Vec<u32> = one.cells.nodes(c).iter().map(|&p| p + base).collect();
+                assert_eq!(m.cells.nodes(cells + c), &want[..], "{what} grid {k}");
+            }
+            for a in &one.point_data {
+                let all = arr(&m, &a.name);
+                let nc = a.components;
+                for i in 0..one.points.len() * nc {
+                    assert_eq!(
+                        all.data.get(points * nc + i),
+                        a.data.get(i),
+                        "{what} {}",
+                        a.name
+                    );
+                }
+            }
+            points += one.points.len();
+            cells += one.cells.len();
+            base += one.points.len() as u32;
+        }
+        assert_eq!((m.points.len(), m.cells.len()), (points, cells), "{what}");
+        // Each grid blanks one point: some cells left out.
+        assert_eq!(o.iblank, cells < 2 + 2 + 3, "{what}");
+        assert!(
+            m.source.notes.iter().any(|s| s.contains("3 grids")),
+            "{what}"
+        );
+        n += 1;
+    }
+    assert_eq!(n, 16);
+    // A header announcing more grid data than the file holds.
+    let o = all_opts()[4 + 8];
+    let mut b = write_multi(o, &dims, false);
+    b.truncate(b.len() - 40);
     let e = read_bytes(Path::new("multi.xyz"), &b, None)
         .unwrap_err()
         .to_string();
-    assert!(
-        e.contains("multi.xyz") && e.contains("2 grids") && e.contains("byte 0"),
-        "{e}"
-    );
+    assert!(e.contains("multi.xyz") && e.contains("3 grids"), "{e}");
 }

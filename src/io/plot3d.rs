@@ -1,9 +1,14 @@
-//! PLOT3D reader: single-grid, 3D, whole-format binary grids (`.xyz`, `.bin`,
-//! `.p3d`) and their `q` solution files.
+//! PLOT3D reader: 3D whole-format binary grids (`.xyz`, `.bin`, `.p3d`),
+//! single- or multi-grid, and their `q` solution files.
 //!
 //! PLOT3D files carry no magic number, so the layout is inferred from the
 //! sizes. A grid file is `[nblocks]? ni nj nk`, then all x, all y, all z
-//! (`f32` or `f64`), then optionally `ni*nj*nk` 32-bit IBLANK flags. Written
+//! (`f32` or `f64`), then optionally `ni*nj*nk` 32-bit IBLANK flags. A
+//! multi-grid file has `nblocks > 1`, the dimensions of every grid in one
+//! record, then each grid's record in turn (a q file: each grid's
+//! conditions and data); its grids are merged into one mesh as the pieces
+//! of a parallel file are (point ids offset per grid), and the topology
+//! joins them where their faces meet point for point. Written
 //! by Fortran, each record may be framed by 4-byte length markers. For both
 //! byte orders and each framing we read the dimensions and keep the variant
 //! whose expected size fits the file: with markers the markers must match;
@@ -75,60 +80,76 @@ impl Framing {
         }))
     }
 
-    /// Dimensions and the offset where the data starts (after the header
-    /// record and, with markers, before the data record's leading marker).
-    fn header(self, b: &[u8]) -> Option<([usize; 3], usize)> {
+    /// Each grid's dimensions and the offset where the data starts (after
+    /// the header records and, with markers, before the first data record's
+    /// leading marker). With an `nblocks` prefix the dimensions of all
+    /// grids form one record; a grid count needs that many plausible
+    /// triples within the file.
+    fn header(self, b: &[u8]) -> Option<(Vec<[usize; 3]>, usize)> {
         let mut off = 0;
+        let mut grids = 1usize;
         if self.nblocks {
             if self.markers {
                 (self.int(b, 0)? == 4).then_some(())?;
-                (self.int(b, 4)? == 1).then_some(())?;
+                grids = usize::try_from(self.int(b, 4)?).ok()?;
                 (self.int(b, 8)? == 4).then_some(())?;
                 off = 12;
             } else {
-                (self.int(b, 0)? == 1).then_some(())?;
+                grids = usize::try_from(self.int(b, 0)?).ok()?;
                 off = 4;
+            }
+            // Each grid needs at least its dimensions and a point.
+            if grids == 0 || grids > MAX_GRIDS || grids.saturating_mul(16) > b.len() {
+                return None;
             }
         }
         if self.markers {
-            (self.int(b, off)? == 12).then_some(())?;
+            (self.int(b, off)? == 12 * grids as i64).then_some(())?;
             off += 4;
         }
-        let mut d = [0usize; 3];
-        for (i, v) in d.iter_mut().enumerate() {
-            let x = self.int(b, off + 4 * i)?;
-            *v = usize::try_from(x)
-                .ok()
-                .filter(|&x| (1..=1 << 24).contains(&x))?;
+        let mut dims = Vec::with_capacity(grids);
+        for g in 0..grids {
+            let mut d = [0usize; 3];
+            for (i, v) in d.iter_mut().enumerate() {
+                let x = self.int(b, off + 12 * g + 4 * i)?;
+                *v = usize::try_from(x)
+                    .ok()
+                    .filter(|&x| (1..=1 << 24).contains(&x))?;
+            }
+            dims.push(d);
         }
-        off += 12;
+        off += 12 * grids;
         if self.markers {
-            (self.int(b, off)? == 12).then_some(())?;
+            (self.int(b, off)? == 12 * grids as i64).then_some(())?;
             off += 4;
         }
-        Some((d, off))
+        Some((dims, off))
     }
 }
 
+/// The most grids a multi-grid file may hold.
+const MAX_GRIDS: usize = 1 << 20;
+
 /// A detected layout of a grid or q file.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct Layout {
     framing: Framing,
-    dims: [usize; 3],
+    /// Each grid's dimensions.
+    dims: Vec<[usize; 3]>,
     double: bool,
     iblank: bool,
-    /// Offset of the first value of the main data record.
-    data: usize,
+    /// Offset of the first value of each grid's main data record.
+    data: Vec<usize>,
     padding: usize,
 }
 
-impl Layout {
-    /// Point count, saturating (each dimension is at most 2^24, so a
-    /// product can exceed `usize`; a saturated count fails the size checks).
-    fn points(&self) -> usize {
-        self.dims.iter().fold(1usize, |a, &d| a.saturating_mul(d))
-    }
+/// Point count of a grid, saturating (each dimension is at most 2^24, so
+/// a product can exceed `usize`; a saturated count fails the size checks).
+fn point_count(dims: [usize; 3]) -> usize {
+    dims.iter().fold(1usize, |a, &d| a.saturating_mul(d))
+}
 
+impl Layout {
     fn real_size(&self) -> usize {
         if self.double {
             8
@@ -163,18 +184,19 @@ impl Layout {
 /// with the least trailing padding (`want`: dimensions the header must
 /// give). A grid has one record after the header (coordinates and IBLANK);
 /// a q file two (the four conditions, the data).
-fn detect(b: &[u8], q: bool, want: Option<[usize; 3]>) -> Option<Layout> {
+fn detect(b: &[u8], q: bool, want: Option<&[[usize; 3]]>) -> Option<Layout> {
     let mut best: Option<Layout> = None;
     for framing in Framing::ALL {
         let Some((dims, off)) = framing.header(b) else {
             continue;
         };
-        if want.is_some_and(|w| w != dims) {
+        if want.is_some_and(|w| w != dims.as_slice()) {
             continue;
         }
-        let Some(n) = dims[0]
-            .checked_mul(dims[1])
-            .and_then(|x| x.checked_mul(dims[2]))
+        let Some(counts) = dims
+            .iter()
+            .map(|d| d[0].checked_mul(d[1]).and_then(|x| x.checked_mul(d[2])))
+            .collect::<Option<Vec<usize>>>()
         else {
             continue;
         };
@@ -184,55 +206,18 @@ fn detect(b: &[u8], q: bool, want: Option<[usize; 3]>) -> Option<Layout> {
                 if q && iblank {
                     continue;
                 }
-                // (bytes of each record after the header)
-                let main = if q {
-                    n.checked_mul(5 * rs)
-                } else {
-                    n.checked_mul(3 * rs + if iblank { 4 } else { 0 })
-                };
-                let Some(main) = main else {
+                let Some((data, end)) = walk_records(b, framing, off, &counts, q, rs, iblank)
+                else {
                     continue;
                 };
-                let records: &[usize] = if q { &[4 * rs, main] } else { &[main] };
-                let mut pos = off;
-                let mut ok = true;
-                let mut data = 0;
-                for (ri, &r) in records.iter().enumerate() {
-                    if framing.markers {
-                        if framing.int(b, pos).and_then(|m| usize::try_from(m).ok()) != Some(r) {
-                            ok = false;
-                            break;
-                        }
-                        pos += 4;
-                    }
-                    if ri + 1 == records.len() {
-                        data = pos;
-                    }
-                    pos = match pos.checked_add(r) {
-                        Some(p) if p <= b.len() => p,
-                        _ => {
-                            ok = false;
-                            break;
-                        }
-                    };
-                    if framing.markers {
-                        if framing.int(b, pos).and_then(|m| usize::try_from(m).ok()) != Some(r) {
-                            ok = false;
-                            break;
-                        }
-                        pos += 4;
-                    }
-                }
-                if !ok || pos > b.len() {
-                    continue;
-                }
-                let padding = b.len() - pos;
-                if padding >= 4 * n.max(1) {
+                let padding = b.len() - end;
+                let last = counts.last().copied().unwrap_or(1);
+                if padding >= 4 * last.max(1) {
                     continue;
                 }
                 let cand = Layout {
                     framing,
-                    dims,
+                    dims: dims.clone(),
                     double,
                     iblank,
                     data,
@@ -240,8 +225,8 @@ fn detect(b: &[u8], q: bool, want: Option<[usize; 3]>) -> Option<Layout> {
                 };
                 // A 3D reading beats one with a dimension of 1 (which could be
                 // an `nblocks = 1` prefix misread), then the least padding wins.
-                let key = |l: &Layout| (l.dims.contains(&1), l.padding);
-                if best.is_none_or(|x| key(&cand) < key(&x)) {
+                let key = |l: &Layout| (l.dims.iter().any(|d| d.contains(&1)), l.padding);
+                if best.as_ref().is_none_or(|x| key(&cand) < key(x)) {
                     best = Some(cand);
                 }
             }
@@ -250,21 +235,79 @@ fn detect(b: &[u8], q: bool, want: Option<[usize; 3]>) -> Option<Layout> {
     best
 }
 
+/// Walks the data records of grids of `counts` points from `off`: per grid
+/// one record (coordinates and IBLANK), or for a q file two (the four
+/// conditions, the data), each framed by matching markers when the file
+/// has them. Returns each grid's main data offset and where the records
+/// end, if they fit the file.
+fn walk_records(
+    b: &[u8],
+    framing: Framing,
+    off: usize,
+    counts: &[usize],
+    q: bool,
+    rs: usize,
+    iblank: bool,
+) -> Option<(Vec<usize>, usize)> {
+    let marker = |pos: usize, r: usize| {
+        !framing.markers || framing.int(b, pos).and_then(|m| usize::try_from(m).ok()) == Some(r)
+    };
+    let step = if framing.markers { 4 } else { 0 };
+    let mut pos = off;
+    let mut data = Vec::with_capacity(counts.len());
+    for &n in counts {
+        let main = if q {
+            n.checked_mul(5 * rs)?
+        } else {
+            n.checked_mul(3 * rs + if iblank { 4 } else { 0 })?
+        };
+        let both = [4 * rs, main];
+        let records: &[usize] = if q { &both } else { &both[1..] };
+        for (k, &r) in records.iter().enumerate() {
+            marker(pos, r).then_some(())?;
+            pos += step;
+            if k + 1 == records.len() {
+                data.push(pos);
+            }
+            pos = pos.checked_add(r).filter(|&p| p <= b.len())?;
+            marker(pos, r).then_some(())?;
+            pos += step;
+        }
+    }
+    (pos <= b.len()).then_some((data, pos))
+}
+
 /// Explains why no layout fits: for the first framing whose header reads as
 /// dimensions, where the data should start and how many bytes it needs.
 fn diagnose(path: &Path, b: &[u8], q: bool) -> IoError {
     let kind = if q { "q solution" } else { "grid" };
-    if let Some(nb) = grid_count(b) {
-        return IoError::parse(
-            path,
-            Location::Byte(0),
-            format!("PLOT3D {kind} with {nb} grids: only single-grid files are read"),
-        );
-    }
-    for framing in Framing::ALL {
-        let Some((d, off)) = framing.header(b) else {
-            continue;
-        };
+    // A multi-grid header first (its count would also read as a single
+    // grid's first dimension).
+    let multi = Framing::ALL
+        .iter()
+        .filter_map(|&f| f.header(b).map(|h| (f, h)))
+        .find(|(_, (dims, _))| dims.len() > 1);
+    let first = multi.or_else(|| {
+        Framing::ALL
+            .iter()
+            .find_map(|&f| f.header(b).map(|h| (f, h)))
+    });
+    if let Some((framing, (dims, off))) = first {
+        if dims.len() > 1 {
+            let order = if framing.big_endian { "big" } else { "little" };
+            let marks = if framing.markers { "with" } else { "without" };
+            return IoError::parse(
+                path,
+                Location::Byte(off as u64),
+                format!(
+                    "PLOT3D {kind} header says {} grids ({order}-endian, {marks} record markers), \
+                     but no precision/IBLANK layout fits their data in the {} bytes that remain",
+                    dims.len(),
+                    b.len() - off
+                ),
+            );
+        }
+        let d = dims[0];
         let n = d[0] as u128 * d[1] as u128 * d[2] as u128;
         let min = if q { 5 * 4 * n + 16 } else { 3 * 4 * n };
         let order = if framing.big_endian { "big" } else { "little" };
@@ -287,7 +330,7 @@ fn diagnose(path: &Path, b: &[u8], q: bool) -> IoError {
         path,
         Location::Byte(0),
         format!(
-            "not a single-grid 3D whole-format PLOT3D {kind}: the first bytes hold no plausible \
+            "not a 3D whole-format PLOT3D {kind}: the first bytes hold no plausible \
              dimensions (1..=2^24 each) in either byte order, with or without record markers \
              ({} bytes in the file)",
             b.len()
@@ -295,34 +338,14 @@ fn diagnose(path: &Path, b: &[u8], q: bool) -> IoError {
     )
 }
 
-/// The grid count of a multi-grid file (`nblocks > 1` followed by that many
-/// plausible dimension triples), in any framing.
-fn grid_count(b: &[u8]) -> Option<i64> {
-    Framing::ALL.iter().find_map(|f| {
-        let (nb, dims_at) = if f.markers {
-            (f.int(b, 0)? == 4 && f.int(b, 8)? == 4).then_some(())?;
-            (f.int(b, 4)?, 16)
-        } else {
-            (f.int(b, 0)?, 4)
-        };
-        if !(2..=1_000_000).contains(&nb) {
-            return None;
-        }
-        let plausible = (0..3 * nb.min(64) as usize).all(|i| {
-            f.int(b, dims_at + 4 * i)
-                .is_some_and(|d| (1..=1 << 24).contains(&d))
-        });
-        plausible.then_some(nb)
-    })
-}
-
 /// Whether the first bytes look like a PLOT3D grid header (used by format
 /// sniffing when the extension says nothing).
 pub fn looks_like_grid(head: &[u8]) -> bool {
     Framing::ALL.iter().any(|f| {
-        let Some((dims, off)) = f.header(head) else {
+        let Some((grids, off)) = f.header(head) else {
             return false;
         };
+        let dims = grids[0];
         let Some(n) = dims.iter().try_fold(1usize, |a, &d| a.checked_mul(d)) else {
             return false;
         };
@@ -377,19 +400,54 @@ pub fn read(path: &Path, q: Option<&Path>) -> Result<Mesh, IoError> {
 /// memory; paths only name the files in errors.
 pub fn read_bytes(path: &Path, grid: &[u8], q: Option<(&Path, &[u8])>) -> Result<Mesh, IoError> {
     let lay = detect(grid, false, None).ok_or_else(|| diagnose(path, grid, false))?;
-    let n = lay.points();
+    let qlay = match q {
+        Some((qp, qb)) => Some((qp, qb, q_layout(&lay.dims, qp, qb)?)),
+        None => None,
+    };
+    let mut grids = Vec::with_capacity(lay.dims.len());
+    for g in 0..lay.dims.len() {
+        let mut mesh = read_grid(path, grid, &lay, g)?;
+        if let Some((qp, qb, ql)) = &qlay {
+            attach_q(&mut mesh, qp, qb, ql, g);
+        }
+        grids.push(mesh);
+    }
+    let count = grids.len();
+    let mut mesh = super::xml::merge_pieces(grids);
+    if count > 1 {
+        mesh.source.notes.push(format!("{count} grids merged"));
+    }
+    if lay.padding > 0 {
+        mesh.source
+            .notes
+            .push(format!("{} trailing padding bytes ignored", lay.padding));
+    }
+    Ok(mesh)
+}
+
+/// Grid `g` of the file as hexahedra (cells touching a blanked point left
+/// out).
+fn read_grid(path: &Path, grid: &[u8], lay: &Layout, g: usize) -> Result<Mesh, IoError> {
+    let dims = lay.dims[g];
+    let n = point_count(dims);
     let rs = lay.real_size();
+    let data = lay.data[g];
     let mut points = Vec::with_capacity(n);
     for p in 0..n {
         let mut v = [0.0; 3];
         for (c, x) in v.iter_mut().enumerate() {
-            let off = lay.data + (c * n + p) * rs;
+            let off = data + (c * n + p) * rs;
             *x = lay.real(grid, off);
             if !x.is_finite() {
+                let which = if lay.dims.len() > 1 {
+                    format!("grid {g}, ")
+                } else {
+                    String::new()
+                };
                 return Err(IoError::parse(
                     path,
                     Location::Byte(off as u64),
-                    format!("point {p} has a non-finite coordinate"),
+                    format!("{which}point {p} has a non-finite coordinate"),
                 ));
             }
         }
@@ -397,16 +455,11 @@ pub fn read_bytes(path: &Path, grid: &[u8], q: Option<(&Path, &[u8])>) -> Result
     }
     let mut mesh = Mesh {
         points,
-        cells: super::legacy::hexahedra(lay.dims),
+        cells: super::legacy::hexahedra(dims),
         ..Mesh::default()
     };
-    if lay.padding > 0 {
-        mesh.source
-            .notes
-            .push(format!("{} trailing padding bytes ignored", lay.padding));
-    }
     if lay.iblank {
-        let base = lay.data + 3 * n * rs;
+        let base = data + 3 * n * rs;
         let flags: Vec<i64> = (0..n)
             .map(|p| lay.framing.int(grid, base + 4 * p).unwrap_or(1))
             .collect();
@@ -418,16 +471,13 @@ pub fn read_bytes(path: &Path, grid: &[u8], q: Option<(&Path, &[u8])>) -> Result
             vtk_type: "Int32".into(),
         });
     }
-    let total = super::legacy::vtk_cell_count(lay.dims);
+    let total = super::legacy::vtk_cell_count(dims);
     if mesh.cells.is_empty() {
         mesh.source.ignored_cells = total;
     } else {
         mesh.source
             .cells_by_type
             .insert("hexahedron".into(), mesh.cells.len());
-    }
-    if let Some((qp, qb)) = q {
-        attach_q(&mut mesh, lay.dims, qp, qb)?;
     }
     Ok(mesh)
 }
@@ -451,8 +501,8 @@ fn drop_blanked(mesh: &mut Mesh, flags: &[i64]) {
     }
 }
 
-/// Reads a q file and attaches its arrays.
-fn attach_q(mesh: &mut Mesh, dims: [usize; 3], path: &Path, b: &[u8]) -> Result<(), IoError> {
+/// The layout of a q file for grids of `dims`.
+fn q_layout(dims: &[[usize; 3]], path: &Path, b: &[u8]) -> Result<Layout, IoError> {
     let lay = match detect(b, true, Some(dims)) {
         Some(l) => l,
         None => match detect(b, true, None) {
@@ -470,16 +520,22 @@ fn attach_q(mesh: &mut Mesh, dims: [usize; 3], path: &Path, b: &[u8]) -> Result<
             ),
         ));
     }
-    let n = lay.points();
+    Ok(lay)
+}
+
+/// Attaches grid `g`'s solution (of the q file `b` with layout `lay`).
+fn attach_q(mesh: &mut Mesh, _path: &Path, b: &[u8], lay: &Layout, g: usize) {
+    let n = point_count(lay.dims[g]);
     let rs = lay.real_size();
+    let data = lay.data[g];
     // The four reals fsmach, alpha, re, time precede the data record.
-    let conds = lay.data - 4 * rs - if lay.framing.markers { 8 } else { 0 };
+    let conds = data - 4 * rs - if lay.framing.markers { 8 } else { 0 };
     let c: Vec<f64> = (0..4).map(|i| lay.real(b, conds + i * rs)).collect();
     mesh.source.notes.push(format!(
         "q: fsmach {} alpha {} re {} time {}",
         c[0], c[1], c[2], c[3]
     ));
-    let var = |v: usize, p: usize| lay.real(b, lay.data + (v * n + p) * rs);
+    let var = |v: usize, p: usize| lay.real(b, data + (v * n + p) * rs);
     let mut rho = Vec::with_capacity(n);
     let mut mom = Vec::with_capacity(3 * n);
     let mut energy = Vec::with_capacity(n);
@@ -516,5 +572,4 @@ fn attach_q(mesh: &mut Mesh, dims: [usize; 3], path: &Path, b: &[u8]) -> Result<
     mesh.point_data.push(arr("VelocityMagnitude", 1, vmag));
     mesh.point_data.push(arr("Pressure", 1, pres));
     mesh.active_point_scalars = Some("Density".into());
-    Ok(())
 }

@@ -23,6 +23,10 @@
 //! element (with its `Name` and byte offset) or the byte where reading failed.
 
 mod arrays;
+
+/// Merges meshes as the pieces of a file are merged (point ids offset per
+/// piece; an array missing from some piece dropped, with a note).
+pub(crate) use arrays::merge as merge_pieces;
 pub(crate) mod dom;
 mod encoding;
 mod multiblock;
