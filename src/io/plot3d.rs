@@ -127,8 +127,10 @@ impl Framing {
     }
 }
 
-/// The most grids a multi-grid file may hold.
-const MAX_GRIDS: usize = 1 << 20;
+/// The most grids a multi-grid file may hold: far above real multi-block
+/// and overset grids (thousands), low enough that a hostile count of tiny
+/// grids cannot make a million meshes to merge.
+const MAX_GRIDS: usize = 1 << 16;
 
 /// A detected layout of a grid or q file.
 #[derive(Clone, Debug)]
