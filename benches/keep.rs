@@ -10,8 +10,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use zoovr::camera::CameraParams;
-use zoovr::generate::{warped_hex_grid, Warp};
-use zoovr::render::{Mode, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec, Shading};
+use zoovr::render::{Mode, ProjectedOptions, RenderOptions, Renderer, Scene, Shading};
 use zoovr::testdata::hex_shell_scene;
 use zoovr::tf::TransferFunction;
 
@@ -19,17 +18,7 @@ fn scene() -> (&'static str, Scene) {
     if let Some(s) = hex_shell_scene() {
         return ("hex_shell", s);
     }
-    let mesh = warped_hex_grid(
-        40,
-        &Warp {
-            amplitude: 0.05,
-            seed: 1,
-        },
-    );
-    (
-        "grid_40",
-        Scene::build(mesh, &SceneSpec::default()).expect("scene"),
-    )
+    zoovr::testdata::grid_40_scene()
 }
 
 /// `shading` with its colours rotated (extinction unchanged).

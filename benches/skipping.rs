@@ -41,17 +41,7 @@ fn scene() -> (&'static str, Scene) {
             Scene::build(mesh, &SceneSpec::default()).expect("scene"),
         );
     }
-    let mesh = warped_hex_grid(
-        40,
-        &Warp {
-            amplitude: 0.05,
-            seed: 1,
-        },
-    );
-    (
-        "grid_40",
-        Scene::build(mesh, &SceneSpec::default()).expect("scene"),
-    )
+    zoovr::testdata::grid_40_scene()
 }
 
 /// The scene's shading with extinction only in the top tenth of the range.

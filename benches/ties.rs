@@ -18,8 +18,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use zoovr::camera::CameraParams;
-use zoovr::generate::{warped_hex_grid, Warp};
-use zoovr::render::{Mode, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec};
+use zoovr::render::{Mode, ProjectedOptions, RenderOptions, Renderer, Scene};
 use zoovr::testdata::hex_shell_scene;
 
 fn scene() -> (&'static str, Scene, CameraParams) {
@@ -39,18 +38,8 @@ fn scene() -> (&'static str, Scene, CameraParams) {
     if let Some(scene) = hex_shell_scene() {
         return ("hex_shell", scene, camera);
     }
-    let mesh = warped_hex_grid(
-        40,
-        &Warp {
-            amplitude: 0.05,
-            seed: 1,
-        },
-    );
-    (
-        "grid_40",
-        Scene::build(mesh, &SceneSpec::default()).expect("scene"),
-        camera,
-    )
+    let (name, scene) = zoovr::testdata::grid_40_scene();
+    (name, scene, camera)
 }
 
 fn bench(c: &mut Criterion) {

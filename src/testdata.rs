@@ -91,6 +91,22 @@ pub fn hex_shell_scene() -> Option<crate::render::Scene> {
     crate::render::Scene::build(mesh, &spec).ok()
 }
 
+/// The benchmarks' stand-in without the shared data: a generated 40^3
+/// warped hexahedral grid (amplitude 0.05, seed 1) with the default scene
+/// settings, named `grid_40`.
+pub fn grid_40_scene() -> (&'static str, crate::render::Scene) {
+    let mesh = crate::generate::warped_hex_grid(
+        40,
+        &crate::generate::Warp {
+            amplitude: 0.05,
+            seed: 1,
+        },
+    );
+    let scene = crate::render::Scene::build(mesh, &crate::render::SceneSpec::default())
+        .expect("a generated grid builds");
+    ("grid_40", scene)
+}
+
 /// xorshift64* (Vigna): the seeded generator of the tests and benchmarks
 /// (fixed seeds, reproducible runs, no dependency). The seed must not be 0.
 #[derive(Clone, Debug)]

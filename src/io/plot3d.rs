@@ -295,9 +295,9 @@ fn diagnose(path: &Path, b: &[u8], q: bool) -> IoError {
             .find_map(|&f| f.header(b).map(|h| (f, h)))
     });
     if let Some((framing, (dims, off))) = first {
+        let order = if framing.big_endian { "big" } else { "little" };
+        let marks = if framing.markers { "with" } else { "without" };
         if dims.len() > 1 {
-            let order = if framing.big_endian { "big" } else { "little" };
-            let marks = if framing.markers { "with" } else { "without" };
             return IoError::parse(
                 path,
                 Location::Byte(off as u64),
@@ -312,8 +312,6 @@ fn diagnose(path: &Path, b: &[u8], q: bool) -> IoError {
         let d = dims[0];
         let n = d[0] as u128 * d[1] as u128 * d[2] as u128;
         let min = if q { 5 * 4 * n + 16 } else { 3 * 4 * n };
-        let order = if framing.big_endian { "big" } else { "little" };
-        let marks = if framing.markers { "with" } else { "without" };
         return IoError::parse(
             path,
             Location::Byte(off as u64),
