@@ -38,7 +38,7 @@ use crate::mesh::Mesh;
 use crate::tf::{EmissionModel, TransferFunction};
 use crate::visibility::Order;
 
-use super::super::ProjectedOptions;
+use super::super::{ProjectedOptions, ProjectedStats};
 
 /// The most a kept frame may hold (vertices and indices), bytes.
 pub const KEEP_MAX_BYTES: usize = 1 << 30;
@@ -102,6 +102,34 @@ pub struct KeptCounts {
     pub steep_triangles: usize,
     pub triangles: usize,
     pub hidden_pieces: usize,
+}
+
+impl KeptCounts {
+    /// The counts of a frame's statistics.
+    pub fn of(s: &ProjectedStats) -> KeptCounts {
+        KeptCounts {
+            culled_pieces: s.culled_pieces,
+            slabs: s.slabs,
+            refined_triangles: s.refined_triangles,
+            tie_pixels: s.tie_pixels,
+            steep_triangles: s.steep_triangles,
+            triangles: s.triangles,
+            hidden_pieces: s.hidden_pieces,
+        }
+    }
+
+    /// Writes them into the statistics of a frame that drew the kept
+    /// triangles, and says so.
+    pub fn restore(&self, s: &mut ProjectedStats) {
+        s.culled_pieces = self.culled_pieces;
+        s.slabs = self.slabs;
+        s.refined_triangles = self.refined_triangles;
+        s.tie_pixels = self.tie_pixels;
+        s.steep_triangles = self.steep_triangles;
+        s.triangles = self.triangles;
+        s.hidden_pieces = self.hidden_pieces;
+        s.projection_reused = true;
+    }
 }
 
 /// A frame's triangles as they went to the GPU, batch by batch.

@@ -703,15 +703,9 @@ pub fn render_projected<M: ProjectedMode>(
             for (v, i) in batches {
                 sink.push(v, i)?;
             }
-            let c = kept_frame.as_ref().map(|k| k.counts).unwrap_or_default();
-            stats.culled_pieces = c.culled_pieces;
-            stats.slabs = c.slabs;
-            stats.refined_triangles = c.refined_triangles;
-            stats.tie_pixels = c.tie_pixels;
-            stats.steep_triangles = c.steep_triangles;
-            stats.triangles = c.triangles;
-            stats.hidden_pieces = c.hidden_pieces;
-            stats.projection_reused = true;
+            if let Some(k) = kept_frame.as_ref() {
+                k.counts.restore(&mut stats);
+            }
             progress(order.pieces.len(), order.pieces.len());
             return finish(sink, stats, tp.elapsed().as_secs_f64(), t_gpu);
         }
@@ -796,15 +790,7 @@ pub fn render_projected<M: ProjectedMode>(
         }
     }
     if let Some(mut r) = record {
-        r.counts = KeptCounts {
-            culled_pieces: stats.culled_pieces,
-            slabs: stats.slabs,
-            refined_triangles: stats.refined_triangles,
-            tie_pixels: stats.tie_pixels,
-            steep_triangles: stats.steep_triangles,
-            triangles: stats.triangles,
-            hidden_pieces: stats.hidden_pieces,
-        };
+        r.counts = KeptCounts::of(&stats);
         *kept_frame = r.complete();
     }
     finish(sink, stats, tp.elapsed().as_secs_f64(), t_gpu)
