@@ -28,10 +28,14 @@ pub const MERGE_POINTS_REL: f64 = 1e-12;
 /// every comparison of compositor opacities with exact values.
 pub const EXP_TABLE_MAX_ABS_ERROR: f64 = 1.2e-4;
 
-/// Exact mode: a region edge is refined when (optical depth at its ends,
-/// capped at 1) x (largest glow-colour difference between its ends) exceeds
-/// this. Inside a region `C/alpha` is interpolated, which is exact only for
-/// constant glow colour; docs/math.md 8.1 measures errors up to ~7e-3 for
+/// Exact mode: a region edge is refined when (a bound on the optical depth
+/// along it: its ends' largest length times the transfer function's largest
+/// extinction on the piece's scalar range, capped at 1) x (largest
+/// glow-colour difference between its ends) exceeds this. (The depth at the
+/// ends is no bound: an edge from a thick end where the field maps to
+/// little extinction to a silhouette end, of no length, where it maps to
+/// much is optically deep in between.) Inside a region `C/alpha` is
+/// interpolated, which is exact only for constant glow colour; docs/math.md 8.1 measures errors up to ~7e-3 for
 /// depth <= 1 with colour spread 1. 0.02 left 0.06 on single pixels of
 /// coarse tet meshes seen up close (`tetraMesh`, 128 px, oblique
 /// orthographic view); 0.004 brings every pixel of the shared datasets

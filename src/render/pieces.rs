@@ -440,6 +440,19 @@ impl PieceSource<'_> {
         }
     }
 
+    /// The largest extinction (per unit length) the transfer function
+    /// takes on `[lo, hi]` (at its ends and on both sides of every node
+    /// inside), `f64::MAX` when not finite: a bound on the optical depth
+    /// per unit length of any segment whose scalars lie in `[lo, hi]`.
+    pub fn max_extinction(&self, lo: f64, hi: f64) -> f64 {
+        let t = self.fold_nodes(lo, hi, 0.0, |t, m| t.max(m.tau));
+        if t.is_finite() {
+            t
+        } else {
+            f64::MAX
+        }
+    }
+
     /// Folds `f` over the materials at the ends of `[lo, hi]` and on both
     /// sides of every transfer-function node inside: where a piecewise
     /// linear function takes its extremes.
@@ -447,8 +460,12 @@ impl PieceSource<'_> {
         let m = |s: f64| self.tf.material(s);
         let mut acc = f(init, m(lo));
         acc = f(acc, m(hi));
-        for &b in self.tf.breakpoints_slice() {
-            if b >= lo && b <= hi {
+        // The breakpoints are sorted: only those in `[lo, hi]` (none for
+        // NaN ends).
+        let breaks = self.tf.breakpoints_slice();
+        let first = breaks.partition_point(|&b| b < lo);
+        for &b in breaks[first..].iter().take_while(|&&b| b <= hi) {
+            if b >= lo {
                 let left = b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL;
                 acc = f(acc, m(b));
                 acc = f(acc, m(left));

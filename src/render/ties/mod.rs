@@ -474,10 +474,19 @@ pub fn decide_ties(
                 continue;
             }
         }
-        let (value, faces) = match (ray_through(poly, rays, c, &mut scratch.proj), grid_in) {
-            (RayThrough::Crosses(v, f), false) => (Some(v), f),
-            (RayThrough::Crosses(v, f), true) if forced => (Some(v), f),
-            (RayThrough::Misses, true) => (None, [0; 2]),
+        // Here the float test is not certain (or the centre is forced):
+        // the centre lies on an edge of the part's projection up to
+        // rounding. Where the part holds it, the exact segment is drawn
+        // even where the rasteriser agrees: on such an edge the projection
+        // may have regions of no area (a face seen edge-on up to the
+        // rounding of its points' coordinates, which fan triangulation
+        // leaves out), and the ray through the centre can cross the part
+        // for a length the drawn triangle's values at its edge do not
+        // give (a face tilted by 1e-15 against the ray leaves the ray
+        // inside the part for part of the face only).
+        let (value, faces) = match ray_through(poly, rays, c, &mut scratch.proj) {
+            RayThrough::Crosses(v, f) => (Some(v), f),
+            RayThrough::Misses if grid_in => (None, [0; 2]),
             _ => continue,
         };
         scratch.decisions.push(TieDecision {

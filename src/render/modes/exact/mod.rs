@@ -358,8 +358,26 @@ impl ProjectedMode for ExactMode {
         }));
         // Refine only pieces whose optical depth and glow spread could make
         // the interpolated C/alpha err (the common thin or uniform piece
-        // skips it).
-        let depth = vals.iter().map(|v| v.depth).fold(0.0, f64::max).min(1.0);
+        // skips it). The optical depth is bounded where the interpolation
+        // happens, inside the triangles, not only at their corners: the
+        // length there is at most the corners' largest (it is linear on a
+        // region), the extinction at most the transfer function's largest
+        // on the piece's scalar range. A corner's own depth is no bound: a
+        // triangle from a thick corner where the scalar maps to little
+        // extinction to silhouette corners (no length) where it maps to
+        // much is optically deep inside, with a small depth at every corner
+        // (a long cell seen end-on in an orthographic view).
+        let (s_lo, s_hi) = value_range(part.scalars.iter().copied());
+        let tau_max = src.max_extinction(s_lo, s_hi);
+        let depth_at = |l: f64| (l * tau_max).min(1.0);
+        let l_max = proj
+            .vertices
+            .iter()
+            .zip(used.iter())
+            .filter(|(_, &u)| u)
+            .map(|(v, _)| v.l)
+            .fold(0.0, f64::max);
+        let depth = depth_at(l_max);
         let spread = (0..3)
             .map(|k| {
                 let (lo, hi) = value_range(
@@ -388,7 +406,7 @@ impl ProjectedMode for ExactMode {
                             .map(|w| vertex_values(tf, w.l, w.s_front, w.s_back)),
                     );
                     let (va, vb) = (&vals[a as usize], &vals[b as usize]);
-                    let depth = va.depth.max(vb.depth).min(1.0);
+                    let depth = depth_at(v[a as usize].l.max(v[b as usize].l));
                     let spread = (0..3)
                         .map(|k| (va.glow[k] - vb.glow[k]).abs())
                         .fold(0.0, f64::max);
