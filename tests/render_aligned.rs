@@ -199,21 +199,30 @@ fn long_cells_seen_end_on_with_a_turning_colour() {
     if !gpu_available() {
         return;
     }
-    let mesh = half_annulus([3, 6, 1], 20.0, 0.0, true);
-    let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
-    let unit = scene.unit_distance;
-    scene.tf = turning_colour_tf(scene.range, unit);
     let mut failures = Vec::new();
-    for zoom in [2.0, 5.0] {
-        let camera = CameraParams {
-            width: 80,
-            height: 80,
-            zoom,
-            ortho: true,
-            ..Default::default()
-        };
-        let tag = format!("long half annulus zoom={zoom}");
-        failures.extend(check(&scene, camera, &[Mode::Exact, Mode::ExactFrag], &tag));
+    // One cell and two along the length; end-on and turned by half a
+    // degree (thin silhouette regions of no length at their outer corners).
+    let cases = [
+        ([3, 6, 1], 20.0, [(2.0, 0.0), (5.0, 0.0)]),
+        ([3, 6, 2], 12.0, [(5.0, 0.0), (5.0, 0.5)]),
+    ];
+    for (dims, length, views) in cases {
+        let mesh = half_annulus(dims, length, 0.0, true);
+        let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        let unit = scene.unit_distance;
+        scene.tf = turning_colour_tf(scene.range, unit);
+        for (zoom, azimuth) in views {
+            let camera = CameraParams {
+                width: 80,
+                height: 80,
+                zoom,
+                azimuth,
+                ortho: true,
+                ..Default::default()
+            };
+            let tag = format!("long half annulus {dims:?} zoom={zoom} az={azimuth}");
+            failures.extend(check(&scene, camera, &[Mode::Exact, Mode::ExactFrag], &tag));
+        }
     }
     assert_none(failures);
 }

@@ -13,9 +13,12 @@
 //!   triangle uses, the closed-form integral
 //!   ([`crate::integrate::vertex_values`]) gives the glow colour `C/alpha`
 //!   and the mean extinction `tau` along the vertex's ray of length `l`.
-//!   Region triangles whose vertices differ much in optical depth and glow
-//!   colour are refined (docs/math.md 8.1: `C/alpha` is interpolated inside a
-//!   region), see [`COLOR_REFINE_TOL`]. Each piece's `l` and `tau` are
+//!   Region triangles are refined where the optical depth inside them (a
+//!   bound: their corners' largest length times the largest extinction on
+//!   the piece's scalar range) times the spread of their corners' glow
+//!   colours, or the glow's departure from linear at an edge's midpoint, is
+//!   large (docs/math.md 8.1: `C/alpha` is interpolated inside a region),
+//!   see [`COLOR_REFINE_TOL`] and `EdgeColours`. Each piece's `l` and `tau` are
 //!   balanced for the table's axes ([`depth_balance`]);
 //! - **stage** (`shaders/exact.wgsl`, [`EXACT_STAGE`]): per fragment,
 //!   `alpha = 1 - exp(-l tau)` from the 2D exponential table
@@ -33,7 +36,7 @@ use crate::gpu::cpu::{lerp, CpuStage};
 use crate::gpu::{Binding, Context, GpuError, GpuVertex, Resource, Stage, StageDesc, Table};
 use crate::integrate::{vertex_values, VertexValues};
 use crate::numeric::tolerance::{COLOR_REFINE_MAX_DEPTH, COLOR_REFINE_TOL};
-use crate::projection::{refine_with, Polyhedron, Projected, RefineScratch};
+use crate::projection::{refine_with, Polyhedron, Projected, RefineScratch, RegionVertex};
 use crate::render::breakpoints::split_points;
 use crate::render::driver::ProjectedMode;
 use crate::render::pieces::{value_range, PieceSource};
@@ -368,8 +371,15 @@ impl ProjectedMode for ExactMode {
         // much is optically deep inside, with a small depth at every corner
         // (a long cell seen end-on in an orthographic view).
         let (s_lo, s_hi) = value_range(part.scalars.iter().copied());
-        let tau_max = src.max_extinction(s_lo, s_hi);
-        let depth_at = |l: f64| (l * tau_max).min(1.0);
+        // The glow colours anywhere in the piece are means of the colour
+        // over its scalar range: their spread bounds what interpolation
+        // can get wrong.
+        let edge = EdgeColours {
+            tf,
+            tau_max: src.max_extinction(s_lo, s_hi),
+            colour_spread: src.colour_spread(s_lo, s_hi),
+            tol: self.refine_tol,
+        };
         let l_max = proj
             .vertices
             .iter()
@@ -377,7 +387,7 @@ impl ProjectedMode for ExactMode {
             .filter(|(_, &u)| u)
             .map(|(v, _)| v.l)
             .fold(0.0, f64::max);
-        let depth = depth_at(l_max);
+        let depth = edge.depth_at(l_max);
         let spread = (0..3)
             .map(|k| {
                 let (lo, hi) = value_range(
@@ -389,8 +399,7 @@ impl ProjectedMode for ExactMode {
                 hi - lo
             })
             .fold(0.0, f64::max);
-        let tol = self.refine_tol;
-        if depth * spread > tol {
+        if depth * spread.max(edge.colour_spread) > edge.tol {
             let before = proj.triangles.len();
             // Each vertex's values once (a vertex has about six edges, and
             // an edge may be tested at every level): the refinement's new
@@ -405,12 +414,10 @@ impl ProjectedMode for ExactMode {
                             .iter()
                             .map(|w| vertex_values(tf, w.l, w.s_front, w.s_back)),
                     );
-                    let (va, vb) = (&vals[a as usize], &vals[b as usize]);
-                    let depth = depth_at(v[a as usize].l.max(v[b as usize].l));
-                    let spread = (0..3)
-                        .map(|k| (va.glow[k] - vb.glow[k]).abs())
-                        .fold(0.0, f64::max);
-                    depth * spread > tol
+                    edge.splits(
+                        (&v[a as usize], &vals[a as usize]),
+                        (&v[b as usize], &vals[b as usize]),
+                    )
                 },
                 &mut payload.refine,
             );
@@ -442,6 +449,62 @@ impl ProjectedMode for ExactMode {
             (vv.tau_mean / k) as f32,
             [vv.glow[0] as f32, vv.glow[1] as f32, vv.glow[2] as f32],
         )
+    }
+}
+
+/// The colour refinement's test of one region edge (see
+/// [`COLOR_REFINE_TOL`]) in a piece whose extinction is at most `tau_max`
+/// and whose glow colours lie within `colour_spread` of each other.
+struct EdgeColours<'a> {
+    tf: &'a TransferFunction,
+    tau_max: f64,
+    colour_spread: f64,
+    tol: f64,
+}
+
+impl EdgeColours<'_> {
+    /// A bound on the optical depth of a segment of length `l` (at most
+    /// 1: the interpolation error stops growing with the depth there).
+    fn depth_at(&self, l: f64) -> f64 {
+        (l * self.tau_max).min(1.0)
+    }
+
+    /// Whether the edge between region vertices `a` and `b` (with their
+    /// exact values) is split: where the depth bound times the spread of
+    /// the ends' glow colours exceeds the tolerance, or, where the piece's
+    /// colours spread enough for it to matter, where the exact glow at the
+    /// edge's midpoint is that far from the interpolated one. The ends can
+    /// agree while the middle does not: the glow is a mean of the colour
+    /// weighted by the attenuation, and both the scalars and the depth
+    /// change along the edge (a thick corner whose front weighting lands on
+    /// the colour of silhouette corners of no length, with a mean of other
+    /// colours between). The values are linear along the edge (up to the
+    /// perspective bound), so the midpoint's are the ends' means.
+    fn splits(
+        &self,
+        (ra, va): (&RegionVertex, &VertexValues),
+        (rb, vb): (&RegionVertex, &VertexValues),
+    ) -> bool {
+        let depth = self.depth_at(ra.l.max(rb.l));
+        let spread = (0..3)
+            .map(|k| (va.glow[k] - vb.glow[k]).abs())
+            .fold(0.0, f64::max);
+        if depth * spread > self.tol {
+            return true;
+        }
+        if depth * self.colour_spread <= self.tol {
+            return false;
+        }
+        let m = vertex_values(
+            self.tf,
+            0.5 * (ra.l + rb.l),
+            0.5 * (ra.s_front + rb.s_front),
+            0.5 * (ra.s_back + rb.s_back),
+        );
+        let off = (0..3)
+            .map(|k| (m.glow[k] - 0.5 * (va.glow[k] + vb.glow[k])).abs())
+            .fold(0.0, f64::max);
+        off * m.alpha > self.tol
     }
 }
 
@@ -477,6 +540,60 @@ fn depth_balance(src: &PieceSource, piece: &Polyhedron) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A thick corner (front-weighted onto the colour of the silhouette
+    /// corners at its front scalar) and a silhouette corner of no length:
+    /// the two glows agree within 1.3e-3, the midpoint's is 0.02 off (the
+    /// case of a long half annulus seen end-on, turned by half a degree).
+    #[test]
+    fn an_edge_whose_ends_agree_is_split_where_its_middle_does_not() {
+        let (hi, unit) = (1.0044, 1.246);
+        let tf = TransferFunction::from_channels(
+            &[(0.0, [0.0]), (hi, [1.0 / unit])],
+            &[
+                (0.0, [0.0, 0.0, 1.0]),
+                (0.2, [0.0, 1.0, 0.0]),
+                (hi, [1.0, 1.0, 0.0]),
+            ],
+            None,
+            EmissionModel::Glow,
+        )
+        .unwrap();
+        let vertex = |l: f64, s_front: f64, s_back: f64| RegionVertex {
+            px: 0.0,
+            py: 0.0,
+            z_front: 1.0,
+            z_back: 1.0 + l,
+            l,
+            s_front,
+            s_back,
+            profile: l == 0.0,
+        };
+        let thick = vertex(4.794, 0.8177, 0.5335);
+        let thin = vertex(0.0, 0.7385, 0.7385);
+        let values = |r: &RegionVertex| vertex_values(&tf, r.l, r.s_front, r.s_back);
+        let (vt, vs) = (values(&thick), values(&thin));
+        let ends = (0..3)
+            .map(|k| (vt.glow[k] - vs.glow[k]).abs())
+            .fold(0.0, f64::max);
+        let edge = EdgeColours {
+            tf: &tf,
+            tau_max: 1.0 / unit,
+            colour_spread: 1.0,
+            tol: COLOR_REFINE_TOL,
+        };
+        assert!(
+            edge.depth_at(thick.l) * ends <= COLOR_REFINE_TOL,
+            "ends {ends}"
+        );
+        assert!(edge.splits((&thick, &vt), (&thin, &vs)));
+        // Colours that spread too little to matter: not split.
+        let flat = EdgeColours {
+            colour_spread: 1e-3,
+            ..edge
+        };
+        assert!(!flat.splits((&thick, &vt), (&thin, &vs)));
+    }
 
     #[test]
     fn layout_matches_struct() {
