@@ -48,6 +48,18 @@ const MAX: f64 = 2.0 / 255.0;
 /// With f16 accumulation (as `tests/render_exact.rs`'s `F16_MAX`).
 const F16_MAX: f64 = 1.6e-2;
 
+/// The RMS bound: 2e-3 (as `tests/render_exact.rs`), 3e-3 with f16
+/// accumulation, whose rounding touches every pixel (measured 2.03e-3 on
+/// `prisms_zoo/hexa.vtk`, a few hexahedra filling the view, with the
+/// turning colour on GL).
+fn rms_bound() -> f64 {
+    if gpu_accumulates_f16() {
+        3e-3
+    } else {
+        2e-3
+    }
+}
+
 fn max_bound() -> f64 {
     if gpu_accumulates_f16() {
         F16_MAX
@@ -139,7 +151,7 @@ fn check(scene: &Scene, camera: CameraParams, modes: &[Mode], tag: &str) -> Vec<
     let bounds = Bounds {
         max_abs: max_bound(),
         p999: max_bound(),
-        rms: 2e-3,
+        rms: rms_bound(),
     };
     let fitted = Camera::fit(scene.mesh.bounds(), &camera);
     for &mode in modes {
