@@ -34,11 +34,7 @@ pub const EXP_TABLE_MAX_ABS_ERROR: f64 = 1.2e-4;
 /// glow-colour difference between its ends) exceeds this. (The depth at the
 /// ends is no bound: an edge from a thick end where the field maps to
 /// little extinction to a silhouette end, of no length, where it maps to
-/// much is optically deep in between.) Where the ends agree but the
-/// piece's colours spread enough to matter, the edge is also split when the
-/// exact glow at its midpoint, times its opacity, is more than this off the
-/// interpolated one (the glow is a mean weighted by the attenuation, not
-/// monotone along an edge). Inside a region `C/alpha` is
+/// much is optically deep in between.) Inside a region `C/alpha` is
 /// interpolated, which is exact only for constant glow colour; docs/math.md 8.1 measures errors up to ~7e-3 for
 /// depth <= 1 with colour spread 1. 0.02 left 0.06 on single pixels of
 /// coarse tet meshes seen up close (`tetraMesh`, 128 px, oblique

@@ -453,40 +453,6 @@ impl PieceSource<'_> {
         }
     }
 
-    /// The largest spread (over the channels, largest minus least) of the
-    /// transfer function's glow colour on `[lo, hi]` (at its ends and on
-    /// both sides of every node inside), `f64::MAX` when not finite: a
-    /// bound on how far apart the glow colours `C / alpha` of any two
-    /// segments whose scalars lie in `[lo, hi]` are (each is a weighted
-    /// mean of the colour over its scalars).
-    pub fn colour_spread(&self, lo: f64, hi: f64) -> f64 {
-        let mut lo_c = [f64::INFINITY; 3];
-        let mut hi_c = [f64::NEG_INFINITY; 3];
-        let mut take = |s: f64| {
-            let c = self.tf.color_at(s);
-            for k in 0..3 {
-                lo_c[k] = lo_c[k].min(c[k]);
-                hi_c[k] = hi_c[k].max(c[k]);
-            }
-        };
-        take(lo);
-        take(hi);
-        let breaks = self.tf.breakpoints_slice();
-        let first = breaks.partition_point(|&b| b < lo);
-        for &b in breaks[first..].iter().take_while(|&&b| b <= hi) {
-            if b >= lo {
-                take(b);
-                take(b - b.abs().max(LEFT_LIMIT_FLOOR) * LEFT_LIMIT_REL);
-            }
-        }
-        let spread = (0..3).map(|k| hi_c[k] - lo_c[k]).fold(0.0, f64::max);
-        if spread.is_finite() {
-            spread
-        } else {
-            f64::MAX
-        }
-    }
-
     /// Folds `f` over the materials at the ends of `[lo, hi]` and on both
     /// sides of every transfer-function node inside: where a piecewise
     /// linear function takes its extremes.

@@ -16,9 +16,8 @@
 //!   Region triangles are refined where the optical depth inside them (a
 //!   bound: their corners' largest length times the largest extinction on
 //!   the piece's scalar range) times the spread of their corners' glow
-//!   colours, or the glow's departure from linear at an edge's midpoint, is
-//!   large (docs/math.md 8.1: `C/alpha` is interpolated inside a region),
-//!   see [`COLOR_REFINE_TOL`] and `EdgeColours`. Each piece's `l` and `tau` are
+//!   colours is large (docs/math.md 8.1: `C/alpha` is interpolated inside a
+//!   region), see [`COLOR_REFINE_TOL`] and `EdgeColours`. Each piece's `l` and `tau` are
 //!   balanced for the table's axes ([`depth_balance`]);
 //! - **stage** (`shaders/exact.wgsl`, [`EXACT_STAGE`]): per fragment,
 //!   `alpha = 1 - exp(-l tau)` from the 2D exponential table
@@ -375,9 +374,7 @@ impl ProjectedMode for ExactMode {
         // over its scalar range: their spread bounds what interpolation
         // can get wrong.
         let edge = EdgeColours {
-            tf,
             tau_max: src.max_extinction(s_lo, s_hi),
-            colour_spread: src.colour_spread(s_lo, s_hi),
             tol: self.refine_tol,
         };
         let l_max = proj
@@ -399,7 +396,7 @@ impl ProjectedMode for ExactMode {
                 hi - lo
             })
             .fold(0.0, f64::max);
-        if depth * spread.max(edge.colour_spread) > edge.tol {
+        if depth * spread > edge.tol {
             let before = proj.triangles.len();
             // Each vertex's values once (a vertex has about six edges, and
             // an edge may be tested at every level): the refinement's new
@@ -453,58 +450,33 @@ impl ProjectedMode for ExactMode {
 }
 
 /// The colour refinement's test of one region edge (see
-/// [`COLOR_REFINE_TOL`]) in a piece whose extinction is at most `tau_max`
-/// and whose glow colours lie within `colour_spread` of each other.
-struct EdgeColours<'a> {
-    tf: &'a TransferFunction,
+/// [`COLOR_REFINE_TOL`]) in a piece whose extinction is at most `tau_max`.
+struct EdgeColours {
     tau_max: f64,
-    colour_spread: f64,
     tol: f64,
 }
 
-impl EdgeColours<'_> {
-    /// A bound on the optical depth of a segment of length `l` (at most
-    /// 1: the interpolation error stops growing with the depth there).
+impl EdgeColours {
+    /// A bound on the optical depth of a segment of length `l` in the
+    /// piece (at most 1: the interpolation error stops growing with the
+    /// depth there).
     fn depth_at(&self, l: f64) -> f64 {
         (l * self.tau_max).min(1.0)
     }
 
     /// Whether the edge between region vertices `a` and `b` (with their
-    /// exact values) is split: where the depth bound times the spread of
-    /// the ends' glow colours exceeds the tolerance, or, where the piece's
-    /// colours spread enough for it to matter, where the exact glow at the
-    /// edge's midpoint is that far from the interpolated one. The ends can
-    /// agree while the middle does not: the glow is a mean of the colour
-    /// weighted by the attenuation, and both the scalars and the depth
-    /// change along the edge (a thick corner whose front weighting lands on
-    /// the colour of silhouette corners of no length, with a mean of other
-    /// colours between). The values are linear along the edge (up to the
-    /// perspective bound), so the midpoint's are the ends' means.
+    /// exact values) is split: where the bound on the optical depth along
+    /// it (the length is linear along it, so at most its ends') times the
+    /// spread of its ends' glow colours exceeds the tolerance.
     fn splits(
         &self,
         (ra, va): (&RegionVertex, &VertexValues),
         (rb, vb): (&RegionVertex, &VertexValues),
     ) -> bool {
-        let depth = self.depth_at(ra.l.max(rb.l));
         let spread = (0..3)
             .map(|k| (va.glow[k] - vb.glow[k]).abs())
             .fold(0.0, f64::max);
-        if depth * spread > self.tol {
-            return true;
-        }
-        if depth * self.colour_spread <= self.tol {
-            return false;
-        }
-        let m = vertex_values(
-            self.tf,
-            0.5 * (ra.l + rb.l),
-            0.5 * (ra.s_front + rb.s_front),
-            0.5 * (ra.s_back + rb.s_back),
-        );
-        let off = (0..3)
-            .map(|k| (m.glow[k] - 0.5 * (va.glow[k] + vb.glow[k])).abs())
-            .fold(0.0, f64::max);
-        off * m.alpha > self.tol
+        self.depth_at(ra.l.max(rb.l)) * spread > self.tol
     }
 }
 
@@ -541,13 +513,13 @@ fn depth_balance(src: &PieceSource, piece: &Polyhedron) -> f64 {
 mod tests {
     use super::*;
 
-    /// A thick corner (front-weighted onto the colour of the silhouette
-    /// corners at its front scalar) and a silhouette corner of no length:
-    /// the two glows agree within 1.3e-3, the midpoint's is 0.02 off (the
-    /// case of a long half annulus seen end-on, turned by half a degree).
+    /// An edge from a thick corner where the field maps to little
+    /// extinction to a silhouette corner (no length) where it maps to much,
+    /// with different glow colours: both ends are optically shallow, the
+    /// middle is not (a long cell seen end-on in an orthographic view).
     #[test]
-    fn an_edge_whose_ends_agree_is_split_where_its_middle_does_not() {
-        let (hi, unit) = (1.0044, 1.246);
+    fn an_edge_deep_only_between_its_ends_is_split() {
+        let (hi, unit) = (1.0, 0.01);
         let tf = TransferFunction::from_channels(
             &[(0.0, [0.0]), (hi, [1.0 / unit])],
             &[
@@ -569,30 +541,27 @@ mod tests {
             s_back,
             profile: l == 0.0,
         };
-        let thick = vertex(4.794, 0.8177, 0.5335);
-        let thin = vertex(0.0, 0.7385, 0.7385);
+        let thick = vertex(0.005, 0.0, 0.0015);
+        let thin = vertex(0.0, 0.65, 0.65);
         let values = |r: &RegionVertex| vertex_values(&tf, r.l, r.s_front, r.s_back);
         let (vt, vs) = (values(&thick), values(&thin));
+        // The corners' own depths would not split it.
         let ends = (0..3)
             .map(|k| (vt.glow[k] - vs.glow[k]).abs())
             .fold(0.0, f64::max);
+        assert!(
+            vt.depth.max(vs.depth) * ends <= COLOR_REFINE_TOL,
+            "{vt:?} {vs:?}"
+        );
+        // The middle is deep (the exact midpoint) and the bound says so.
+        let mid = vertex_values(&tf, 0.0025, 0.325, 0.32575);
+        assert!(mid.depth > 0.05, "{mid:?}");
         let edge = EdgeColours {
-            tf: &tf,
             tau_max: 1.0 / unit,
-            colour_spread: 1.0,
             tol: COLOR_REFINE_TOL,
         };
-        assert!(
-            edge.depth_at(thick.l) * ends <= COLOR_REFINE_TOL,
-            "ends {ends}"
-        );
+        assert!(edge.depth_at(thick.l) >= mid.depth);
         assert!(edge.splits((&thick, &vt), (&thin, &vs)));
-        // Colours that spread too little to matter: not split.
-        let flat = EdgeColours {
-            colour_spread: 1e-3,
-            ..edge
-        };
-        assert!(!flat.splits((&thick, &vt), (&thin, &vs)));
     }
 
     #[test]
