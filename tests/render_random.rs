@@ -1,6 +1,7 @@
 //! Randomised comparison of the exact mode with the reference ray caster:
 //! seeded random dataset x view x size, `--split all` against `--model
-//! tets` (the same field), bounded over every pixel.
+//! tets` (the same field), bounded over every pixel; the last cases look
+//! along the axes at odd sizes.
 //!
 //! The exact mode is composited by the CPU twin of the GPU stage
 //! (`gpu::cpu`, the GPU's own pixels to ~1e-4, see `tests/coverage.rs` for
@@ -67,10 +68,14 @@ fn random_views_match_the_reference_on_every_pixel() {
             (name, Scene::build(mesh, &SceneSpec::default()).unwrap())
         })
         .collect();
-    for case in 0..15 {
+    // Cases 15 on look along the mesh's axes (azimuth and elevation
+    // multiples of 90 degrees) at odd sizes, whose middle row and column
+    // of pixel centres lie in the planes through the bounds' centre: rows
+    // of centres in the planes of faces, cells seen end-on.
+    for case in 0..21 {
         let (name, scene) = &scenes[(next() * scenes.len() as f64) as usize % scenes.len()];
         let size = 64 + (next() * 192.0) as u32;
-        let camera = CameraParams {
+        let mut camera = CameraParams {
             width: size,
             height: 64 + (next() * 192.0) as u32,
             azimuth: next() * 360.0,
@@ -79,6 +84,12 @@ fn random_views_match_the_reference_on_every_pixel() {
             ortho: next() < 0.5,
             ..Default::default()
         };
+        if case >= 15 {
+            camera.width |= 1;
+            camera.height |= 1;
+            camera.azimuth = (camera.azimuth / 90.0).floor() * 90.0;
+            camera.elevation = (camera.elevation / 90.0).round() * 90.0;
+        }
         let tag = format!("case {case}: {name} {camera:?}");
         let mut renderer = Renderer::new(scene.geometry());
         let exact = RenderOptions {
