@@ -369,10 +369,24 @@ impl ProjectedMode for ExactMode {
         // extinction to silhouette corners (no length) where it maps to
         // much is optically deep inside, with a small depth at every corner
         // (a long cell seen end-on in an orthographic view).
+        let spread = (0..3)
+            .map(|k| {
+                let (lo, hi) = value_range(
+                    vals.iter()
+                        .zip(used.iter())
+                        .filter(|(_, &u)| u)
+                        .map(|(v, _)| v.glow[k]),
+                );
+                hi - lo
+            })
+            .fold(0.0, f64::max);
+        // The depth bound is at most 1: a piece whose glow colours spread
+        // less than the tolerance needs neither it nor refinement (most
+        // pieces, and NaN).
+        if spread.is_nan() || spread <= self.refine_tol {
+            return;
+        }
         let (s_lo, s_hi) = value_range(part.scalars.iter().copied());
-        // The glow colours anywhere in the piece are means of the colour
-        // over its scalar range: their spread bounds what interpolation
-        // can get wrong.
         let edge = EdgeColours {
             tau_max: src.max_extinction(s_lo, s_hi),
             tol: self.refine_tol,
@@ -385,17 +399,6 @@ impl ProjectedMode for ExactMode {
             .map(|(v, _)| v.l)
             .fold(0.0, f64::max);
         let depth = edge.depth_at(l_max);
-        let spread = (0..3)
-            .map(|k| {
-                let (lo, hi) = value_range(
-                    vals.iter()
-                        .zip(used.iter())
-                        .filter(|(_, &u)| u)
-                        .map(|(v, _)| v.glow[k]),
-                );
-                hi - lo
-            })
-            .fold(0.0, f64::max);
         if depth * spread > edge.tol {
             let before = proj.triangles.len();
             // Each vertex's values once (a vertex has about six edges, and
