@@ -88,22 +88,15 @@ fn iso_over(front: vec4<f32>, back: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(front.xyz + t * back.xyz, front.w + t * back.w);
 }
 
-// Whether the segment crosses surface k at level v: exactly (lo < v <= hi),
-// or, for an opaque surface, within the snap bound e_f of its front end. Where
-// pieces meet at a face, the piece behind claims a crossing its front end
-// is that close to, so the pixel sees the surface at least once: when the
-// piece in front crossed it too, its copy (the true one, drawn first in
-// front-to-back order) hides this one; when the snap made the piece in
-// front miss it, this one fills the crack.
-fn iso_crosses(k: u32, v: f32, seg: Seg, e: vec2<f32>) -> bool {
+// Whether the segment crosses level v: lo < v <= hi. Where a surface meets
+// a face between two pieces, the centres next to the line where the face's
+// scalar is the isovalue get the exact segment's values in both pieces (the
+// driver's seams, src/render/ties), so the two cannot both miss it or both
+// take it.
+fn iso_crosses(v: f32, seg: Seg) -> bool {
     let lo = min(seg.s_f, seg.s_b);
     let hi = max(seg.s_f, seg.s_b);
-    if v > lo && v <= hi {
-        return true;
-    }
-    let s = surfaces[k];
-    let opaque = s.front.w >= 1.0 && s.back.w >= 1.0;
-    return opaque && abs(seg.s_f - v) <= e.x;
+    return v > lo && v <= hi;
 }
 
 // The segment with its surfaces, front to back. One loop, one call of
@@ -112,16 +105,15 @@ fn iso_crosses(k: u32, v: f32, seg: Seg, e: vec2<f32>) -> bool {
 // step b ends it at the segment's back. RKE's blend (iso.mix 1) instead
 // draws every surface's front-face layer (opacity times 1 - u), the whole
 // segment's volume at step b, then the back-face layers (times u).
-fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, e: vec2<f32>, range: vec2<f32>) -> vec4<f32> {
+fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, range: vec2<f32>) -> vec4<f32> {
     let lo = min(seg.s_f, seg.s_b);
     let hi = max(seg.s_f, seg.s_b);
-    let m = max(e.x, e.y);
     // The search window, within the part's scalar range (flat): a no-op
     // inside the triangle, a bound on the lanes a rasteriser shades
     // outside it with extrapolated scalars (whose loops would otherwise
     // run over every isovalue).
-    let wlo = max(lo, range.x) - m;
-    let whi = min(hi, range.y) + m;
+    let wlo = max(lo, range.x);
+    let whi = min(hi, range.y);
     // Most segments cross nothing: two reads decide it before any search.
     var a = 0u;
     var b = 0u;
@@ -147,15 +139,14 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, e: vec2<f32>, range: vec2
                 k = a + b - 1u - i;
             }
             let v = surfaces[k].value.x;
-            if !iso_crosses(k, v, seg, e) {
+            if !iso_crosses(v, seg) {
                 continue;
             }
             u = 0.0;
             if d != 0.0 {
                 u = clamp((v - seg.s_f) / d, 0.0, 1.0);
             }
-            // The scalar there: v, or the end a near crossing snaps to.
-            sv = clamp(v, lo, hi);
+            sv = v;
         }
         if !blend || i == b {
             var from_u = u0;
@@ -200,7 +191,7 @@ fn fs_iso(f: VertexOut) -> FragOut {
         gb = gb / f.back.y;
     }
     var out: FragOut;
-    out.color = iso_segment(seg, gf, gb, f.snap, f.range);
+    out.color = iso_segment(seg, gf, gb, f.range);
     out.depth = piece_depth(f.piece);
     return out;
 }

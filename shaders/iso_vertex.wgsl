@@ -7,11 +7,9 @@
 // fills it): grad_front = g_f (orthographic) or g_f q_f (perspective), and
 // grad_back likewise with q_b. The gradient is linear on each boundary
 // triangle (smooth shading) or constant (flat), so, as s q, g q is affine in
-// screen position and the fragment divides by the interpolated q. snap =
-// (e_f, e_b) bounds how far the snap of region corners to the sub-pixel grid
-// can move s_f and s_b (normalised units): shaders/iso.wgsl lets an opaque
-// surface within that of a segment's end count as crossed, so that two
-// pieces meeting at a face where s = V cannot both miss it.
+// screen position and the fragment divides by the interpolated q. range is
+// the part's normalised scalar range (flat), where the isovalues are
+// searched.
 
 // Keep in sync with `IsoVertex` in src/render/modes/iso.rs.
 struct VertexIn {
@@ -22,8 +20,7 @@ struct VertexIn {
     @location(4) piece: u32,
     @location(5) grad_front: vec3<f32>,
     @location(6) grad_back: vec3<f32>,
-    @location(7) snap: vec2<f32>,
-    @location(8) range: vec2<f32>,
+    @location(7) range: vec2<f32>,
 }
 
 // Default (perspective-correct, with w = 1 screen-linear) interpolation, as
@@ -36,8 +33,7 @@ struct VertexOut {
     @location(3) @interpolate(flat) piece: u32,
     @location(4) grad_front: vec3<f32>,
     @location(5) grad_back: vec3<f32>,
-    @location(6) snap: vec2<f32>,
-    @location(7) @interpolate(flat) range: vec2<f32>,
+    @location(6) @interpolate(flat) range: vec2<f32>,
 }
 
 @vertex
@@ -50,7 +46,6 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.piece = v.piece;
     out.grad_front = v.grad_front;
     out.grad_back = v.grad_back;
-    out.snap = v.snap;
     out.range = v.range;
     return out;
 }

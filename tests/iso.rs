@@ -9,11 +9,12 @@
 //! Bounds (linear premultiplied RGBA, any channel of any pixel): a pixel is
 //! *off* when it differs from the reference by more than `PIXEL_TOL`
 //! (`PIXEL_TOL_F16` where the GPU accumulates in f16); the
-//! tests allow a measured number of off pixels per image, each where a
-//! surface meets the mesh boundary or a face within the snap of region
-//! corners to the 1/256-pixel grid (the crossing there is at `u = 0` or `1`
-//! of a segment whose end scalars the snap shifts; RKE's "patch edge"
-//! artefacts), and bound every other pixel by `PIXEL_TOL`.
+//! tests allow a measured number of off pixels per image, each where a ray
+//! grazes a surface (its scalars within the `f32` stages' rounding of the
+//! value) or meets it at the mesh boundary, and bound every other pixel by
+//! `PIXEL_TOL`. Where a surface meets a face between two pieces (RKE's
+//! "patch edge" artefacts), the centres next to the face's iso line are
+//! decided exactly in both pieces (`render::ties` seams).
 
 mod render_util;
 
@@ -29,7 +30,7 @@ use zoovr::render::iso::{IsoMix, IsoOptions, IsoSpec, Lighting};
 use zoovr::render::{
     Compositor, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
 };
-use zoovr::testdata::mesh_file;
+use zoovr::testdata::{mesh_file, shared_file};
 
 use render_util::gpu_available;
 
@@ -341,6 +342,73 @@ fn isosurfaces_match_the_reference_on_the_project_meshes() {
     }
 }
 
+/// Surfaces in a nearly uniform field: bluntfin's density is 1 within a
+/// few 1e-4 over much of the grid (the free stream), so a surface at or
+/// next to 1 meets faces on long lines, at grazing angles, and along rays
+/// whose scalars stay within 1e-6 of the value. Two rules used to draw it
+/// wrong there (145 to 656 of about 4,000 covered pixels off, 49 to 476 of
+/// them by more than 0.05, up to 0.95):
+/// a piece claimed an opaque crossing where its front scalar was within a
+/// snap bound of the value (which grows the surface wherever the field
+/// comes that close without crossing), and the `f32` stages counted a
+/// scalar within 1e-6 of the whole normalised range below the value as
+/// reaching it (which hides the dips of this field below its free
+/// stream). Now the centres next to the lines where a face's scalar is an
+/// isovalue are decided exactly in both pieces (the seams of
+/// `render::ties`), and the margin is relative to the value. Exact-frag,
+/// surfaces mixed with the volume, opaque, whole cells against `faces`.
+/// Skipped without the shared data.
+#[test]
+fn surfaces_in_a_nearly_uniform_field() {
+    let Some(path) = shared_file("bluntfin/bluntfin_converted.vts") else {
+        eprintln!("skipping: no shared data");
+        return;
+    };
+    let mesh = io::read(&path, &ReadOptions::default()).unwrap();
+    let scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+    let mut r = Renderer::new(scene.geometry());
+    let mut worst = 0;
+    for list in ["0.9999", "1", "1.0001"] {
+        for ortho in [false, true] {
+            let set = iso(list, Lighting::Smooth, false);
+            let mut ref_opts = options(Mode::Raycast, ortho, &set, Compositor::Cpu);
+            ref_opts.reference = ReferenceOptions {
+                model: FieldModel::Faces,
+                ..Default::default()
+            };
+            let expected = render(&mut r, &scene, &ref_opts);
+            let covered = expected.pixels.iter().filter(|p| p[3] > 0.0).count();
+            for c in compositors() {
+                let got = render(&mut r, &scene, &options(Mode::ExactFrag, ortho, &set, c));
+                let (off, max) = off_pixels(&got, &expected, pixel_tol(c));
+                let far: Vec<_> = off.iter().filter(|o| o.2 > 0.05).collect();
+                eprintln!(
+                    "bluntfin {list} ortho={ortho} {c:?}: {} off ({} by more than 0.05) of \
+                     {covered} covered, max {max:.2e} elsewhere {:?}",
+                    off.len(),
+                    far.len(),
+                    &off[..off.len().min(4)]
+                );
+                assert!(max <= pixel_tol(c), "{list} {c:?}: {max:.3e}");
+                assert!(
+                    off.len() <= NEAR_UNIFORM_MAX_OFF,
+                    "{list} ortho={ortho} {c:?}: {} off",
+                    off.len()
+                );
+                worst = worst.max(off.len());
+            }
+        }
+    }
+    eprintln!("bluntfin: at most {worst} off pixels per image");
+}
+
+/// Off pixels allowed per 96 x 96 image of bluntfin's nearly uniform field
+/// (about 4,000 pixels covered), measured at most 32 (at most 3 of them by
+/// more than 0.05): rays that graze the surface, whose scalars come within
+/// the `f32` stages' rounding of the value (`ISO_LEVEL_F32`, relative to
+/// it), and centres within that rounding of a face's iso line.
+const NEAR_UNIFORM_MAX_OFF: usize = 40;
+
 /// Whole cells against the `faces` field, on a mesh whose faces are planar
 /// (an unwarped grid: no cell is split) with a nonlinear field.
 #[test]
@@ -424,9 +492,9 @@ fn compare_with_reference(scene: &Scene, name: &str, lists: &[String], split: bo
 }
 
 /// Off pixels allowed per image of 96 x 96 (see the module docs): measured
-/// at most 7 (zoo_3x3x3, 10 translucent surfaces, whose boundaries on the
-/// mesh's faces are long), 0 to 2 for one or two surfaces.
-const MAX_OFF: usize = 16;
+/// at most 11 (curvilinear_4x4x4, 10 translucent surfaces), 0 to 4
+/// elsewhere.
+const MAX_OFF: usize = 12;
 
 /// An isovalue at the field's minimum is never crossed: the image is the
 /// volume's alone, pixel for pixel. At the maximum only rays touching it

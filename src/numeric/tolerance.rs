@@ -426,21 +426,11 @@ pub const ISO_LEVEL_F64: f64 = 1e-12;
 /// interpolation of equal values, with room.
 pub const ISO_LEVEL_ULPS: f64 = 4.0;
 
-/// The same margin for the GPU stages and their twins, in normalised scalar
-/// units (`f32`, about 16 ulps of 1), relative to `max(1, |V|)`: the
-/// fragment's `s = (s q) / q` is interpolated in `f32`.
+/// The same margin for the GPU stages and their twins, relative to the
+/// normalised isovalue `|V|` (`f32`, about 16 ulps): the fragment's
+/// `s = (s q) / q` is interpolated in `f32`, and where the corners all hold
+/// `V` (the case the margin is for) it rounds to within a few ulps of `V`.
+/// Relative to `V`, not to the normalised range: a margin of 1e-6 of the
+/// range hid the dips of a nearly uniform field (bluntfin's free stream,
+/// within 2e-7 of the range of a surface at 0.9999) from the stages.
 pub const ISO_LEVEL_F32: f64 = 1e-6;
-
-/// How far (pixels) the snap of region corners to the 1/256-pixel grid can
-/// move where a fragment's boundary-triangle values are evaluated, with a
-/// margin: a corner moves at most 1/512 pixel per axis (sqrt(2)/512 in all),
-/// and a pixel centre within 1/256 pixel of a region's edge may be drawn by
-/// the neighbouring region, whose face is extrapolated that far. An opaque
-/// isosurface within this times the face's screen gradient of a segment's
-/// end counts as crossed (shaders/iso.wgsl `iso_crosses`).
-pub const ISO_SNAP_PX: f64 = 1.0 / 128.0;
-
-/// The largest snap bound (normalised scalar units): faces seen edge-on
-/// have unbounded screen gradients over slivers that colour no pixel of
-/// their own; past this an opaque surface would grow visibly.
-pub const ISO_SNAP_MAX: f64 = 1e-3;

@@ -434,6 +434,11 @@ pub struct Projected {
     /// next to them are decided on the exact geometry, as next to the
     /// outline ([`crate::render::ties`]). Set by the mode, empty otherwise.
     pub seams: Vec<(u32, u32)>,
+    /// Seams given by their end points (pixel positions) rather than by
+    /// vertices: the isosurface modes' lines where a boundary triangle's
+    /// scalar equals an isovalue (`render::modes::iso`). Decided as
+    /// [`Projected::seams`].
+    pub seam_lines: Vec<[DVec2; 2]>,
     /// For the values of tie decisions ([`crate::render::ties`], no
     /// regions): the piece's boundary triangles (indices into
     /// [`Polyhedron::triangles`]) where each vertex's ray enters and leaves.
@@ -455,6 +460,7 @@ impl Projected {
         self.faces.clear();
         self.region_faces.clear();
         self.seams.clear();
+        self.seam_lines.clear();
         self.tie_faces.clear();
         self.spans.clear();
         self.culled.clear();

@@ -27,8 +27,8 @@ use glam::{DVec2, DVec3};
 
 use crate::gpu::cpu::{lerp, CpuStage};
 use crate::gpu::{Binding, ClipMapper, Context, GpuError, GpuVertex, Resource, Stage, StageDesc};
-use crate::numeric::tolerance::{ISO_LEVEL_F32, ISO_SNAP_MAX, ISO_SNAP_PX};
-use crate::projection::{FaceTri, Polyhedron, Projected};
+use crate::numeric::tolerance::ISO_LEVEL_F32;
+use crate::projection::{Polyhedron, Projected};
 use crate::render::driver::ProjectedMode;
 use crate::render::gradients::{barycentric, boundary_gradient, piece_gradient};
 use crate::render::iso::{IsoMix, IsoSet, Lighting, AMBIENT, DIFFUSE};
@@ -59,15 +59,15 @@ pub static INFO: ModeInfo = ModeInfo {
         // them, more surfaces): f32 crossings and light.
         split_max: 2.0 / 255.0,
         whole_max: 2.0 / 255.0,
-        // Where a surface meets a face or the mesh boundary within the
-        // 1/256-pixel snap of region corners, the crossing sits at the very
-        // end of a segment whose end scalar the snap moves: the surface's
-        // edge may there move by a pixel. Measured at most 6.
-        split_outliers: 8,
+        // Where a ray grazes the surface (its scalars within the f32
+        // stages' rounding of the value) or meets it at the mesh boundary,
+        // the surface's edge may move by a pixel. Measured at most 1 (6
+        // before the face's iso lines were decided exactly).
+        split_outliers: 4,
         // Whole cells against `faces`: in the cells the order splits into
         // tets (zoo_3x3x3's nonplanar cells) the surface is the `tets`
-        // field's, elsewhere than the `faces` field's. Measured 45 there,
-        // at most 6 on meshes without split cells.
+        // field's, elsewhere than the `faces` field's. Measured 41 there,
+        // at most 1 on meshes without split cells.
         whole_outliers: 48,
     }),
 };
@@ -84,9 +84,6 @@ pub struct IsoVertex {
     pub grad_front: [f32; 3],
     /// `g_b` or `g_b q_b`.
     pub grad_back: [f32; 3],
-    /// How far the snap of region corners to the sub-pixel grid can move
-    /// `s_f` and `s_b` here ([`snap_bound`]), normalised units.
-    pub snap: [f32; 2],
     /// The part's normalised scalar range, widened by [`RANGE_MARGIN`]
     /// (flat): every segment of the part lies in it, so the stage searches
     /// the isovalues only there. A rasteriser may shade lanes outside the
@@ -104,7 +101,7 @@ pub const RANGE_MARGIN: f64 = 1e-3;
 
 impl IsoVertex {
     /// Vertex attributes (`@location`s of `VertexIn`).
-    pub const ATTRIBUTES: [wgpu::VertexAttribute; 9] = wgpu::vertex_attr_array![
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 8] = wgpu::vertex_attr_array![
         0 => Float32x4,
         1 => Float32x2,
         2 => Float32x2,
@@ -113,7 +110,6 @@ impl IsoVertex {
         5 => Float32x3,
         6 => Float32x3,
         7 => Float32x2,
-        8 => Float32x2,
     ];
 
     /// The vertex buffer layout of the isosurface stages.
@@ -141,7 +137,6 @@ impl GpuVertex for IsoVertex {
         self.seg.is_finite()
             && self.grad_front.iter().all(|v| v.is_finite())
             && self.grad_back.iter().all(|v| v.is_finite())
-            && self.snap.iter().all(|v| v.is_finite())
             && self.range.iter().all(|v| !v.is_nan())
     }
     fn with_clip(self, pos: [f32; 4]) -> Self {
@@ -155,21 +150,18 @@ impl GpuVertex for IsoVertex {
             seg: SegmentVertex::lerp3(tri.map(|v| &v.seg), bary),
             grad_front: [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_front[k])),
             grad_back: [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_back[k])),
-            snap: [0, 1].map(|k| lerp(tri, bary, |v| v.snap[k])),
             // Flat: the first vertex's (every vertex of a part has the
             // part's).
             range: tri[0].range,
         }
     }
     fn transparent(self) -> Self {
-        // The empty segment at one scalar: no volume, no crossing (not
-        // even a near one).
+        // The empty segment at one scalar: no volume, no crossing.
         IsoVertex {
             seg: SegmentVertex {
                 back: self.seg.front,
                 ..self.seg.transparent()
             },
-            snap: [-1.0; 2],
             ..self
         }
     }
@@ -232,10 +224,10 @@ pub fn iso_buffers(set: &IsoSet, map: &ScalarMap) -> (IsoParams, Vec<IsoSurface>
 }
 
 /// The level the stage compares with for normalised isovalue `v`: `v` in
-/// `f32` less [`ISO_LEVEL_F32`] of its scale (see [`IsoSet::levels`]).
+/// `f32` less [`ISO_LEVEL_F32`] of itself (see [`IsoSet::levels`]): exact at 0.
 pub fn gpu_level(v: f64) -> f32 {
     let v32 = v as f32;
-    (v32 as f64 - ISO_LEVEL_F32 * v.abs().max(1.0)) as f32
+    (v32 as f64 - ISO_LEVEL_F32 * v.abs()) as f32
 }
 
 macro_rules! iso_stage {
@@ -419,14 +411,9 @@ pub fn iso_over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
 }
 
 /// Twin of `iso_crosses`.
-pub fn iso_crosses(stage: &IsoTwin, k: u32, v: f32, seg: &Seg, e: [f32; 2]) -> bool {
+pub fn iso_crosses(v: f32, seg: &Seg) -> bool {
     let (lo, hi) = (seg.s_f.min(seg.s_b), seg.s_f.max(seg.s_b));
-    if v > lo && v <= hi {
-        return true;
-    }
-    let s = &stage.surfaces[k as usize];
-    let opaque = s.front[3] >= 1.0 && s.back[3] >= 1.0;
-    opaque && (seg.s_f - v).abs() <= e[0]
+    v > lo && v <= hi
 }
 
 /// Twin of `iso_segment`.
@@ -435,16 +422,14 @@ pub fn iso_segment(
     seg: &Seg,
     gf: [f32; 3],
     gb: [f32; 3],
-    e: [f32; 2],
     range: [f32; 2],
 ) -> [f32; 4] {
     let (lo, hi) = (seg.s_f.min(seg.s_b), seg.s_f.max(seg.s_b));
-    let m = e[0].max(e[1]);
     let n = stage.params.count as usize;
     let (mut a, mut b) = (0, 0);
     // The search window within the part's range (a no-op inside the
     // triangle).
-    let (wlo, whi) = (lo.max(range[0]) - m, hi.min(range[1]) + m);
+    let (wlo, whi) = (lo.max(range[0]), hi.min(range[1]));
     if n > 0 && whi >= stage.surfaces[0].value[0] && wlo <= stage.surfaces[n - 1].value[0] {
         a = count_at_most(stage, wlo);
         b = count_at_most(stage, whi).max(a);
@@ -459,7 +444,7 @@ pub fn iso_segment(
         if i < b {
             k = if rising { i } else { a + b - 1 - i };
             let v = stage.surfaces[k as usize].value[0];
-            if !iso_crosses(stage, k, v, seg, e) {
+            if !iso_crosses(v, seg) {
                 continue;
             }
             u = if d != 0.0 {
@@ -467,7 +452,7 @@ pub fn iso_segment(
             } else {
                 0.0
             };
-            sv = v.clamp(lo, hi);
+            sv = v;
         }
         if !blend || i == b {
             let (from_u, from_s) = if blend { (0.0, seg.s_f) } else { (u0, s0) };
@@ -505,8 +490,7 @@ pub fn fs_iso(stage: &IsoTwin, tri: [&IsoVertex; 3], bary: [f64; 3]) -> Option<[
         gf = gf.map(|g| g / qf);
         gb = gb.map(|g| g / qb);
     }
-    let e = [0, 1].map(|k| lerp(tri, bary, |v| v.snap[k]));
-    Some(iso_segment(stage, &seg, gf, gb, e, tri[0].range))
+    Some(iso_segment(stage, &seg, gf, gb, tri[0].range))
 }
 
 impl CpuStage<IsoVertex> for IsoTwin {
@@ -521,13 +505,11 @@ impl CpuStage<IsoVertex> for IsoTwin {
 }
 
 /// The payload of one part: the segment payload, and the entry and exit
-/// gradients of every vertex (normalised scalar units, view space) with
-/// their snap bounds.
+/// gradients of every vertex (normalised scalar units, view space).
 #[derive(Default)]
 pub struct IsoPayload {
     seg: SegmentPayload,
     grads: Vec<[DVec3; 2]>,
-    snap: Vec<[f64; 2]>,
     /// The part's [`IsoVertex::range`].
     range: [f32; 2],
     /// Scratch: the vertices whose gradients are set.
@@ -544,29 +526,6 @@ fn part_range(part: &Polyhedron, map: &ScalarMap) -> [f32; 2] {
     let (lo, hi) = (map.apply(lo), map.apply(hi));
     let widen = |v: f64, sign: f64| v + sign * RANGE_MARGIN * v.abs().max(1.0);
     [widen(lo, -1.0) as f32, widen(hi, 1.0) as f32]
-}
-
-/// How far the scalar a fragment rebuilds on a boundary triangle can move
-/// when the region corners are snapped to the sub-pixel grid: the
-/// triangle's scalar gradient across the screen (per pixel) times
-/// [`ISO_SNAP_PX`], capped at [`ISO_SNAP_MAX`] (a face seen edge-on has an
-/// unbounded screen gradient over a sliver of no area).
-pub fn snap_bound(face: &FaceTri, scale: f64) -> f64 {
-    let [a, b, c] = face.p;
-    let (e1, e2) = (b - a, c - a);
-    let det = e1.perp_dot(e2);
-    if det == 0.0 || !det.is_finite() {
-        return ISO_SNAP_MAX;
-    }
-    let (d1, d2) = (face.s[1] - face.s[0], face.s[2] - face.s[0]);
-    // Solve [e1; e2] g = [d1; d2] for the screen gradient g.
-    let g = DVec2::new(d1 * e2.y - d2 * e1.y, e1.x * d2 - e2.x * d1) / det;
-    let bound = g.length() * scale * ISO_SNAP_PX;
-    if bound.is_finite() {
-        bound.min(ISO_SNAP_MAX)
-    } else {
-        ISO_SNAP_MAX
-    }
 }
 
 /// Isosurfaces alone or over a volume, on the projected-cell driver.
@@ -732,24 +691,21 @@ impl ProjectedMode for IsoMode {
         payload.seg.set(src);
         let scale = payload.seg.map.scale;
         payload.range = part_range(part, &payload.seg.map);
-        // The snap bound of a vertex: the largest of its regions' faces'
-        // (tie-quad vertices, which have no regions, are exact: 0).
-        payload.snap.clear();
-        payload.snap.resize(proj.vertices.len(), [0.0; 2]);
-        for (r, reg) in proj.regions.iter().enumerate() {
-            let Some(&[f, b]) = proj.region_faces.get(r) else {
-                continue;
-            };
-            let e = [f, b].map(|t| {
-                proj.faces
-                    .get(t as usize)
-                    .map_or(ISO_SNAP_MAX, |face| snap_bound(face, scale))
-            });
-            for &v in reg {
-                let s = &mut payload.snap[v as usize];
-                s[0] = s[0].max(e[0]);
-                s[1] = s[1].max(e[1]);
-            }
+        // Where a boundary triangle's scalar is an isovalue, a surface
+        // meets the face shared with the next piece: the two pieces
+        // interpolate the face's scalar on different triangles with
+        // snapped corners, so a centre next to that line could fall below
+        // the value in one and above it in the other (a crack, or the
+        // surface twice). The driver decides such centres exactly
+        // ([`crate::render::ties`]), with the ray caster's crossing of the
+        // face, the same in both. (Tie values have no faces.)
+        for face in &proj.faces {
+            super::iso_seams::iso_lines(
+                face,
+                &self.set.values,
+                payload.seg.ortho,
+                &mut proj.seam_lines,
+            );
         }
         payload.grads.clear();
         payload.grads.resize(proj.vertices.len(), [DVec3::ZERO; 2]);
@@ -812,12 +768,10 @@ impl ProjectedMode for IsoMode {
             let g = g * q;
             [g.x as f32, g.y as f32, g.z as f32].map(|c| if c.is_finite() { c } else { 0.0 })
         };
-        let e = payload.snap.get(i).copied().unwrap_or([0.0; 2]);
         IsoVertex {
             seg,
             grad_front: f32x3(g[0], qf),
             grad_back: f32x3(g[1], qb),
-            snap: e.map(|x| x as f32),
             range: payload.range,
         }
     }
@@ -829,9 +783,9 @@ mod tests {
 
     #[test]
     fn layout_matches_struct() {
-        assert_eq!(std::mem::size_of::<IsoVertex>(), 80);
+        assert_eq!(std::mem::size_of::<IsoVertex>(), 72);
         let offs: Vec<u64> = IsoVertex::ATTRIBUTES.iter().map(|a| a.offset).collect();
-        assert_eq!(offs, vec![0, 16, 24, 32, 36, 40, 52, 64, 72]);
+        assert_eq!(offs, vec![0, 16, 24, 32, 36, 40, 52, 64]);
         assert_eq!(std::mem::size_of::<IsoSurface>(), 48);
     }
 }

@@ -50,10 +50,13 @@
 //! Two more kinds of centre are decided exactly, and get the exact
 //! segment's quad wherever the part holds them (not only where the two
 //! tests disagree):
-//! - next to a mode's **seams** ([`Projected::seams`]): edges inside the
-//!   outline across which the payload jumps (an isosurface region of the
-//!   exact mode beside a region without it), where a centre must go to
-//!   the same side in every part that shares the edge;
+//! - next to a mode's **seams** ([`Projected::seams`],
+//!   [`Projected::seam_lines`]): edges inside the outline across which the
+//!   payload jumps (an isosurface region of the exact mode beside a region
+//!   without it), or lines where a face's scalar is an isovalue (the other
+//!   isosurface modes, whose two pieces on either side of the face
+//!   interpolate its scalar on different snapped triangles), where a
+//!   centre must go to the same side in every part that shares the edge;
 //! - inside **slivers**, exact triangles narrower than [`SLIVER_TIE_PX`]:
 //!   the snap of their corners shifts the interpolated values by their
 //!   screen gradient times the snap, which across a sliver is a large part
@@ -435,6 +438,9 @@ pub fn decide_ties(
     let forced = &mut scratch.forced;
     for &(ia, ib) in &part.proj.seams {
         near_centres(pos(ia), pos(ib), part.width, part.height, forced);
+    }
+    for &[a, b] in &part.proj.seam_lines {
+        near_centres(a, b, part.width, part.height, forced);
     }
     centres.extend_from_slice(forced);
     if centres.is_empty() {
