@@ -434,3 +434,10 @@ pub const ISO_LEVEL_ULPS: f64 = 4.0;
 /// range hid the dips of a nearly uniform field (bluntfin's free stream,
 /// within 2e-7 of the range of a surface at 0.9999) from the stages.
 pub const ISO_LEVEL_F32: f64 = 1e-6;
+
+/// How close (relative to the scalar) a sliver's interpolated entry or exit
+/// scalar at a pixel centre must come to an isovalue, beyond the snap's
+/// shift of it, for the centre to be decided on the exact geometry
+/// (`render::ties::scan_triangles`): ten times [`ISO_LEVEL_F32`], above
+/// the `f32` rounding of the stages' scalars.
+pub const ISO_SLIVER_REL: f64 = 1e-5;

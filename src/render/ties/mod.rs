@@ -63,7 +63,11 @@
 //!   of the values' change (a region of a face seen nearly edge-on; an
 //!   optically thick tet seen almost along a face); a sliver whose corners
 //!   collapse on the grid is not drawn at all, and its centres would take
-//!   the values of the triangle beside it.
+//!   the values of the triangle beside it. In the isosurface modes the
+//!   same shift of the entry or exit scalar can put a centre on the other
+//!   side of an isovalue than the piece beside it puts it: a sliver's
+//!   centres whose exact scalars come within that shift of an isovalue
+//!   are decided too ([`PartTriangles::isovalues`]).
 
 mod band;
 
@@ -73,7 +77,9 @@ use band::{centres_within, in_grown_triangle, inside_by_float, near_centres, nea
 
 use crate::camera::Camera;
 use crate::gpu::{GpuVertex, SUBPIXEL};
-use crate::numeric::tolerance::{PLUCKER_FILTER_K, RASTER_FILTER_MAX_COORD_PX, RASTER_FILTER_PX};
+use crate::numeric::tolerance::{
+    ISO_SLIVER_REL, PLUCKER_FILTER_K, RASTER_FILTER_MAX_COORD_PX, RASTER_FILTER_PX,
+};
 use crate::projection::{Polyhedron, Projected, RegionVertex};
 use crate::raycast::geometry::{bounding_sphere, Proj, RayFrame};
 
@@ -414,6 +420,21 @@ pub struct PartTriangles<'a> {
     /// (its outline is then not the whole part's): every centre goes to
     /// the exact test.
     pub clipped: bool,
+    /// The isovalues the mode finds per fragment (sorted; empty for the
+    /// others): in a sliver, the snap of the corners shifts the
+    /// interpolated entry and exit scalars by their change across it
+    /// times the snap over its width, which can put a centre on the other
+    /// side of an isovalue than the piece beside it puts it; those centres
+    /// are decided exactly too.
+    pub isovalues: &'a [f64],
+}
+
+/// The distance from `s` to the nearest of the sorted `values`.
+fn to_nearest(values: &[f64], s: f64) -> f64 {
+    let k = values.partition_point(|&v| v < s);
+    let above = values.get(k).map_or(f64::INFINITY, |&v| v - s);
+    let below = k.checked_sub(1).map_or(f64::INFINITY, |k| s - values[k]);
+    above.min(below)
 }
 
 /// Decides the centres near the part's outline (see the module docs) into
@@ -608,10 +629,12 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
     let (l_lo, l_hi) = part.l_range;
     let reach = part.rate_bound * (l_hi - l_lo) * SNAP_PX / SLIVER_DEPTH_TOL;
     // NaN stays NaN: no triangle is narrower.
-    let widest = if slivers {
+    let widest = if !slivers {
+        0.0
+    } else if part.isovalues.is_empty() {
         reach.clamp(0.0, SLIVER_TIE_PX)
     } else {
-        0.0
+        SLIVER_TIE_PX
     };
     // False for NaN too.
     let may_be_steep = reach > SLIVER_TIE_PX;
@@ -649,7 +672,30 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
         let w = area2 / long;
         // False for NaN too.
         let matters = |r: f64| r * dl * SNAP_PX > SLIVER_DEPTH_TOL * w;
-        if !matters(part.rate_bound) || !matters((part.rate)()) {
+        // With isovalues: the snap's shift of the entry and exit scalars
+        // across this sliver, where its corners bracket one (with that
+        // shift); NaN or 0 otherwise.
+        let iso_shift = if part.isovalues.is_empty() {
+            0.0
+        } else {
+            let v = t.map(|i| &part.proj.vertices[i as usize]);
+            let spread = |s: [f64; 3]| {
+                let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
+                let shift = (hi - lo) * SNAP_PX / w;
+                let k = part.isovalues.partition_point(|&x| x < lo - shift);
+                let holds = part.isovalues.get(k).is_some_and(|&x| x <= hi + shift);
+                if holds {
+                    shift
+                } else {
+                    0.0
+                }
+            };
+            spread(v.map(|v| v.s_front)).max(spread(v.map(|v| v.s_back)))
+        };
+        let narrow_for_depth = w < reach.min(SLIVER_TIE_PX);
+        // False for NaN too.
+        let iso = iso_shift > 0.0;
+        if !iso && (!narrow_for_depth || !matters(part.rate_bound) || !matters((part.rate)())) {
             continue;
         }
         let k = if d2[0] == longest {
@@ -667,11 +713,32 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
         // culling keeps every triangle within COVERAGE_MARGIN_PX (1/64 px)
         // of a centre, so it drops no sliver that has such a centre, and
         // changes no decision.
-        out.extend(
-            near.iter()
-                .copied()
-                .filter(|&(i, j)| in_grown_triangle(p, DVec2::new(i as f64 + 0.5, j as f64 + 0.5))),
-        );
+        let depth = narrow_for_depth && matters(part.rate_bound) && matters((part.rate)());
+        // Where only an isovalue matters: the centres whose exact scalars
+        // are within the shift (and the f32 stages' rounding) of one.
+        let vals = t.map(|i| {
+            let v = &part.proj.vertices[i as usize];
+            [v.s_front, v.s_back]
+        });
+        out.extend(near.iter().copied().filter(|&(i, j)| {
+            let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+            if !in_grown_triangle(p, c) {
+                return false;
+            }
+            if depth {
+                return true;
+            }
+            let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+            let b1 = (c - p[0]).perp_dot(p[2] - p[0]) / area;
+            let b2 = (p[1] - p[0]).perp_dot(c - p[0]) / area;
+            let b = [1.0 - b1 - b2, b1, b2];
+            (0..2).any(|side| {
+                let s: f64 = (0..3).map(|k| b[k] * vals[k][side]).sum();
+                let margin = iso_shift + ISO_SLIVER_REL * s.abs();
+                // Not for NaN.
+                to_nearest(part.isovalues, s) <= margin
+            })
+        }));
     }
 }
 

@@ -331,6 +331,7 @@ fn one_pass_finds_the_steep_triangles_and_the_sliver_centres() {
             rate_bound,
             l_range,
             clipped: false,
+            isovalues: &[],
         };
         let slivers = rng.below(2) == 0;
         let mut scratch = TieScratch::default();
@@ -386,4 +387,51 @@ fn one_pass_finds_the_steep_triangles_and_the_sliver_centres() {
         steep_seen > 100 && sliver_seen > 100,
         "{steep_seen} {sliver_seen}"
     );
+}
+
+/// A sliver (a region seen nearly edge-on) whose entry scalar runs from
+/// 0.2 to 0.4 across its 0.02 px: the snap of its corners shifts the
+/// interpolated scalar by far more than the distance of a centre inside
+/// it from the isovalue 0.3, so with that isovalue the centre is decided
+/// exactly; without it (an optically thin part) it is not, nor with an
+/// isovalue the sliver does not come near.
+#[test]
+fn a_sliver_holding_an_isovalue_has_its_centres_decided() {
+    let mut proj = Projected::default();
+    // Centre (2.5, 1.5) lies in the sliver, where the scalar interpolates
+    // to 0.3; (1.5, 1.5) and (3.5, 1.5) lie on its upper edges, where it
+    // is 0.3 too.
+    let v = |x: f64, y: f64, s: f64| RegionVertex {
+        px: x,
+        py: y,
+        l: 1e-6,
+        s_front: s,
+        s_back: s,
+        ..Default::default()
+    };
+    proj.vertices.push(v(0.5, 1.49, 0.2));
+    proj.vertices.push(v(4.5, 1.49, 0.2));
+    proj.vertices.push(v(2.5, 1.51, 0.4));
+    proj.triangles.push([0, 1, 2]);
+    let rate = || 0.0;
+    let scan = |isovalues: &[f64]| {
+        let part = PartTriangles {
+            proj: &proj,
+            drawn: &[],
+            exact: &proj.triangles,
+            width: 6,
+            height: 4,
+            rate: &rate,
+            rate_bound: 0.0,
+            l_range: (1e-6, 1e-6),
+            clipped: false,
+            isovalues,
+        };
+        let mut scratch = TieScratch::default();
+        scan_triangles(&part, true, &mut scratch);
+        scratch.forced
+    };
+    assert_eq!(scan(&[0.3]), vec![(1, 1), (2, 1), (3, 1)]);
+    assert!(scan(&[]).is_empty());
+    assert!(scan(&[0.9]).is_empty());
 }
