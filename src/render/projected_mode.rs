@@ -45,6 +45,15 @@ pub trait ProjectedMode: Sync {
         None
     }
 
+    /// The isovalues whose crossings the mode finds per fragment from the
+    /// interpolated scalars (sorted; none by default): the driver decides
+    /// exactly the sliver centres whose scalars come within the snap's
+    /// shift of one ([`super::ties::PartTriangles::isovalues`]). The exact
+    /// mode slices its pieces at the isovalues instead and says none.
+    fn fragment_isovalues(&self) -> &[f64] {
+        &[]
+    }
+
     /// Whether the mode draws the volume (only `--mode iso` does not).
     fn draws_volume(&self) -> bool {
         true

@@ -291,7 +291,7 @@ fn draw_part<M: ProjectedMode>(
         rate: &rate,
         l_range,
         clipped: !std::ptr::eq(projected, part),
-        isovalues: mode.isosurfaces().map_or(&[], |s| &s.values[..]),
+        isovalues: mode.fragment_isovalues(),
     };
     // Steep triangles (`snap_is_steep`) take the exact triangle's values
     // at their snapped corners; the others share the exact corners'. The

@@ -634,6 +634,10 @@ impl ProjectedMode for IsoMode {
         Some(&self.set)
     }
 
+    fn fragment_isovalues(&self) -> &[f64] {
+        &self.set.values
+    }
+
     fn draws_volume(&self) -> bool {
         !matches!(self.volume, Volume::None)
     }
