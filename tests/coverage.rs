@@ -45,7 +45,8 @@ use zoovr::mesh::Mesh;
 use zoovr::raycast::brute::Brute;
 use zoovr::raycast::{self, FieldModel, Raycaster};
 use zoovr::render::{
-    Compositor, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec, Shading,
+    Compositor, Mode, ModeStats, PieceDraw, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec,
+    Shading,
 };
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
@@ -75,19 +76,42 @@ fn counts(
     kind: DrawKind,
     compositor: Compositor,
 ) -> Image {
+    counts_with(renderer, shading, camera, kind, compositor, PieceDraw::Regions).0
+}
+
+/// [`counts`] of the exact mode (`Regions`) or of exact-frag's whole-piece
+/// quads (`Quads`).
+fn counts_with(
+    renderer: &mut Renderer,
+    shading: &Shading,
+    camera: &Camera,
+    kind: DrawKind,
+    compositor: Compositor,
+    draw: PieceDraw,
+) -> (Image, usize) {
     let opts = RenderOptions {
+        mode: if draw == PieceDraw::Quads {
+            Mode::ExactFrag
+        } else {
+            Mode::Exact
+        },
         projected: ProjectedOptions {
             split_all: true,
             draw: kind,
             compositor,
+            piece_draw: draw,
             ..Default::default()
         },
         ..Default::default()
     };
-    renderer
+    let (img, stats) = renderer
         .render_with_camera(shading, &opts, camera, |_, _| {})
-        .unwrap()
-        .0
+        .unwrap();
+    let whole = match stats.detail {
+        ModeStats::Projected(p) => p.whole_pieces,
+        _ => 0,
+    };
+    (img, whole)
 }
 
 /// The reference: the ray caster's brute force over the `tets`, built once
@@ -504,6 +528,76 @@ fn refinement_changes_no_coverage() {
             }
             eprintln!("{tag}: refined triangles {refined:?}, counts unchanged");
             assert!(refined[1] > refined[0], "{tag}: {refined:?}");
+        }
+    }
+}
+
+/// Exact-frag's whole-piece quads cover what their rays meet: the quad
+/// stage's counting fragment counts where the pixel's ray meets the piece
+/// (`shaders/piece_quad.wgsl`: its sheared edge functions, from each
+/// edge's lower-numbered point), which must equal the number of tets the
+/// brute-force ray crosses for a positive length at every centre, with the
+/// GPU equal to the twin. The on-grid meshes are sheared along both axes
+/// so that no face is edge-on (pieces with one are projected as regions,
+/// checked above) while every vertex still projects onto a pixel centre:
+/// centres on shared edges and vertices by the thousand.
+#[test]
+fn whole_piece_quads_cover_what_their_rays_meet() {
+    let gpu = gpu_available();
+    let mut cases = Vec::new();
+    for (sx, sy) in [(1.0, 1.0), (-2.0, 1.0)] {
+        let (mut mesh, camera) = on_grid(6, sx);
+        for p in &mut mesh.points {
+            p.y += sy * p.z;
+        }
+        cases.push((format!("on-grid shear {sx}, {sy}"), mesh, vec![camera]));
+    }
+    for path in project_and_shared(&[
+        "tets_small/CylinderLinear.vtk",
+        "prisms_zoo/PentaHexa.vtk",
+        "angular_sector/AngularSector.vtk",
+    ]) {
+        let mesh = io::read(&path, &ReadOptions::default()).unwrap();
+        let b = mesh.bounds();
+        let cams = (0..4)
+            .map(|v| {
+                let params = CameraParams {
+                    width: 64,
+                    height: 56,
+                    azimuth: 30.0 + 77.0 * v as f64,
+                    elevation: 20.0 - 23.0 * v as f64,
+                    zoom: 1.1,
+                    ortho: v % 2 == 0,
+                    ..Default::default()
+                };
+                Camera::fit(b, &params)
+            })
+            .collect();
+        cases.push((path.display().to_string(), mesh, cams));
+    }
+    for (name, mesh, cams) in cases {
+        let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+        scene.tf = flat_tf(scene.range);
+        let mut renderer = Renderer::new(scene.geometry());
+        let brute = reference(&scene);
+        for (v, camera) in cams.iter().enumerate() {
+            let tag = format!("{name} view {v} quads");
+            let shading = scene.shading();
+            let count = |r: &mut Renderer, c| {
+                counts_with(r, &shading, camera, DrawKind::CountPieces, c, PieceDraw::Quads)
+            };
+            let (twin, whole) = count(&mut renderer, Compositor::Cpu);
+            let twin = red(&twin);
+            if gpu {
+                let got = red(&count(&mut renderer, Compositor::Gpu).0);
+                let bad = (0..got.len()).filter(|&k| got[k] != twin[k]).count();
+                assert_eq!(bad, 0, "{tag}: GPU and twin counts differ at {bad} pixels");
+            }
+            let want = reference_counts(&brute, camera);
+            check_counts(&scene, camera, &twin, &want, &tag);
+            let pieces = scene.mesh.cells.len();
+            eprintln!("{tag}: all right, {whole} tets drawn whole of {pieces} cells");
+            assert!(whole > 0, "{tag}: no piece drawn whole");
         }
     }
 }

@@ -10,7 +10,7 @@ use zoovr::camera::CameraParams;
 use zoovr::gpu::{AccumFormat, Backend, GpuOptions};
 use zoovr::raycast::{FieldModel, Traversal};
 use zoovr::render::{
-    Geometry, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, RenderStats, Renderer,
+    Geometry, Mode, PieceDraw, ProjectedOptions, ReferenceOptions, RenderOptions, RenderStats, Renderer,
     SceneSpec, Shading, TableBuild, TableOptions,
 };
 
@@ -138,6 +138,14 @@ pub struct ViewArgs {
     /// to the ray caster, higher draws fewer triangles.
     #[arg(long, value_name = "T", value_parser = parse_positive)]
     pub refine_tol: Option<f64>,
+    /// exact-frag: how pieces are drawn. `regions` (default): each piece
+    /// projected into regions on the CPU. `quads`: each piece drawn whole
+    /// as one quad over its pixel bounding box, every fragment intersecting
+    /// its own ray with the piece (view-independent cell projection); the
+    /// CPU does no subdivision, the same accuracy (pieces that f32 cannot
+    /// settle are projected as regions).
+    #[arg(long, value_name = "HOW", default_value = "regions")]
+    pub piece_draw: PieceDraw,
     /// Projected modes: draw the pieces hidden behind opaque ones too. By
     /// default a front-to-back pass over the order leaves out every piece
     /// whose pixels already lie behind an optical depth that lets through
@@ -203,6 +211,7 @@ impl ViewArgs {
                     .unwrap_or(zoovr::numeric::tolerance::COLOR_REFINE_TOL),
                 occlusion: (!self.no_occlusion)
                     .then_some(zoovr::numeric::tolerance::OCCLUSION_TRANSMITTANCE),
+                piece_draw: self.piece_draw,
                 ..Default::default()
             },
             gpu: GpuOptions {
@@ -245,6 +254,12 @@ impl ViewArgs {
     pub fn usage_error(&self) -> Option<String> {
         if self.mode == Mode::Iso && self.iso.is_none() {
             return Some("--mode iso draws isosurfaces only: give them with --iso V,V,...".into());
+        }
+        if self.piece_draw == PieceDraw::Quads && (self.mode != Mode::ExactFrag || self.iso.is_some())
+        {
+            return Some(
+                "--piece-draw quads is exact-frag's (without --iso): give --mode exact-frag".into(),
+            );
         }
         if self.traversal == Some(Traversal::Brute) && self.model == Some(FieldModel::Native) {
             return Some(

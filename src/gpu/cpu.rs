@@ -58,6 +58,13 @@ pub trait CpuStage<V>: Sync {
     /// `bary` of triangle `tri` (weights of the snapped triangle, in `f64`),
     /// or `None` where the shader discards.
     fn shade(&self, tri: [&V; 3], bary: [f64; 3]) -> Option<[f32; 4]>;
+    /// Whether the fragment at `bary` of `tri` is drawn at all (what a
+    /// counting draw counts): true unless the stage's `fs_count` discards
+    /// some fragments, as a stage drawing a piece's bounding quad does
+    /// where the pixel's ray misses the piece.
+    fn covers(&self, _tri: [&V; 3], _bary: [f64; 3]) -> bool {
+        true
+    }
     /// The interpolated values the shader works from, named, for
     /// diagnostics ([`CpuFrame::covering`]).
     fn describe(&self, tri: [&V; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)>;
@@ -260,6 +267,9 @@ impl CpuFrame {
                 }
             },
             DrawKind::CountPieces | DrawKind::CountTriangles => {
+                if !stage.covers(tri, bary) {
+                    return;
+                }
                 let clip = tri[0].clip();
                 count_of(clip[2] / clip[3])
             }

@@ -47,7 +47,7 @@ use crate::visibility::{Sorter, VisibilityError};
 pub use breakpoints::split_points;
 pub use modes::{Bounds, Mode, ModeInfo};
 pub use options::{
-    Compositor, ProjectedOptions, ReferenceOptions, RenderOptions, TableBuild, TableOptions,
+    Compositor, ProjectedOptions, ReferenceOptions, RenderOptions, TableBuild, TableOptions, PieceDraw
 };
 pub use pieces::PieceError;
 pub use scene::{Geometry, ScalarsRef, Scene, SceneSpec, Shading};
@@ -300,6 +300,13 @@ impl Renderer {
                 };
                 self.projected(&mode, &scene, opts, camera, progress)?
             }
+            Mode::ExactFrag if opts.projected.piece_draw == PieceDraw::Quads => self.projected(
+                &modes::piece_quad::ExactFragQuads,
+                &scene,
+                opts,
+                camera,
+                progress,
+            )?,
             Mode::ExactFrag => self.projected(
                 &modes::exact_frag::ExactFragMode,
                 &scene,

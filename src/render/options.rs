@@ -142,6 +142,36 @@ pub struct ProjectedOptions {
     /// at most [`super::driver::kept::KEEP_MAX_BYTES`]). For interactive
     /// colour editing through the library.
     pub keep_projection: bool,
+    /// How exact-frag draws a piece (`--piece-draw`): projected into
+    /// regions on the CPU, or whole, as one quad whose fragments find
+    /// their own segment ([`super::modes::piece_quad`]).
+    pub piece_draw: PieceDraw,
+}
+
+/// How exact-frag draws its pieces (`--piece-draw`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum PieceDraw {
+    /// Each piece projected into regions on the CPU (winged-edge
+    /// subdivision), the segment payload at their corners.
+    #[default]
+    Regions,
+    /// Each piece drawn whole as one quad over its pixel bounding box;
+    /// every fragment intersects its ray with the piece's boundary
+    /// triangles (view-independent cell projection). Pieces that `f32`
+    /// cannot settle (near plane, faces seen nearly edge-on, optically
+    /// thick, more than 8 points) are projected as with `regions`.
+    Quads,
+}
+
+impl PieceDraw {
+    /// The name `--piece-draw` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            PieceDraw::Regions => "regions",
+            PieceDraw::Quads => "quads",
+        }
+    }
 }
 
 impl Default for ProjectedOptions {
@@ -158,6 +188,7 @@ impl Default for ProjectedOptions {
             occlusion: Some(crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE),
             dark_subset: true,
             keep_projection: false,
+            piece_draw: PieceDraw::Regions,
         }
     }
 }

@@ -79,6 +79,23 @@ pub trait ProjectedMode: Sync {
     /// The CPU twin of the stage's fragment shader, for one frame of `src`.
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<Self::Vertex>>;
 
+    /// The vertex that draws `part` whole, as one quad over its pixel
+    /// bounding box whose fragments find their own segment through the
+    /// part (exact-frag's `--piece-draw quads`,
+    /// [`super::modes::piece_quad`]), with the clip position left to the
+    /// driver; `None` (the default, and for a part the mode cannot draw
+    /// whole): the driver projects the part into regions. `rate` is the
+    /// part's largest rate ([`PieceSource::max_rate`] on its range).
+    fn whole_part(
+        &self,
+        _src: &PieceSource,
+        _part: &Polyhedron,
+        _payload: &mut Self::Payload,
+        _rate: &dyn Fn() -> f64,
+    ) -> Option<Self::Vertex> {
+        None
+    }
+
     /// Computes the payload of `part`'s projection at every vertex
     /// `used[i]` marks (a kept triangle uses it). `part` is the polyhedron
     /// whose triangles `proj`'s faces index: a part reaching the near plane

@@ -30,6 +30,9 @@ pub struct ProjectedStats {
     /// the optical depth, drawn with the exact triangle's values at the
     /// snapped corners ([`super::ties::snap_is_steep`]).
     pub steep_triangles: usize,
+    /// Parts drawn whole as one quad (exact-frag `--piece-draw quads`,
+    /// [`super::modes::piece_quad`]); the others were projected.
+    pub whole_pieces: usize,
     /// Pieces left out as hidden behind opaque ones
     /// ([`super::occlusion`]), and the time the pass took.
     pub hidden_pieces: usize,
@@ -126,7 +129,7 @@ impl fmt::Display for ProjectedStats {
         )?;
         writeln!(
             f,
-            "project+draw {:.3} s{}  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles, {} tie pixels, {} steep triangles)",
+            "project+draw {:.3} s{}  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles, {} tie pixels, {} steep triangles{})",
             e.project_s,
             if e.projection_reused {
                 ", kept triangles drawn again"
@@ -138,7 +141,12 @@ impl fmt::Display for ProjectedStats {
             e.slabs,
             e.refined_triangles,
             e.tie_pixels,
-            e.steep_triangles
+            e.steep_triangles,
+            if e.whole_pieces > 0 {
+                format!(", {} pieces drawn whole", e.whole_pieces)
+            } else {
+                String::new()
+            }
         )?;
         if let Some(t) = &e.table {
             writeln!(

@@ -116,6 +116,8 @@ pub(super) struct ChunkOut<V> {
     /// Triangles whose snapped corners took the exact triangle's values
     /// ([`super::ties::snap_is_steep`]).
     steep: usize,
+    /// Parts drawn whole, as one quad ([`ProjectedMode::whole_part`]).
+    whole: usize,
     pub(super) error: Option<PieceError>,
 }
 
@@ -131,6 +133,7 @@ impl<V> Default for ChunkOut<V> {
             degenerate: 0,
             tie_pixels: 0,
             steep: 0,
+            whole: 0,
             error: None,
         }
     }
@@ -148,6 +151,7 @@ impl<V> ChunkOut<V> {
         self.degenerate = 0;
         self.tie_pixels = 0;
         self.steep = 0;
+        self.whole = 0;
         self.error = None;
     }
 }
@@ -210,6 +214,14 @@ fn draw_part<M: ProjectedMode>(
     w: &mut Worker<M::Payload, M::Vertex>,
     out: &mut ChunkOut<M::Vertex>,
 ) -> Result<(), crate::projection::ProjectionError> {
+    // The part's largest rate, computed once, where a bound on it does
+    // not settle a question.
+    let part_rate_once = std::cell::OnceCell::new();
+    let rate = || *part_rate_once.get_or_init(|| part_rate(src, part));
+    if let Some(v) = mode.whole_part(src, part, &mut w.payload, &rate) {
+        draw_whole(src.camera, part, v, out);
+        return Ok(());
+    }
     w.projector.project(part, src.camera, &mut w.proj)?;
     let proj = &mut w.proj;
     if proj.triangles.is_empty() {
@@ -274,10 +286,6 @@ fn draw_part<M: ProjectedMode>(
             out.degenerate += 1;
         }
     }
-    // The part's largest rate, computed once, where a bound on it does
-    // not settle a question.
-    let part_rate_once = std::cell::OnceCell::new();
-    let rate = || *part_rate_once.get_or_init(|| part_rate(src, part));
     let l_range = value_range(proj.vertices.iter().map(|v| v.l));
     // Centres next to the outline first (they decide their pixels), then
     // the triangles.
@@ -314,6 +322,49 @@ fn draw_part<M: ProjectedMode>(
         }
     }
     Ok(())
+}
+
+/// Draws `part` whole as one piece: a quad over the whole pixels its
+/// points' bounding box touches (widened by
+/// [`crate::numeric::tolerance::COVERAGE_MARGIN_PX`], clipped to the
+/// image), every corner carrying `v`. Its corners lie on whole pixels, so
+/// the quad holds every pixel centre the part's outline can; the stage
+/// discards the fragments whose ray misses the part. A part whose box
+/// holds no centre is culled.
+fn draw_whole<V: GpuVertex>(camera: &Camera, part: &Polyhedron, v: V, out: &mut ChunkOut<V>) {
+    use crate::numeric::tolerance::COVERAGE_MARGIN_PX;
+    let extent = camera.half_extent();
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &part.points {
+        let Some((px, py, _)) = camera.view_to_pixel_with(*p, extent) else {
+            out.culled += 1;
+            return;
+        };
+        lo = [lo[0].min(px), lo[1].min(py)];
+        hi = [hi[0].max(px), hi[1].max(py)];
+    }
+    let size = [camera.width as f64, camera.height as f64];
+    let lo = [0, 1].map(|k| (lo[k] - COVERAGE_MARGIN_PX).floor().max(0.0));
+    let hi = [0, 1].map(|k| (hi[k] + COVERAGE_MARGIN_PX).ceil().min(size[k]));
+    if !(hi[0] > lo[0] && hi[1] > lo[1]) {
+        out.culled += 1;
+        return;
+    }
+    let mapper = ClipMapper::for_camera(camera);
+    let base = out.vertices.len() as u32;
+    for (x, y) in [(lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])] {
+        let Some((ndc, _)) = mapper.ndc(x, y) else {
+            out.vertices.truncate(base as usize);
+            out.culled += 1;
+            return;
+        };
+        out.vertices
+            .push(v.with_clip([ndc[0], ndc[1], 0.5, 1.0]).with_piece(out.pieces));
+    }
+    out.pieces += 1;
+    out.whole += 1;
+    out.indices
+        .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
 }
 
 /// The largest rate on `part`'s scalar range.
@@ -566,6 +617,7 @@ fn push_out<V: GpuVertex>(
     stats.refined_triangles += out.refined;
     stats.tie_pixels += out.tie_pixels;
     stats.steep_triangles += out.steep;
+    stats.whole_pieces += out.whole;
     stats.triangles += out.indices.len() / 3;
     sink.push(&out.vertices, &out.indices)?;
     if let Some(r) = record {

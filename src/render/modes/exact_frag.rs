@@ -79,6 +79,7 @@ const fn exact_frag_stage(
         fragment: "fs_main",
         wgsl: concat!(
             include_str!("../../../shaders/segment_vertex.wgsl"),
+            include_str!("../../../shaders/segment_view.wgsl"),
             include_str!("../../../shaders/segment.wgsl"),
             include_str!("../../../shaders/integral.wgsl"),
             include_str!("../../../shaders/exact_frag.wgsl"),

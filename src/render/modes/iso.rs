@@ -240,6 +240,7 @@ macro_rules! iso_stage {
             fragment: "fs_iso",
             wgsl: concat!(
                 include_str!("../../../shaders/iso_vertex.wgsl"),
+                include_str!("../../../shaders/segment_view.wgsl"),
                 include_str!("../../../shaders/segment.wgsl"),
                 $(include_str!(concat!("../../../shaders/", $file)),)*
                 $glue,

@@ -36,7 +36,9 @@ pub mod preint2d_cyl;
 pub mod preint3d;
 pub mod preint_tables;
 pub mod raycast;
+pub mod piece_quad;
 pub mod segment;
+pub mod segment_view;
 pub mod table_build;
 pub mod twins;
 
@@ -220,6 +222,14 @@ pub const SHADERS: &[(&str, &str)] = &[
     (
         "segment.wgsl",
         include_str!("../../../shaders/segment.wgsl"),
+    ),
+    (
+        "segment_view.wgsl",
+        include_str!("../../../shaders/segment_view.wgsl"),
+    ),
+    (
+        "piece_quad.wgsl",
+        include_str!("../../../shaders/piece_quad.wgsl"),
     ),
     (
         "segment_vertex.wgsl",

@@ -62,6 +62,7 @@ pub static PREINT2D_STAGE: StageDesc = StageDesc {
     fragment: "fs_main",
     wgsl: concat!(
         include_str!("../../../shaders/segment_vertex.wgsl"),
+        include_str!("../../../shaders/segment_view.wgsl"),
         include_str!("../../../shaders/segment.wgsl"),
         include_str!("../../../shaders/preint.wgsl"),
         include_str!("../../../shaders/preint2d.wgsl"),

@@ -58,6 +58,7 @@ pub static PREINT3D_STAGE: StageDesc = StageDesc {
     fragment: "fs_main",
     wgsl: concat!(
         include_str!("../../../shaders/segment_vertex.wgsl"),
+        include_str!("../../../shaders/segment_view.wgsl"),
         include_str!("../../../shaders/segment.wgsl"),
         include_str!("../../../shaders/preint.wgsl"),
         include_str!("../../../shaders/preint3d.wgsl"),

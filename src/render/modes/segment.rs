@@ -27,7 +27,6 @@
 //! is held here once.
 
 use bytemuck::{Pod, Zeroable};
-use glam::DVec2;
 
 use crate::camera::Camera;
 use crate::gpu::cpu::{lerp, CpuStage};
@@ -35,6 +34,8 @@ use crate::gpu::{ClipMapper, Context, GpuError, GpuVertex, Stage};
 use crate::projection::{Polyhedron, Projected, ViewMap};
 use crate::render::driver::ProjectedMode;
 use crate::render::pieces::PieceSource;
+
+pub use super::segment_view::segment_of;
 use crate::tf::TransferFunction;
 
 /// Normalised scalars beyond this magnitude are clamped (they lie far in the
@@ -241,27 +242,14 @@ pub fn segment_at(
     let front = [0, 1].map(|k| lerp(tri, bary, |v| v.front[k]));
     let back = [0, 1].map(|k| lerp(tri, bary, |v| v.back[k]));
     let thick = lerp(tri, bary, |v| v.thick);
-    let s_f = front[0] / front[1];
-    let s_b = back[0] / back[1];
-    let mut l = if view.ortho == 1 {
-        thick
+    let p = if view.ortho == 1 {
+        [0.0; 2]
     } else {
         let clip = [0, 1].map(|k| lerp(tri, bary, |v| v.pos[k]));
         let (px, py) = mapper.pixel_of([clip[0], clip[1], 0.5, 1.0]);
-        let p = DVec2::new(px, py).as_vec2();
-        let u = [
-            p.x * view.scale[0] + view.offset[0],
-            p.y * view.scale[1] + view.offset[1],
-        ];
-        thick / (front[1] * back[1]) * (1.0 + u[0] * u[0] + u[1] * u[1]).sqrt()
+        [px as f32, py as f32]
     };
-    l = l.max(0.0);
-    Seg {
-        s_f,
-        s_b,
-        l,
-        ok: s_f.is_finite() && s_b.is_finite() && l.is_finite(),
-    }
+    segment_of(view, front, back, thick, p)
 }
 
 /// The payload of the segment modes for one part: the frame's scalar map

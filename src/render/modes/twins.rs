@@ -32,8 +32,8 @@ use std::any::type_name_of_val as path;
 use super::exact::exptable::{self, ExpTable};
 use super::integral::{self, TfBuffer};
 use super::{
-    exact, exact_frag, exact_iso, iso, preint, preint2d, preint2d_cyl, preint3d, segment,
-    table_build,
+    exact, exact_frag, exact_iso, iso, piece_quad, preint, preint2d, preint2d_cyl, preint3d, segment,
+    segment_view, table_build,
 };
 use crate::gpu::{common, layer};
 use crate::integrate::cylinder;
@@ -96,6 +96,8 @@ pub fn stage_twins() -> Vec<StageTwins> {
         twins!("preint3d.wgsl": preint3d::table_rgba),
         twins!("segment.wgsl": segment::segment_at),
         twins!("segment_vertex.wgsl"),
+        twins!("segment_view.wgsl": segment_view::segment_of),
+        twins!("piece_quad.wgsl": piece_quad::segment_at, piece_quad::corners, piece_quad::edge),
         twins!("table_build.wgsl":
             cylinder::cyl_to_table, table_build::optical_depth, table_build::build_main),
     ]
