@@ -45,8 +45,8 @@ use zoovr::mesh::Mesh;
 use zoovr::raycast::brute::Brute;
 use zoovr::raycast::{self, FieldModel, Raycaster};
 use zoovr::render::{
-    Compositor, Mode, ModeStats, PieceDraw, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec,
-    Shading,
+    Compositor, Mode, ModeStats, PieceDraw, ProjectedOptions, RenderOptions, Renderer, Scene,
+    SceneSpec, Shading,
 };
 use zoovr::testdata::{mesh_file, shared_file};
 use zoovr::tf::{EmissionModel, TransferFunction};
@@ -76,7 +76,15 @@ fn counts(
     kind: DrawKind,
     compositor: Compositor,
 ) -> Image {
-    counts_with(renderer, shading, camera, kind, compositor, PieceDraw::Regions).0
+    counts_with(
+        renderer,
+        shading,
+        camera,
+        kind,
+        compositor,
+        PieceDraw::Regions,
+    )
+    .0
 }
 
 /// [`counts`] of the exact mode (`Regions`) or of exact-frag's whole-piece
@@ -584,7 +592,14 @@ fn whole_piece_quads_cover_what_their_rays_meet() {
             let tag = format!("{name} view {v} quads");
             let shading = scene.shading();
             let count = |r: &mut Renderer, c| {
-                counts_with(r, &shading, camera, DrawKind::CountPieces, c, PieceDraw::Quads)
+                counts_with(
+                    r,
+                    &shading,
+                    camera,
+                    DrawKind::CountPieces,
+                    c,
+                    PieceDraw::Quads,
+                )
             };
             let (twin, whole) = count(&mut renderer, Compositor::Cpu);
             let twin = red(&twin);

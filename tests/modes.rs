@@ -21,7 +21,8 @@ use zoovr::render::iso::IsoOptions;
 use zoovr::render::modes::twins::missing_twins;
 use zoovr::render::modes::SHADERS;
 use zoovr::render::{
-    Compositor, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
+    Compositor, Mode, PieceDraw, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer,
+    Scene, SceneSpec,
 };
 use zoovr::testdata::mesh_file;
 
@@ -185,11 +186,22 @@ fn every_mode_matches_the_reference(name: &str) {
                 if gpu {
                     compositors.push(Compositor::Gpu);
                 }
-                for compositor in compositors {
+                // exact-frag draws its pieces as regions and whole, as
+                // quads, at the same bounds.
+                let draws: &[PieceDraw] = if mode == Mode::ExactFrag {
+                    &[PieceDraw::Regions, PieceDraw::Quads]
+                } else {
+                    &[PieceDraw::Regions]
+                };
+                for (compositor, &draw) in compositors
+                    .iter()
+                    .flat_map(|&c| draws.iter().map(move |d| (c, d)))
+                {
                     let opts = RenderOptions {
                         projected: ProjectedOptions {
                             split_all: split,
                             compositor,
+                            piece_draw: draw,
                             ..options(mode, ortho).projected
                         },
                         iso: if mode == Mode::Iso {
@@ -202,7 +214,7 @@ fn every_mode_matches_the_reference(name: &str) {
                     let got = render(&mut renderer, &s, &opts);
                     let (d, diff) = compare_display(&got, expected, [0.0; 3]).unwrap();
                     eprintln!(
-                        "{mode} {name} ortho={ortho} split={split} {compositor:?}: max {:.2e} at {:?}",
+                        "{mode} {name} ortho={ortho} split={split} {compositor:?} {draw:?}: max {:.2e} at {:?}",
                         d.max_abs, d.worst
                     );
                     let (bound, outliers) = if split {

@@ -22,7 +22,7 @@ use zoovr::image::{check_images_with, Bounds, Image};
 use zoovr::mesh::Mesh;
 use zoovr::raycast::FieldModel;
 use zoovr::render::iso::IsoOptions;
-use zoovr::render::{Mode, Renderer, Scene, SceneSpec};
+use zoovr::render::{Mode, PieceDraw, Renderer, Scene, SceneSpec};
 use zoovr::tf::{EmissionModel, TransferFunction};
 
 /// Bounds with the same field (`--split all` vs `tets`), max over every
@@ -145,24 +145,26 @@ fn run(case: Case, gpu: bool) {
         let cam = camera(&scene.mesh, v, size);
         // The cells the last projected render drew as tets.
         let last_split = std::cell::RefCell::new(Vec::new());
-        let mut render = |mode: Mode, model: FieldModel, split_all: bool| -> Image {
-            let opts = options(mode, split_all, model);
-            let (img, _) = r
-                .render_with_camera(&scene.shading(), &opts, &cam, |_, _| {})
-                .unwrap_or_else(|e| panic!("{} view {vi} {mode:?}: {e}", case.name));
-            if mode != Mode::Raycast {
-                *last_split.borrow_mut() = split_cells(&r, scene.mesh.cells.len());
-            }
-            assert_eq!(
-                img.count_non_finite(),
-                0,
-                "{} view {vi} {mode:?} {model:?} split {split_all}: non-finite pixels",
-                case.name
-            );
-            img
-        };
-        let faces = render(Mode::Raycast, FieldModel::Faces, false);
-        let tets = render(Mode::Raycast, FieldModel::Tets, false);
+        let mut render =
+            |mode: Mode, model: FieldModel, split_all: bool, draw: PieceDraw| -> Image {
+                let mut opts = options(mode, split_all, model);
+                opts.projected.piece_draw = draw;
+                let (img, _) = r
+                    .render_with_camera(&scene.shading(), &opts, &cam, |_, _| {})
+                    .unwrap_or_else(|e| panic!("{} view {vi} {mode:?}: {e}", case.name));
+                if mode != Mode::Raycast {
+                    *last_split.borrow_mut() = split_cells(&r, scene.mesh.cells.len());
+                }
+                assert_eq!(
+                    img.count_non_finite(),
+                    0,
+                    "{} view {vi} {mode:?} {model:?} split {split_all}: non-finite pixels",
+                    case.name
+                );
+                img
+            };
+        let faces = render(Mode::Raycast, FieldModel::Faces, false, PieceDraw::Regions);
+        let tets = render(Mode::Raycast, FieldModel::Tets, false, PieceDraw::Regions);
         let covered = faces.pixels.iter().filter(|p| p[3] > 1e-3).count();
         eprintln!("{} view {vi}: {covered} covered pixels", case.name);
         if !gpu {
@@ -188,10 +190,10 @@ fn run(case: Case, gpu: bool) {
         // The table modes: finite everywhere (render() checks), whole
         // cells and split.
         for mode in [Mode::Preint3d, Mode::Preint2d, Mode::Preint2dCyl] {
-            render(mode, FieldModel::Faces, false);
-            render(mode, FieldModel::Faces, true);
+            render(mode, FieldModel::Faces, false, PieceDraw::Regions);
+            render(mode, FieldModel::Faces, true, PieceDraw::Regions);
         }
-        let split = render(Mode::Exact, FieldModel::Faces, true);
+        let split = render(Mode::Exact, FieldModel::Faces, true, PieceDraw::Regions);
         let d = check_images_with(
             &format!("stress_{}_{vi}_split", case.name),
             &split,
@@ -203,7 +205,7 @@ fn run(case: Case, gpu: bool) {
             "{} view {vi} split vs tets: max {:.2e} p99.9 {:.2e} rms {:.2e}",
             case.name, d.max_abs, d.p999, d.rms
         );
-        let whole = render(Mode::Exact, FieldModel::Faces, false);
+        let whole = render(Mode::Exact, FieldModel::Faces, false, PieceDraw::Regions);
         // Outside the pixels whose rays meet a split cell, the whole-cell
         // image integrates the `faces` field itself: the split bound holds.
         let mask = split_mask(&scene, &cam, &last_split.borrow());
@@ -266,22 +268,28 @@ fn run(case: Case, gpu: bool) {
                 rms: 1e-2,
             }
         };
-        for split_all in [true, false] {
-            let got = render(Mode::ExactFrag, FieldModel::Faces, split_all);
+        // Its whole-piece quads (`--piece-draw quads`) at the same bounds.
+        for (split_all, draw) in [
+            (true, PieceDraw::Regions),
+            (false, PieceDraw::Regions),
+            (true, PieceDraw::Quads),
+            (false, PieceDraw::Quads),
+        ] {
+            let got = render(Mode::ExactFrag, FieldModel::Faces, split_all, draw);
             let (reference, what) = if split_all {
                 (&tets, "split vs tets")
             } else {
                 (&faces, "whole vs faces")
             };
             let d = check_images_with(
-                &format!("stress_{}_{vi}_frag_{split_all}", case.name),
+                &format!("stress_{}_{vi}_frag_{split_all}_{draw:?}", case.name),
                 &got,
                 reference,
                 if split_all { &frag_split } else { &frag_whole },
             )
             .unwrap_or_else(|e| panic!("{e}"));
             eprintln!(
-                "{} view {vi} exact-frag {what}: max {:.2e} p99.9 {:.2e} rms {:.2e}",
+                "{} view {vi} exact-frag {draw:?} {what}: max {:.2e} p99.9 {:.2e} rms {:.2e}",
                 case.name, d.max_abs, d.p999, d.rms
             );
         }

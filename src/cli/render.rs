@@ -10,8 +10,8 @@ use zoovr::camera::CameraParams;
 use zoovr::gpu::{AccumFormat, Backend, GpuOptions};
 use zoovr::raycast::{FieldModel, Traversal};
 use zoovr::render::{
-    Geometry, Mode, PieceDraw, ProjectedOptions, ReferenceOptions, RenderOptions, RenderStats, Renderer,
-    SceneSpec, Shading, TableBuild, TableOptions,
+    Geometry, Mode, PieceDraw, ProjectedOptions, ReferenceOptions, RenderOptions, RenderStats,
+    Renderer, SceneSpec, Shading, TableBuild, TableOptions,
 };
 
 use zoovr::render::iso::{IsoMix, IsoOptions, IsoSpec, Lighting};
@@ -255,7 +255,8 @@ impl ViewArgs {
         if self.mode == Mode::Iso && self.iso.is_none() {
             return Some("--mode iso draws isosurfaces only: give them with --iso V,V,...".into());
         }
-        if self.piece_draw == PieceDraw::Quads && (self.mode != Mode::ExactFrag || self.iso.is_some())
+        if self.piece_draw == PieceDraw::Quads
+            && (self.mode != Mode::ExactFrag || self.iso.is_some())
         {
             return Some(
                 "--piece-draw quads is exact-frag's (without --iso): give --mode exact-frag".into(),

@@ -47,7 +47,8 @@ use crate::visibility::{Sorter, VisibilityError};
 pub use breakpoints::split_points;
 pub use modes::{Bounds, Mode, ModeInfo};
 pub use options::{
-    Compositor, ProjectedOptions, ReferenceOptions, RenderOptions, TableBuild, TableOptions, PieceDraw
+    Compositor, PieceDraw, ProjectedOptions, ReferenceOptions, RenderOptions, TableBuild,
+    TableOptions,
 };
 pub use pieces::PieceError;
 pub use scene::{Geometry, ScalarsRef, Scene, SceneSpec, Shading};

@@ -352,14 +352,21 @@ fn draw_whole<V: GpuVertex>(camera: &Camera, part: &Polyhedron, v: V, out: &mut 
     }
     let mapper = ClipMapper::for_camera(camera);
     let base = out.vertices.len() as u32;
-    for (x, y) in [(lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])] {
+    for (x, y) in [
+        (lo[0], lo[1]),
+        (hi[0], lo[1]),
+        (hi[0], hi[1]),
+        (lo[0], hi[1]),
+    ] {
         let Some((ndc, _)) = mapper.ndc(x, y) else {
             out.vertices.truncate(base as usize);
             out.culled += 1;
             return;
         };
-        out.vertices
-            .push(v.with_clip([ndc[0], ndc[1], 0.5, 1.0]).with_piece(out.pieces));
+        out.vertices.push(
+            v.with_clip([ndc[0], ndc[1], 0.5, 1.0])
+                .with_piece(out.pieces),
+        );
     }
     out.pieces += 1;
     out.whole += 1;

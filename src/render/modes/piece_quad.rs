@@ -211,7 +211,11 @@ impl QuadVertex {
             // perspective the depth too (times the pixel's `u`, below 1
             // inside the usual fields of view).
             let a = p.abs();
-            coord = coord.max(if camera.ortho { a.x.max(a.y) } else { a.max_element() });
+            coord = coord.max(if camera.ortho {
+                a.x.max(a.y)
+            } else {
+                a.max_element()
+            });
         }
         let diameter = (hi - lo).length();
         let shift = QUAD_F32_REL * (coord / cos_min + diameter);
@@ -345,7 +349,8 @@ pub fn segment_at(
             continue;
         }
         found[side] = true;
-        mask[side] = ((e[0] != 0.0) as u32) << a | ((e[1] != 0.0) as u32) << b | ((e[2] != 0.0) as u32) << c;
+        mask[side] =
+            ((e[0] != 0.0) as u32) << a | ((e[1] != 0.0) as u32) << b | ((e[2] != 0.0) as u32) << c;
         let w = e.map(|x| x / sum);
         let s = |i: u32| f.points[i as usize][3];
         hit[side] = [
@@ -370,7 +375,9 @@ pub fn segment_at(
         ok: found[0]
             && found[1]
             && mask[0] != mask[1]
-            && s_f.is_finite() && s_b.is_finite() && l.is_finite(),
+            && s_f.is_finite()
+            && s_b.is_finite()
+            && l.is_finite(),
     }
 }
 
@@ -512,13 +519,7 @@ impl ProjectedMode for ExactFragQuads {
         i: usize,
         ndc: [f32; 2],
     ) -> QuadVertex {
-        QuadVertex::region(SegmentVertex::of(
-            proj,
-            i,
-            ndc,
-            &payload.map,
-            payload.ortho,
-        ))
+        QuadVertex::region(SegmentVertex::of(proj, i, ndc, &payload.map, payload.ortho))
     }
 }
 

@@ -32,8 +32,8 @@ use std::any::type_name_of_val as path;
 use super::exact::exptable::{self, ExpTable};
 use super::integral::{self, TfBuffer};
 use super::{
-    exact, exact_frag, exact_iso, iso, piece_quad, preint, preint2d, preint2d_cyl, preint3d, segment,
-    segment_view, table_build,
+    exact, exact_frag, exact_iso, iso, piece_quad, preint, preint2d, preint2d_cyl, preint3d,
+    segment, segment_view, table_build,
 };
 use crate::gpu::{common, layer};
 use crate::integrate::cylinder;
