@@ -89,7 +89,8 @@ fn vs_main(v: VertexIn) -> VertexOut {
 }
 
 // The corners of triangle k of `topo`: three per word, 9 bits each (3 bits
-// per corner); the count is in bits 27 to 31 of word 0.
+// per corner). Bits 27 to 31 of words 0, 1 and 2 hold the number of
+// triangles, of front triangles (they come first) and of points.
 // Twin: render::modes::piece_quad::corners.
 fn corners(topo: vec4<u32>, k: u32) -> vec3<u32> {
     let w = topo[k / 3u] >> (9u * (k % 3u));
@@ -118,8 +119,10 @@ fn segment_at(f: VertexOut, p: vec2<f32>) -> Seg {
         f.depth0.x, f.depth0.y, f.depth0.z, f.depth0.w,
         f.depth1.x, f.depth1.y, f.depth1.z, f.depth1.w,
     );
+    let front_count = f.topo.y >> 27u;
+    let point_count = f.topo.z >> 27u;
     var q: array<vec2<f32>, 8>;
-    for (var i = 0u; i < 8u; i++) {
+    for (var i = 0u; i < point_count; i++) {
         let c = pts[i];
         if view.ortho == 1u {
             q[i] = c.xy - u;
@@ -127,14 +130,22 @@ fn segment_at(f: VertexOut, p: vec2<f32>) -> Seg {
             q[i] = c.xy - u * c.z;
         }
     }
-    // (depth, scalar) where the ray meets a triangle of each sign.
+    // (depth, scalar) where the ray meets a front triangle (side 0; they
+    // come first) and a back one (side 1). Every triangle is wound so that
+    // a ray through it has three edge functions of one sign, positive.
     var hit = array<vec2<f32>, 2>(vec2<f32>(0.0), vec2<f32>(0.0));
     var found = array<bool, 2>(false, false);
     // The points each hit has a nonzero weight on: equal for both sides
     // where the ray only touches the piece (at a vertex, or along an edge
     // of its outline), which it then meets for no length.
     var mask = array<u32, 2>(0u, 0u);
-    for (var k = 0u; k < count; k++) {
+    var side = 0u;
+    var k = 0u;
+    loop {
+        // No front triangle holds the ray: it misses the piece.
+        if (side == 0u && k == front_count) || k >= count {
+            break;
+        }
         let t = corners(f.topo, k);
         let e = vec3<f32>(
             edge(q[t.y], q[t.z], t.y, t.z),
@@ -142,13 +153,7 @@ fn segment_at(f: VertexOut, p: vec2<f32>) -> Seg {
             edge(q[t.x], q[t.y], t.x, t.y),
         );
         let sum = e.x + e.y + e.z;
-        var side = 2u;
         if e.x >= 0.0 && e.y >= 0.0 && e.z >= 0.0 && sum > 0.0 {
-            side = 0u;
-        } else if e.x <= 0.0 && e.y <= 0.0 && e.z <= 0.0 && sum < 0.0 {
-            side = 1u;
-        }
-        if side < 2u && !found[side] {
             let w = e / sum;
             found[side] = true;
             mask[side] = (select(0u, 1u, e.x != 0.0) << t.x) | (select(0u, 1u, e.y != 0.0) << t.y)
@@ -157,7 +162,14 @@ fn segment_at(f: VertexOut, p: vec2<f32>) -> Seg {
                 dot(w, vec3<f32>(zs[t.x], zs[t.y], zs[t.z])),
                 dot(w, vec3<f32>(pts[t.x].w, pts[t.y].w, pts[t.z].w)),
             );
+            if side == 1u {
+                break;
+            }
+            side = 1u;
+            k = front_count;
+            continue;
         }
+        k = k + 1u;
     }
     var out: Seg;
     out.ok = found[0] && found[1] && mask[0] != mask[1];

@@ -138,13 +138,15 @@ pub struct ViewArgs {
     /// to the ray caster, higher draws fewer triangles.
     #[arg(long, value_name = "T", value_parser = parse_positive)]
     pub refine_tol: Option<f64>,
-    /// exact-frag: how pieces are drawn. `regions` (default): each piece
-    /// projected into regions on the CPU. `quads`: each piece drawn whole
-    /// as one quad over its pixel bounding box, every fragment intersecting
-    /// its own ray with the piece (view-independent cell projection); the
-    /// CPU does no subdivision, the same accuracy (pieces that f32 cannot
-    /// settle are projected as regions).
-    #[arg(long, value_name = "HOW", default_value = "regions")]
+    /// exact-frag: how pieces are drawn. `regions`: each piece projected
+    /// into regions on the CPU. `quads`: each piece drawn whole as one quad
+    /// over its pixel bounding box, every fragment intersecting its own ray
+    /// with the piece (view-independent cell projection): the CPU does no
+    /// subdivision, at the same accuracy (pieces that f32 cannot settle are
+    /// projected as regions). `auto`: quads on a hardware GPU, regions on a
+    /// software adapter (llvmpipe, lavapipe), where triangles cost more
+    /// than the quads' fragments.
+    #[arg(long, value_name = "HOW", default_value = "auto")]
     pub piece_draw: PieceDraw,
     /// Projected modes: draw the pieces hidden behind opaque ones too. By
     /// default a front-to-back pass over the order leaves out every piece

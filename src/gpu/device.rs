@@ -38,6 +38,15 @@ pub struct ContextInfo {
     pub auto_format: AccumFormat,
 }
 
+impl ContextInfo {
+    /// Whether the adapter rasterises on the CPU (llvmpipe, lavapipe,
+    /// WARP: `DeviceType::Cpu`), where triangle setup costs far more than
+    /// fragments and stages pick their cheaper-per-triangle paths.
+    pub fn is_software(&self) -> bool {
+        self.device_type == format!("{:?}", wgpu::DeviceType::Cpu)
+    }
+}
+
 impl std::fmt::Display for ContextInfo {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(

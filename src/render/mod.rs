@@ -210,6 +210,40 @@ impl Renderer {
         }
     }
 
+    /// The GPU context of `opts`, opened now (or the pending one waited
+    /// for) if none is open yet.
+    fn open_gpu(&mut self, opts: &RenderOptions) -> Result<&Context, RenderError> {
+        if self.gpu.is_none() {
+            self.gpu = Some(match self.pending_gpu.take() {
+                Some(p) if p.options() == &opts.gpu => p.wait()?,
+                _ => Context::new(&opts.gpu)?,
+            });
+        }
+        match self.gpu.as_ref() {
+            Some(g) => Ok(g),
+            None => unreachable!("opened above"),
+        }
+    }
+
+    /// How exact-frag draws its pieces for `opts`: `auto` is whole-piece
+    /// quads on a hardware GPU (the CPU then only sorts and packs pieces)
+    /// and regions on a software adapter (its triangle setup dearer than
+    /// the quads' fragments) and on the CPU twin.
+    fn piece_draw(&mut self, opts: &RenderOptions) -> Result<PieceDraw, RenderError> {
+        Ok(match opts.projected.piece_draw {
+            PieceDraw::Auto => {
+                let hardware = opts.projected.compositor == Compositor::Gpu
+                    && !self.open_gpu(opts)?.info().is_software();
+                if hardware {
+                    PieceDraw::Quads
+                } else {
+                    PieceDraw::Regions
+                }
+            }
+            d => d,
+        })
+    }
+
     /// The visibility sorter of the projected-cell modes (made on first
     /// use), e.g. to change its options ([`Sorter::plane_split`],
     /// [`Sorter::nonconvex`]).
@@ -301,7 +335,7 @@ impl Renderer {
                 };
                 self.projected(&mode, &scene, opts, camera, progress)?
             }
-            Mode::ExactFrag if opts.projected.piece_draw == PieceDraw::Quads => self.projected(
+            Mode::ExactFrag if self.piece_draw(opts)? == PieceDraw::Quads => self.projected(
                 &modes::piece_quad::ExactFragQuads,
                 &scene,
                 opts,

@@ -152,9 +152,14 @@ pub struct ProjectedOptions {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum PieceDraw {
+    /// `quads` on a hardware GPU (the CPU then only sorts and packs
+    /// pieces), `regions` on a software adapter (llvmpipe, lavapipe: their
+    /// triangle setup dearer than the quads' fragment loop) and on the CPU
+    /// twin.
+    #[default]
+    Auto,
     /// Each piece projected into regions on the CPU (winged-edge
     /// subdivision), the segment payload at their corners.
-    #[default]
     Regions,
     /// Each piece drawn whole as one quad over its pixel bounding box;
     /// every fragment intersects its ray with the piece's boundary
@@ -168,6 +173,7 @@ impl PieceDraw {
     /// The name `--piece-draw` takes.
     pub fn name(self) -> &'static str {
         match self {
+            PieceDraw::Auto => "auto",
             PieceDraw::Regions => "regions",
             PieceDraw::Quads => "quads",
         }
@@ -188,7 +194,7 @@ impl Default for ProjectedOptions {
             occlusion: Some(crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE),
             dark_subset: true,
             keep_projection: false,
-            piece_draw: PieceDraw::Regions,
+            piece_draw: PieceDraw::Auto,
         }
     }
 }

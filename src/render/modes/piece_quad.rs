@@ -231,11 +231,53 @@ impl QuadVertex {
             v.points[k] = [p.x as f32, p.y as f32, p.z as f32, s as f32];
             v.depth[k / 4][k % 4] = (p.z - z0) as f32;
         }
-        for (k, t) in part.triangles.iter().enumerate() {
-            let [a, b, c] = t.map(|i| local[i as usize]);
+        // Front triangles first, every triangle wound so that a ray
+        // through it has positive edge functions: its projection counter-
+        // clockwise (the sheared triangle of a ray through it has the
+        // projected one's orientation, depths being positive). A triangle
+        // faces the eye where the eye and the piece's centroid (inside it,
+        // unlike its bounding box's centre) lie on opposite sides of its
+        // plane.
+        let centre = part.points.iter().sum::<DVec3>() / n as f64;
+        let plane = |p: DVec3| {
+            if camera.ortho {
+                glam::DVec2::new(p.x, p.y)
+            } else {
+                glam::DVec2::new(p.x / p.z, p.y / p.z)
+            }
+        };
+        let mut packed = [[0u32; 3]; MAX_TRIANGLES];
+        let mut next = 0;
+        for pass in [true, false] {
+            for t in &part.triangles {
+                let [a, b, c] = t.map(|i| part.points[i as usize]);
+                let normal = (b - a).cross(c - a);
+                let inside = normal.dot(centre - a);
+                let eye = if camera.ortho {
+                    normal.z
+                } else {
+                    normal.dot(a)
+                };
+                if (eye * inside > 0.0) != pass {
+                    continue;
+                }
+                let (pa, pb, pc) = (plane(a), plane(b), plane(c));
+                let mut k = t.map(|i| local[i as usize]);
+                if (pb - pa).perp_dot(pc - pa) < 0.0 {
+                    k.swap(1, 2);
+                }
+                packed[next] = k;
+                next += 1;
+            }
+            if pass {
+                v.topo[1] = (next as u32) << 27;
+            }
+        }
+        for (k, [a, b, c]) in packed[..m].iter().enumerate() {
             v.topo[k / 3] |= (a | b << 3 | c << 6) << (9 * (k % 3));
         }
         v.topo[0] |= (m as u32) << 27;
+        v.topo[2] |= (n as u32) << 27;
         Some(v)
     }
 }
@@ -319,18 +361,25 @@ pub fn segment_at(
         p[0] * view.scale[0] + view.offset[0],
         p[1] * view.scale[1] + view.offset[1],
     ];
-    let q = f.points.map(|c| {
-        if view.ortho == 1 {
+    let (front_count, point_count) = (f.topo[1] >> 27, (f.topo[2] >> 27) as usize);
+    let mut q = [[0.0f32; 2]; MAX_POINTS];
+    for (qi, c) in q.iter_mut().zip(&f.points).take(point_count) {
+        *qi = if view.ortho == 1 {
             [c[0] - u[0], c[1] - u[1]]
         } else {
             [c[0] - u[0] * c[2], c[1] - u[1] * c[2]]
-        }
-    });
+        };
+    }
     let zs = |i: u32| f.depth[(i / 4) as usize][(i % 4) as usize];
+    let s = |i: u32| f.points[i as usize][3];
     let mut hit = [[0.0f32; 2]; 2];
     let mut found = [false; 2];
     let mut mask = [0u32; 2];
-    for k in 0..count {
+    let (mut side, mut k) = (0, 0);
+    loop {
+        if (side == 0 && k == front_count) || k >= count {
+            break;
+        }
         let [a, b, c] = corners(f.topo, k);
         let e = [
             edge(q[b as usize], q[c as usize], b, c),
@@ -338,25 +387,24 @@ pub fn segment_at(
             edge(q[a as usize], q[b as usize], a, b),
         ];
         let sum = e[0] + e[1] + e[2];
-        let side = if e.iter().all(|&x| x >= 0.0) && sum > 0.0 {
-            0
-        } else if e.iter().all(|&x| x <= 0.0) && sum < 0.0 {
-            1
-        } else {
-            continue;
-        };
-        if found[side] {
+        if e.iter().all(|&x| x >= 0.0) && sum > 0.0 {
+            let w = e.map(|x| x / sum);
+            found[side] = true;
+            mask[side] = ((e[0] != 0.0) as u32) << a
+                | ((e[1] != 0.0) as u32) << b
+                | ((e[2] != 0.0) as u32) << c;
+            hit[side] = [
+                w[0] * zs(a) + w[1] * zs(b) + w[2] * zs(c),
+                w[0] * s(a) + w[1] * s(b) + w[2] * s(c),
+            ];
+            if side == 1 {
+                break;
+            }
+            side = 1;
+            k = front_count;
             continue;
         }
-        found[side] = true;
-        mask[side] =
-            ((e[0] != 0.0) as u32) << a | ((e[1] != 0.0) as u32) << b | ((e[2] != 0.0) as u32) << c;
-        let w = e.map(|x| x / sum);
-        let s = |i: u32| f.points[i as usize][3];
-        hit[side] = [
-            w[0] * zs(a) + w[1] * zs(b) + w[2] * zs(c),
-            w[0] * s(a) + w[1] * s(b) + w[2] * s(c),
-        ];
+        k += 1;
     }
     let (mut front, mut back) = (hit[0], hit[1]);
     if back[0] < front[0] {
