@@ -33,7 +33,7 @@ use zoovr::generate::{warped_hex_grid, Warp};
 use zoovr::gpu::{Backend, Context, GpuOptions};
 use zoovr::image::compare_display;
 use zoovr::io::{self, ReadOptions};
-use zoovr::render::{Mode, RenderOptions, Renderer, Scene, SceneSpec};
+use zoovr::render::{Mode, PieceDraw, ProjectedOptions, RenderOptions, Renderer, Scene, SceneSpec};
 use zoovr::testdata::{hex_shell_scene, shared_file};
 
 fn scenes() -> Vec<(&'static str, Scene, CameraParams)> {
@@ -126,13 +126,34 @@ fn bench(c: &mut Criterion) {
                 };
                 Some(renderer.render(&shading, &opts, |_, _| {}).unwrap().0)
             };
+            // exact-frag both ways: regions, and whole-piece quads.
+            let runs: Vec<(Mode, PieceDraw)> = modes
+                .iter()
+                .flat_map(|&m| {
+                    let draws: &[PieceDraw] = if m == Mode::ExactFrag {
+                        &[PieceDraw::Regions, PieceDraw::Quads]
+                    } else {
+                        &[PieceDraw::Auto]
+                    };
+                    draws.iter().map(move |&d| (m, d))
+                })
+                .collect();
             for &(bname, gpu) in &backends {
-                for &mode in &modes {
+                for &(mode, draw) in &runs {
                     let opts = RenderOptions {
                         camera,
                         mode,
                         gpu,
+                        projected: ProjectedOptions {
+                            piece_draw: draw,
+                            ..Default::default()
+                        },
                         ..Default::default()
+                    };
+                    let mode = if draw == PieceDraw::Quads {
+                        format!("{mode}-quads")
+                    } else {
+                        mode.to_string()
                     };
                     // The first frame builds the sorter and opens the device.
                     let (_, first) = renderer.render(&shading, &opts, |_, _| {}).unwrap();
@@ -151,7 +172,7 @@ fn bench(c: &mut Criterion) {
                         })
                         .unwrap_or_default();
                     eprintln!(
-                        "{name} {mode} {bname} {size}: frame {:.2} s (first {:.2} s) = sort {:.3} + project/payload {:.2} + gpu {:.2} (upload+draw {:.2}, wait {:.2}, readback {:.3}); {} pieces, {} triangles, {} batches; error {err}",
+                        "{name} {mode} {bname} {size}: frame {:.2} s (first {:.2} s) = sort {:.3} + project/payload {:.2} + gpu {:.2} (upload+draw {:.2}, wait {:.2}, readback {:.3}); {} pieces ({} whole), {} triangles, {} batches; error {err}",
                         s.total_s,
                         first.total_s,
                         e.sort_s,
@@ -161,6 +182,7 @@ fn bench(c: &mut Criterion) {
                         e.gpu.gpu_wait_s,
                         e.gpu.readback_s,
                         e.pieces,
+                        e.whole_pieces,
                         e.triangles,
                         e.gpu.batches
                     );
