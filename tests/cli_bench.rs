@@ -74,7 +74,8 @@ fn rows_columns_errors_and_plot() {
         "{table}"
     );
 
-    // One row per (mode, setting, size, view): (1 + 3 + 3) x 2 x 2.
+    // One row per (mode, setting, size, view): (2 + 3 + 3) x 2 x 2
+    // (exact-frag regions and quads, three table sizes, three models).
     let (head, rows) = csv_rows(&csv);
     for c in [
         "mode",
@@ -99,10 +100,10 @@ fn rows_columns_errors_and_plot() {
     ] {
         assert!(head.iter().any(|h| h == c), "column {c} missing: {head:?}");
     }
-    assert_eq!(rows.len(), 28, "{rows:?}");
+    assert_eq!(rows.len(), 32, "{rows:?}");
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    assert_eq!(v["rows"].as_array().unwrap().len(), 28);
+    assert_eq!(v["rows"].as_array().unwrap().len(), 32);
     assert_eq!(v["repeats"], 1);
 
     let gpu = render_util::gpu_available();

@@ -154,6 +154,21 @@ fn usage_errors_say_what_is_wrong() {
     for (bad, words) in [
         (vec!["--size", "0x10"], ["--size", "0x10"]),
         (vec!["--range", "1,1"], ["--range", "1,1"]),
+        (
+            vec!["--piece-draw", "quads"],
+            ["--piece-draw quads", "--mode exact-frag"],
+        ),
+        (
+            vec![
+                "--mode",
+                "exact-frag",
+                "--iso",
+                "0.5",
+                "--piece-draw",
+                "quads",
+            ],
+            ["--piece-draw quads", "without --iso"],
+        ),
     ] {
         let mut args = vec!["render", mesh, "-o", "x.png"];
         args.extend(bad);
@@ -186,6 +201,45 @@ fn raycast_stats_and_other_mode_flags() {
         e.contains("--split all is for the projected-cell modes"),
         "{e}"
     );
+}
+
+/// `--piece-draw quads`: exact-frag draws its pieces whole, reports how
+/// many in `--stats`, and gives the image of `--piece-draw regions`.
+#[test]
+fn exact_frag_draws_pieces_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = mesh_file("zoo_3x3x3.vtu");
+    let mut images = Vec::new();
+    for draw in ["regions", "quads"] {
+        let png = dir.path().join(format!("{draw}.png"));
+        let o = render(
+            &mesh,
+            &png,
+            &[
+                "--size",
+                "48x40",
+                "--mode",
+                "exact-frag",
+                "--piece-draw",
+                draw,
+                "--stats",
+            ],
+        );
+        if no_adapter(&o) {
+            return;
+        }
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert_eq!(
+            stderr(&o).contains("pieces drawn whole"),
+            draw == "quads",
+            "{}",
+            stderr(&o)
+        );
+        images.push(Image::read(&png).unwrap());
+    }
+    let (d, _) = zoovr::image::compare_float(&images[0], &images[1]).unwrap();
+    // Both within 2/255 of the reference, 8-bit PNGs.
+    assert!(d.max_abs <= 4.0 / 255.0, "{}", d.max_abs);
 }
 
 /// `--stats --json`: one JSON object on stdout with the mode, the times and

@@ -46,7 +46,7 @@ use thiserror::Error;
 use crate::camera::CameraParams;
 use crate::image::{compare_display, Image, ImageDiff};
 use crate::raycast::FieldModel;
-use crate::render::{Mode, RenderError, RenderOptions, RenderStats, Renderer, Shading};
+use crate::render::{Mode, PieceDraw, RenderError, RenderOptions, RenderStats, Renderer, Shading};
 
 /// Side of the square probe images the estimate renders.
 pub const PROBE_SIDE: u32 = 64;
@@ -92,6 +92,8 @@ pub enum Setting {
     Table(u32),
     /// The ray caster's field (`--model`).
     Model(FieldModel),
+    /// How exact-frag draws its pieces (`--piece-draw`: regions or quads).
+    PieceDraw(PieceDraw),
 }
 
 impl Setting {
@@ -102,6 +104,7 @@ impl Setting {
             Setting::RefineTol(t) => format!("refine-tol={t}"),
             Setting::Table(n) => format!("table={n}"),
             Setting::Model(m) => format!("model={}", m.name()),
+            Setting::PieceDraw(d) => format!("piece-draw={}", d.name()),
         }
     }
 
@@ -113,6 +116,7 @@ impl Setting {
             Setting::RefineTol(t) => -t,
             Setting::Table(n) => n as f64,
             Setting::Model(m) => m as u8 as f64,
+            Setting::PieceDraw(d) => d as u8 as f64,
         }
     }
 
@@ -122,6 +126,7 @@ impl Setting {
             Setting::RefineTol(t) => opts.projected.refine_tol = t,
             Setting::Table(n) => opts.tables.size = Some(n),
             Setting::Model(m) => opts.reference.model = m,
+            Setting::PieceDraw(d) => opts.projected.piece_draw = d,
         }
     }
 }
@@ -167,7 +172,11 @@ pub fn entries_for(modes: &[Mode]) -> Vec<Entry> {
                 [32, 64, 128].into_iter().map(Setting::Table).collect()
             }
             Mode::Preint2d => [128, 256, 512].into_iter().map(Setting::Table).collect(),
-            Mode::ExactFrag | Mode::Iso => vec![Setting::Default],
+            Mode::ExactFrag => [PieceDraw::Regions, PieceDraw::Quads]
+                .into_iter()
+                .map(Setting::PieceDraw)
+                .collect(),
+            Mode::Iso => vec![Setting::Default],
             Mode::Raycast => [FieldModel::Faces, FieldModel::Tets, FieldModel::Native]
                 .into_iter()
                 .map(Setting::Model)

@@ -156,7 +156,7 @@ impl QuadVertex {
         }
         if !camera.ortho {
             let zc = camera.near * NEAR_CLIP_SCALE;
-            if part.points.iter().any(|p| !(p.z >= zc)) {
+            if !part.points.iter().all(|p| p.z >= zc) {
                 return None;
             }
         }
@@ -194,12 +194,12 @@ impl QuadVertex {
                 (a + b + c) / 3.0
             };
             let len = normal.length() * ray.length();
-            if !(len > 0.0) {
+            if len.is_nan() || len <= 0.0 {
                 return None;
             }
             cos_min = cos_min.min(normal.dot(ray).abs() / len);
         }
-        if !(cos_min >= QUAD_MIN_COS) {
+        if cos_min.is_nan() || cos_min < QUAD_MIN_COS {
             return None;
         }
         let (mut lo, mut hi) = (part.points[0], part.points[0]);
@@ -220,7 +220,8 @@ impl QuadVertex {
         let diameter = (hi - lo).length();
         let shift = QUAD_F32_REL * (coord / cos_min + diameter);
         let rate = rate();
-        if !(rate * shift <= QUAD_DEPTH_TOL) {
+        let depth = rate * shift;
+        if depth.is_nan() || depth > QUAD_DEPTH_TOL {
             return None;
         }
         let mut v = QuadVertex::default();
