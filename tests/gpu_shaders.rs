@@ -22,6 +22,9 @@ fn stages() -> Vec<&'static StageDesc> {
         &iso::ISO_PREINT3D_STAGE,
         &iso::ISO_PREINT2D_STAGE,
         &iso::ISO_PREINT2D_CYL_STAGE,
+        // exact-frag's whole-piece quads.
+        &zoovr::render::modes::piece_quad::PIECE_QUAD_STAGE,
+        &zoovr::render::modes::piece_quad::PIECE_QUAD_THIN_STAGE,
     ]);
     v
 }
@@ -99,6 +102,11 @@ fn format_of(inner: &TypeInner) -> Option<wgpu::VertexFormat> {
                 VectorSize::Quad => wgpu::VertexFormat::Float32x4,
             })
         }
+        TypeInner::Vector { size, scalar } if scalar.kind == ScalarKind::Uint => Some(match size {
+            VectorSize::Bi => wgpu::VertexFormat::Uint32x2,
+            VectorSize::Tri => wgpu::VertexFormat::Uint32x3,
+            VectorSize::Quad => wgpu::VertexFormat::Uint32x4,
+        }),
         _ => None,
     }
 }
