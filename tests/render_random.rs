@@ -1,4 +1,5 @@
-//! Randomised comparison of the exact mode with the reference ray caster:
+//! Randomised comparison of the exact mode (and of exact-frag with its
+//! pieces drawn whole, `--piece-draw quads`) with the reference ray caster:
 //! seeded random dataset x view x size, `--split all` against `--model
 //! tets` (the same field), bounded over every pixel; the last cases look
 //! along the axes at odd sizes.
@@ -15,7 +16,8 @@ use zoovr::image::{compare_display, Image};
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
 use zoovr::render::{
-    Compositor, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer, Scene, SceneSpec,
+    Compositor, Mode, PieceDraw, ProjectedOptions, ReferenceOptions, RenderOptions, Renderer,
+    Scene, SceneSpec,
 };
 use zoovr::testdata::{mesh_file, shared_file};
 
@@ -118,6 +120,44 @@ fn random_views_match_the_reference_on_every_pixel() {
         assert_eq!(img.count_non_finite(), 0, "{tag}: non-finite pixels");
         let (d, _) = compare_display(&img, &want, [0.0; 3]).unwrap();
         eprintln!("{tag}: max {:.2e} rms {:.2e}", d.max_abs, d.rms);
+        // exact-frag with its pieces drawn whole (`--piece-draw quads`):
+        // the same bound, every pixel.
+        let quads = RenderOptions {
+            mode: Mode::ExactFrag,
+            projected: ProjectedOptions {
+                piece_draw: PieceDraw::Quads,
+                ..exact.projected
+            },
+            ..exact.clone()
+        };
+        let (qimg, qstats) = renderer
+            .render(&scene.shading(), &quads, |_, _| {})
+            .unwrap();
+        assert_eq!(qimg.count_non_finite(), 0, "{tag}: non-finite quad pixels");
+        let (dq, _) = compare_display(&qimg, &want, [0.0; 3]).unwrap();
+        let whole = qstats.projected().map_or(0, |e| e.whole_pieces);
+        eprintln!(
+            "{tag}: quads max {:.2e} rms {:.2e} ({whole} pieces whole)",
+            dq.max_abs, dq.rms
+        );
+        assert!(whole > 0, "{tag}: no piece drawn whole");
+        if dq.max_abs > MAX {
+            let (i, j) = dq.worst;
+            let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_random");
+            let _ = std::fs::create_dir_all(&dir);
+            let _ = crop(&qimg, i, j, 8).write_png(
+                &dir.join(format!("case{case}_quads.png")),
+                [0.0; 3],
+                false,
+            );
+            panic!(
+                "{tag}: quads pixel ({i}, {j}) differs by {:.3e} > {MAX:.3e}: quads {:?}, reference {:?} (crop in {})",
+                dq.max_abs,
+                qimg.get(i, j),
+                want.get(i, j),
+                dir.display()
+            );
+        }
         // PentaHexa reached 2.37e-2 (case 13) on the image's centre column:
         // a face seen nearly edge-on whose thickness rises from 0 to 0.4
         // across 0.02 px, refined into slivers that collapsed on the
