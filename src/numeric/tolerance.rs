@@ -441,3 +441,21 @@ pub const ISO_LEVEL_F32: f64 = 1e-6;
 /// (`render::ties::scan_triangles`): ten times [`ISO_LEVEL_F32`], above
 /// the `f32` rounding of the stages' scalars.
 pub const ISO_SLIVER_REL: f64 = 1e-5;
+
+/// Relative rounding of the fragment's `f32` geometry: the shear and the
+/// edge functions are a handful of operations on coordinates of magnitude
+/// `|p|`, each within half an ulp (2^-24) of it; 2^-20 covers 16 of them.
+pub const QUAD_F32_REL: f64 = 1.0 / 1048576.0;
+
+/// The optical depth (or emitted colour) the `f32` geometry of a whole
+/// piece may shift a segment by: the region path's sliver tolerance
+/// ([`crate::render::ties::SLIVER_DEPTH_TOL`], a quarter of an 8-bit level),
+/// for the same guarantee on both paths of exact-frag
+/// ([`crate::render::modes::piece_quad`]).
+pub const QUAD_DEPTH_TOL: f64 = 1e-3;
+
+/// The least cosine between a whole piece's faces and the ray: a face
+/// nearer edge-on leaves the barycentric weights ill-conditioned (its
+/// sheared triangle is a sliver), whatever the rates; the region path and
+/// its exact decisions take such pieces.
+pub const QUAD_MIN_COS: f64 = 1e-3;

@@ -10,8 +10,11 @@
 //!    Pieces hidden behind opaque ones are then left out
 //!    ([`super::occlusion`], a front-to-back pass over the order).
 //! 2. Each piece becomes its view-space parts ([`PieceSource::parts`]:
-//!    pieces with zero extinction over their range are skipped), each part
-//!    is projected into regions ([`Projector`]), leaving out pieces and
+//!    pieces with zero extinction over their range are skipped). A mode
+//!    that draws a part whole ([`ProjectedMode::whole_part`]: exact-frag's
+//!    quads) gets one quad over the part's pixel bounding box
+//!    ([`draw_whole`]); every other part is projected into regions
+//!    ([`Projector`]), leaving out pieces and
 //!    triangles that contain no pixel centre
 //!    ([`crate::projection::coverage`],
 //!    [`super::ProjectedOptions::cull_to_pixels`]).

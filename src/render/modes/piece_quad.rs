@@ -40,7 +40,7 @@ use glam::DVec3;
 use crate::camera::Camera;
 use crate::gpu::cpu::{lerp, CpuStage};
 use crate::gpu::{Binding, ClipMapper, Context, GpuError, GpuVertex, Stage, StageDesc};
-use crate::numeric::tolerance::NEAR_CLIP_SCALE;
+use crate::numeric::tolerance::{NEAR_CLIP_SCALE, QUAD_DEPTH_TOL, QUAD_F32_REL, QUAD_MIN_COS};
 use crate::projection::{Polyhedron, Projected};
 use crate::render::driver::ProjectedMode;
 use crate::render::pieces::PieceSource;
@@ -57,22 +57,6 @@ pub const MAX_POINTS: usize = 8;
 /// Most boundary triangles of a piece drawn whole (three per `u32`, four
 /// words, the count in the top bits of the first).
 pub const MAX_TRIANGLES: usize = 12;
-
-/// Relative rounding of the fragment's `f32` geometry: the shear and the
-/// edge functions are a handful of operations on coordinates of magnitude
-/// `|p|`, each within half an ulp (2^-24) of it; 2^-20 covers 16 of them.
-pub const QUAD_F32_REL: f64 = 1.0 / 1048576.0;
-
-/// The optical depth (or emitted colour) the `f32` geometry of a whole
-/// piece may shift a segment by: the region path's sliver tolerance
-/// ([`crate::render::ties::SLIVER_DEPTH_TOL`], a quarter of an 8-bit level).
-pub const QUAD_DEPTH_TOL: f64 = crate::render::ties::SLIVER_DEPTH_TOL;
-
-/// The least cosine between a whole piece's faces and the ray: a face
-/// nearer edge-on leaves the barycentric weights ill-conditioned (its
-/// sheared triangle is a sliver), whatever the rates; the region path and
-/// its exact decisions take such pieces.
-pub const QUAD_MIN_COS: f64 = 1e-3;
 
 /// One vertex of the quad stage. Keep in sync with `VertexIn` in
 /// `shaders/piece_quad.wgsl`.
