@@ -13,6 +13,15 @@
 //!
 //! Run: `cargo bench --bench render` (`-- bluntfin` to filter).
 //!
+//! exact-frag runs twice, as regions and with its pieces drawn whole
+//! (`exact-frag-quads`, `--piece-draw quads`). Measured 2026-12-06
+//! (lavapipe / GL, frame after the first): hex_shell 512^2 regions 0.90 /
+//! 0.86 s (projection 0.73 s), quads 2.43 / 2.20 s (packing 0.12 s, the
+//! rest the fragments' search); 1024^2 1.89 / 1.88 s against 5.07 / 5.39
+//! s; bluntfin 512^2 0.40 s (criterion) against 1.11 s; grid_1m 512^2 5.39
+//! / 5.33 s against 11.8 / 12.0 s. Errors: hex_shell RMS 1.55e-5 regions,
+//! 2.59e-6 quads (max 4.2e-4 both).
+//!
 //! Measured 2026-12-02 (Mesa 22.3.6, 2 idle cores), frame after the first
 //! (Vulkan / GL): bluntfin 0.22 / 0.22 s at 512^2 (criterion), 0.39 / 0.39
 //! s at 1024^2; hex_shell 2.24 / 2.31 s at 512^2 (2.95M triangles), 3.29 /
