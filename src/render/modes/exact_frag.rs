@@ -241,6 +241,8 @@ impl CpuStage<SegmentVertex> for ExactFragTwin {
 pub struct ExactFragMode;
 
 impl SegmentMode for ExactFragMode {
+    type Vertex = SegmentVertex;
+
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         let tf = TfBuffer::new(src.tf, &ScalarMap::of(src.tf));
         let longest = longest_segment(gpu, src)?;

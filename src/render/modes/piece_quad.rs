@@ -41,14 +41,13 @@ use crate::camera::Camera;
 use crate::gpu::cpu::{lerp, CpuStage};
 use crate::gpu::{Binding, ClipMapper, Context, GpuError, GpuVertex, Stage, StageDesc};
 use crate::numeric::tolerance::{NEAR_CLIP_SCALE, QUAD_DEPTH_TOL, QUAD_F32_REL, QUAD_MIN_COS};
-use crate::projection::{Polyhedron, Projected};
-use crate::render::driver::ProjectedMode;
+use crate::projection::Polyhedron;
 use crate::render::pieces::PieceSource;
 use crate::tf::TransferFunction;
 
-use super::exact_frag::{bind_integral_stage, integral_stage, longest_segment};
-use super::integral::{closed_form_constants, TfBuffer};
-use super::segment::{ScalarMap, Seg, SegmentPayload, SegmentVertex, SegmentView};
+use super::exact_frag::{bind_integral_stage, integral_stage, longest_segment, ExactFragTwin};
+use super::integral::TfBuffer;
+use super::segment::{ScalarMap, Seg, SegmentMode, SegmentVertex, SegmentView};
 use super::segment_view::segment_of;
 
 /// Most points of a piece drawn whole (3 bits per corner index).
@@ -267,6 +266,12 @@ impl QuadVertex {
     }
 }
 
+impl From<SegmentVertex> for QuadVertex {
+    fn from(v: SegmentVertex) -> QuadVertex {
+        QuadVertex::region(v)
+    }
+}
+
 impl GpuVertex for QuadVertex {
     fn clip(&self) -> [f32; 4] {
         self.pos
@@ -440,38 +445,28 @@ const fn quad_stage(name: &'static str, constants: &'static [(&'static str, f64)
     }
 }
 
-/// The quad stage's bindings on the CPU, for its twin [`fs_main`].
-pub struct QuadTwin {
-    view: SegmentView,
-    mapper: ClipMapper,
-    tf: TfBuffer,
-    consts: Vec<[f32; 4]>,
-}
+/// The quad stage's bindings on the CPU, for its twin [`fs_main`]: those
+/// of the exact-frag stage (view, transfer function, the closed form's
+/// constants).
+pub struct QuadTwin(ExactFragTwin);
 
 impl QuadTwin {
     /// The twin for `tf` seen by `camera`.
     pub fn new(tf: &TransferFunction, camera: &Camera) -> QuadTwin {
-        QuadTwin {
-            view: SegmentView::of(camera),
-            mapper: ClipMapper::for_camera(camera),
-            tf: TfBuffer::new(tf, &ScalarMap::of(tf)),
-            consts: closed_form_constants(),
-        }
+        QuadTwin(ExactFragTwin::new(tf, camera))
+    }
+
+    fn segment(&self, tri: [&QuadVertex; 3], bary: [f64; 3]) -> Seg {
+        let (view, mapper) = self.0.view();
+        segment_at(&view, &mapper, tri, bary)
     }
 }
 
 /// The twin of exact-frag's `fs_main` in the quad stage: the fragment's
 /// segment ([`segment_at`]), integrated.
 pub fn fs_main(stage: &QuadTwin, tri: [&QuadVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
-    let seg = segment_at(&stage.view, &stage.mapper, tri, bary);
-    if !seg.ok {
-        return None;
-    }
-    Some(
-        stage
-            .tf
-            .integrate_segment(&stage.consts, seg.l, seg.s_f, seg.s_b),
-    )
+    let seg = stage.segment(tri, bary);
+    seg.ok.then(|| stage.0.volume(seg.l, seg.s_f, seg.s_b))
 }
 
 impl CpuStage<QuadVertex> for QuadTwin {
@@ -480,11 +475,11 @@ impl CpuStage<QuadVertex> for QuadTwin {
     }
 
     fn covers(&self, tri: [&QuadVertex; 3], bary: [f64; 3]) -> bool {
-        segment_at(&self.view, &self.mapper, tri, bary).ok
+        self.segment(tri, bary).ok
     }
 
     fn describe(&self, tri: [&QuadVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {
-        let seg = segment_at(&self.view, &self.mapper, tri, bary);
+        let seg = self.segment(tri, bary);
         vec![
             ("s_f", seg.s_f),
             ("s_b", seg.s_b),
@@ -494,22 +489,14 @@ impl CpuStage<QuadVertex> for QuadTwin {
     }
 }
 
-/// Exact-frag with whole-piece quads on the projected-cell driver: the
+/// Exact-frag with whole-piece quads, a mode on the segment payload: the
 /// pieces [`QuadVertex::whole`] takes are drawn whole, the others as
-/// regions with the segment payload, in one stage.
+/// regions with the segment payload, in one stage. Its frames are not
+/// kept for the next (which pieces go whole depends on the extinction).
 pub struct ExactFragQuads;
 
-impl ProjectedMode for ExactFragQuads {
+impl SegmentMode for ExactFragQuads {
     type Vertex = QuadVertex;
-    type Payload = SegmentPayload;
-
-    fn split_points(&self, _tf: &TransferFunction) -> Vec<f64> {
-        Vec::new()
-    }
-
-    fn perspective_refine(&self) -> bool {
-        SegmentVertex::needs_perspective_refinement()
-    }
 
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         let tf = TfBuffer::new(src.tf, &ScalarMap::of(src.tf));
@@ -526,33 +513,14 @@ impl ProjectedMode for ExactFragQuads {
         &self,
         src: &PieceSource,
         part: &Polyhedron,
-        payload: &mut SegmentPayload,
+        map: &ScalarMap,
         rate: &dyn Fn() -> f64,
     ) -> Option<QuadVertex> {
-        payload.set(src);
-        QuadVertex::whole(part, &payload.map, src.camera, rate)
+        QuadVertex::whole(part, map, src.camera, rate)
     }
 
-    fn payload(
-        &self,
-        src: &PieceSource,
-        _part: &Polyhedron,
-        _proj: &mut Projected,
-        _used: &mut Vec<bool>,
-        payload: &mut SegmentPayload,
-        _refined: &mut usize,
-    ) {
-        payload.set(src);
-    }
-
-    fn vertex(
-        &self,
-        payload: &SegmentPayload,
-        proj: &Projected,
-        i: usize,
-        ndc: [f32; 2],
-    ) -> QuadVertex {
-        QuadVertex::region(SegmentVertex::of(proj, i, ndc, &payload.map, payload.ortho))
+    fn keeps_projection(&self) -> bool {
+        false
     }
 }
 

@@ -445,6 +445,8 @@ impl PreintMode {
 }
 
 impl SegmentMode for PreintMode {
+    type Vertex = SegmentVertex;
+
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         self.bind_stage(gpu, None, src.whole, src.tf, src.camera, &[])
     }

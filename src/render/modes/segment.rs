@@ -283,17 +283,38 @@ impl SegmentPayload {
 /// A projected-cell mode on the segment payload (exact-frag, the table
 /// modes): it supplies its stage and its twin; every such mode is a
 /// [`ProjectedMode`] that slices nowhere, needs no perspective refinement
-/// and sends [`SegmentVertex::of`] its [`SegmentPayload`].
+/// and sends [`SegmentVertex::of`] its [`SegmentPayload`] (as its own
+/// vertex type, [`SegmentMode::Vertex`]: the segment vertex itself, or a
+/// vertex that carries it, as exact-frag's whole-piece quads do).
 pub trait SegmentMode: Sync {
+    /// The stage's vertex: [`SegmentVertex`], or one made from it.
+    type Vertex: GpuVertex + From<SegmentVertex>;
     /// Binds the mode's stage for one frame of `src`.
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError>;
     /// The stage's bindings on the CPU, drawing through its twin, for one
     /// frame of `src`.
-    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>>;
+    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<Self::Vertex>>;
+    /// The vertex that draws `part` whole ([`ProjectedMode::whole_part`]);
+    /// none by default.
+    fn whole_part(
+        &self,
+        _src: &PieceSource,
+        _part: &Polyhedron,
+        _map: &ScalarMap,
+        _rate: &dyn Fn() -> f64,
+    ) -> Option<Self::Vertex> {
+        None
+    }
+    /// Whether a frame's triangles may be kept for the next frame whose
+    /// transfer function differs only in colours
+    /// ([`ProjectedMode::stream_signature`]): yes by default.
+    fn keeps_projection(&self) -> bool {
+        true
+    }
 }
 
 impl<M: SegmentMode> ProjectedMode for M {
-    type Vertex = SegmentVertex;
+    type Vertex = M::Vertex;
     type Payload = SegmentPayload;
 
     fn split_points(&self, _tf: &TransferFunction) -> Vec<f64> {
@@ -305,15 +326,28 @@ impl<M: SegmentMode> ProjectedMode for M {
     }
 
     fn stream_signature(&self, tf: &TransferFunction) -> Option<Vec<u64>> {
-        crate::render::driver::kept::stream_signature(tf)
+        self.keeps_projection()
+            .then(|| crate::render::driver::kept::stream_signature(tf))
+            .flatten()
     }
 
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         SegmentMode::bind(self, gpu, src)
     }
 
-    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {
+    fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<M::Vertex>> {
         SegmentMode::twin(self, src)
+    }
+
+    fn whole_part(
+        &self,
+        src: &PieceSource,
+        part: &Polyhedron,
+        payload: &mut SegmentPayload,
+        rate: &dyn Fn() -> f64,
+    ) -> Option<M::Vertex> {
+        payload.set(src);
+        SegmentMode::whole_part(self, src, part, &payload.map, rate)
     }
 
     fn payload(
@@ -334,8 +368,8 @@ impl<M: SegmentMode> ProjectedMode for M {
         proj: &Projected,
         i: usize,
         ndc: [f32; 2],
-    ) -> SegmentVertex {
-        SegmentVertex::of(proj, i, ndc, &payload.map, payload.ortho)
+    ) -> M::Vertex {
+        SegmentVertex::of(proj, i, ndc, &payload.map, payload.ortho).into()
     }
 }
 
