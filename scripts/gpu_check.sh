@@ -26,6 +26,9 @@
 #    sort, draw (projection and GPU) and total seconds, and cells per second
 #    (cells / total). Grids above 1M cells run exact-frag and preint3d
 #    only, to fit a 10-minute run.
+# A mode written NAME:HOW is `--mode NAME --piece-draw HOW`: exact-frag runs
+# both ways, its pieces projected into regions and drawn whole as quads
+# (`--piece-draw auto` picks quads on a GPU; this checks that choice).
 set -u
 Z=${1:?zoovr binary}
 G=${2:?gen_mesh binary}
@@ -51,8 +54,16 @@ case "$ADAPTER" in
 *llvmpipe* | *lavapipe* | *SwiftShader* | *Cpu*) say "WARNING: a CPU rasteriser, not a GPU" ;;
 esac
 
+# The render flags of a mode NAME or NAME:HOW.
+mode_args() {
+    case "$1" in
+    *:*) echo "--mode ${1%%:*} --piece-draw ${1#*:}" ;;
+    *) echo "--mode $1" ;;
+    esac
+}
+
 # 2. Correctness against the ray caster.
-MODES="exact exact-frag preint3d preint2d preint2d-cyl"
+MODES="exact exact-frag:regions exact-frag:quads preint3d preint2d preint2d-cyl"
 say ""
 say "max error over every pixel, --split all against the ray caster on tets"
 say "(bounds, each mode's registry entry: exact and exact-frag 7.8e-3 (2/255),"
@@ -65,7 +76,7 @@ for mesh in zoo_3x3x3.vtu ring_hole.vtu curvilinear_4x4x4.vtu; do
         line="$mesh [$view]:"
         for m in $MODES; do
             # shellcheck disable=SC2086
-            if "$Z" render "$HERE/meshes/$mesh" $view --size 256x256 --mode "$m" --split all \
+            if "$Z" render "$HERE/meshes/$mesh" $view --size 256x256 $(mode_args "$m") --split all \
                 --float "$WORK/$m.exr" -o "$WORK/$m.png" 2>"$WORK/err"; then
                 e=$("$Z" compare "$WORK/ref.exr" "$WORK/$m.exr" | awk '/max_abs/ {print $2}')
                 line="$line $m $e"
@@ -96,11 +107,12 @@ run_grid() {
     local cells
     cells=$("$Z" info "$mesh" --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["cells3d"])')
     say "grid: $cells hexes (written in $((SECONDS - t0)) s)"
-    say "mode          size   sort s   draw s   total s   cells/s (median of frames 1-3)"
+    say "mode                size   sort s   draw s   total s   cells/s (median of frames 1-3)"
     for size in 1024 2048; do
         for m in $modes; do
             rm -rf "$WORK/frames"
-            if ! timeout 240 "$Z" animate "$mesh" --orbit 2 --count 4 --mode "$m" --size "${size}x$size" \
+            # shellcheck disable=SC2046
+            if ! timeout 240 "$Z" animate "$mesh" --orbit 2 --count 4 $(mode_args "$m") --size "${size}x$size" \
                 --azimuth 20 --elevation 35 -o "$WORK/frames" --stats --json >"$WORK/f.jsonl" 2>"$WORK/err"; then
                 say "$m $size: FAILED ($(tail -1 "$WORK/err"))"
                 continue
@@ -110,14 +122,14 @@ run_grid() {
             s=$(field sort_s <"$WORK/f.jsonl" | median)
             d=$(field draw_s <"$WORK/f.jsonl" | median)
             t=$(field total_s <"$WORK/f.jsonl" | median)
-            say "$(printf '%-13s %-6s %-8.3f %-8.3f %-9.3f %.3g' "$m" "$size" "$s" "$d" "$t" "$(echo "$cells / $t" | bc -l)")"
+            say "$(printf '%-19s %-6s %-8.3f %-8.3f %-9.3f %.3g' "$m" "$size" "$s" "$d" "$t" "$(echo "$cells / $t" | bc -l)")"
         done
     done
     rm -f "$mesh"
 }
 for n in $GRIDS; do
     if [ "$n" -gt 1000000 ]; then
-        run_grid "$n" "exact-frag preint3d"
+        run_grid "$n" "exact-frag:regions exact-frag:quads preint3d"
     else
         run_grid "$n" "$MODES"
     fi

@@ -140,7 +140,8 @@ pub struct ProjectedOptions {
     /// the table modes; [`super::driver::kept`] says when it applies). Off
     /// by default: a kept frame holds its vertices (tens of bytes each,
     /// at most [`super::driver::kept::KEEP_MAX_BYTES`]). For interactive
-    /// colour editing through the library.
+    /// colour editing through the library. exact-frag's whole-piece quads
+    /// are not kept: which pieces go whole depends on the rates.
     pub keep_projection: bool,
     /// How exact-frag draws a piece (`--piece-draw`): projected into
     /// regions on the CPU, or whole, as one quad whose fragments find
