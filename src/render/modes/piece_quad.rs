@@ -327,6 +327,58 @@ pub fn edge(a: [f32; 2], b: [f32; 2], i: u32, j: u32) -> f32 {
     }
 }
 
+/// Twin of `point` in `shaders/piece_quad.wgsl`: point `i` of the piece.
+pub fn point(f: &QuadVertex, i: u32) -> [f32; 4] {
+    f.points[(i & 7) as usize]
+}
+
+/// Twin of `depth` in `shaders/piece_quad.wgsl`: point `i`'s depth
+/// relative to point 0.
+pub fn depth(f: &QuadVertex, i: u32) -> f32 {
+    f.depth[((i >> 2) & 1) as usize][(i & 3) as usize]
+}
+
+/// Twin of `shear` in `shaders/piece_quad.wgsl`: point `c` sheared onto
+/// the ray through view-plane position `u`.
+pub fn shear(view: &SegmentView, c: [f32; 4], u: [f32; 2]) -> [f32; 2] {
+    if view.ortho == 1 {
+        [c[0] - u[0], c[1] - u[1]]
+    } else {
+        [c[0] - u[0] * c[2], c[1] - u[1] * c[2]]
+    }
+}
+
+/// Twin of `find` in `shaders/piece_quad.wgsl`: the first of triangles
+/// `first..last` holding the ray through `u`, as (depth, scalar, mask of
+/// the points with nonzero weight), or `None`.
+pub fn find(
+    view: &SegmentView,
+    f: &QuadVertex,
+    u: [f32; 2],
+    first: u32,
+    last: u32,
+) -> Option<[f32; 3]> {
+    for k in first..last {
+        let [a, b, c] = corners(f.topo, k);
+        let [pa, pb, pc] = [a, b, c].map(|i| point(f, i));
+        let [qa, qb, qc] = [pa, pb, pc].map(|p| shear(view, p, u));
+        let e = [edge(qb, qc, b, c), edge(qc, qa, c, a), edge(qa, qb, a, b)];
+        let sum = e[0] + e[1] + e[2];
+        if e.iter().all(|&x| x >= 0.0) && sum > 0.0 {
+            let w = e.map(|x| x / sum);
+            let mask = ((e[0] != 0.0) as u32) << a
+                | ((e[1] != 0.0) as u32) << b
+                | ((e[2] != 0.0) as u32) << c;
+            return Some([
+                w[0] * depth(f, a) + w[1] * depth(f, b) + w[2] * depth(f, c),
+                w[0] * pa[3] + w[1] * pb[3] + w[2] * pc[3],
+                mask as f32,
+            ]);
+        }
+    }
+    None
+}
+
 /// Twin of `segment_at` in `shaders/piece_quad.wgsl`: the segment of the
 /// fragment of `tri` at weights `bary`. The GPU shades pixel centres, so
 /// the twin takes the centre of the pixel the interpolated position falls
@@ -351,55 +403,20 @@ pub fn segment_at(
         p[0] * view.scale[0] + view.offset[0],
         p[1] * view.scale[1] + view.offset[1],
     ];
-    let (front_count, point_count) = (f.topo[1] >> 27, (f.topo[2] >> 27) as usize);
-    let mut q = [[0.0f32; 2]; MAX_POINTS];
-    for (qi, c) in q.iter_mut().zip(&f.points).take(point_count) {
-        *qi = if view.ortho == 1 {
-            [c[0] - u[0], c[1] - u[1]]
-        } else {
-            [c[0] - u[0] * c[2], c[1] - u[1] * c[2]]
-        };
-    }
-    let zs = |i: u32| f.depth[(i / 4) as usize][(i % 4) as usize];
-    let s = |i: u32| f.points[i as usize][3];
-    let mut hit = [[0.0f32; 2]; 2];
-    let mut found = [false; 2];
-    let mut mask = [0u32; 2];
-    let (mut side, mut k) = (0, 0);
-    loop {
-        if (side == 0 && k == front_count) || k >= count {
-            break;
-        }
-        let [a, b, c] = corners(f.topo, k);
-        let e = [
-            edge(q[b as usize], q[c as usize], b, c),
-            edge(q[c as usize], q[a as usize], c, a),
-            edge(q[a as usize], q[b as usize], a, b),
-        ];
-        let sum = e[0] + e[1] + e[2];
-        if e.iter().all(|&x| x >= 0.0) && sum > 0.0 {
-            let w = e.map(|x| x / sum);
-            found[side] = true;
-            mask[side] = ((e[0] != 0.0) as u32) << a
-                | ((e[1] != 0.0) as u32) << b
-                | ((e[2] != 0.0) as u32) << c;
-            hit[side] = [
-                w[0] * zs(a) + w[1] * zs(b) + w[2] * zs(c),
-                w[0] * s(a) + w[1] * s(b) + w[2] * s(c),
-            ];
-            if side == 1 {
-                break;
-            }
-            side = 1;
-            k = front_count;
-            continue;
-        }
-        k += 1;
-    }
-    let (mut front, mut back) = (hit[0], hit[1]);
-    if back[0] < front[0] {
-        (front, back) = (hit[1], hit[0]);
-    }
+    let front_count = f.topo[1] >> 27;
+    let none = Seg {
+        s_f: 0.0,
+        s_b: 0.0,
+        l: 0.0,
+        ok: false,
+    };
+    let Some(a) = find(view, f, u, 0, front_count) else {
+        return none;
+    };
+    let Some(b) = find(view, f, u, front_count, count) else {
+        return none;
+    };
+    let (front, back) = if b[0] < a[0] { (b, a) } else { (a, b) };
     let mut l = back[0] - front[0];
     if view.ortho == 0 {
         l *= (1.0 + u[0] * u[0] + u[1] * u[1]).sqrt();
@@ -410,12 +427,7 @@ pub fn segment_at(
         s_f,
         s_b,
         l,
-        ok: found[0]
-            && found[1]
-            && mask[0] != mask[1]
-            && s_f.is_finite()
-            && s_b.is_finite()
-            && l.is_finite(),
+        ok: a[2] != b[2] && s_f.is_finite() && s_b.is_finite() && l.is_finite(),
     }
 }
 

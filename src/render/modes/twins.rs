@@ -97,7 +97,8 @@ pub fn stage_twins() -> Vec<StageTwins> {
         twins!("segment.wgsl": segment::segment_at),
         twins!("segment_vertex.wgsl"),
         twins!("segment_view.wgsl": segment_view::segment_of),
-        twins!("piece_quad.wgsl": piece_quad::segment_at, piece_quad::corners, piece_quad::edge),
+        twins!("piece_quad.wgsl": piece_quad::segment_at, piece_quad::corners, piece_quad::edge,
+            piece_quad::point, piece_quad::depth, piece_quad::shear, piece_quad::find),
         twins!("table_build.wgsl":
             cylinder::cyl_to_table, table_build::optical_depth, table_build::build_main),
     ]
