@@ -15,12 +15,13 @@
 //!
 //! exact-frag runs twice, as regions and with its pieces drawn whole
 //! (`exact-frag-quads`, `--piece-draw quads`). Measured 2026-12-06
-//! (lavapipe / GL, frame after the first): hex_shell 512^2 regions 0.90 /
-//! 0.86 s (projection 0.73 s), quads 2.43 / 2.20 s (packing 0.12 s, the
-//! rest the fragments' search); 1024^2 1.89 / 1.88 s against 5.07 / 5.39
-//! s; bluntfin 512^2 0.40 s (criterion) against 1.11 s; grid_1m 512^2 5.39
-//! / 5.33 s against 11.8 / 12.0 s. Errors: hex_shell RMS 1.55e-5 regions,
-//! 2.59e-6 quads (max 4.2e-4 both).
+//! (lavapipe / GL, frame after the first, regions then quads): hex_shell
+//! 512^2 1.16 / 1.22 s (projection 0.96 s) and 1.04 / 1.19 s (packing
+//! 0.13 s, the rest the fragments' search); 1024^2 2.60 / 2.24 s and 2.73
+//! / 2.20 s; bluntfin 512^2 0.34 / 0.30 s and 0.48 / 0.50 s (criterion);
+//! grid_1m 512^2 5.64 / 7.30 s and 5.40 / 4.88 s, 1024^2 13.0 / 11.0 s and
+//! 8.9 / 9.3 s. Errors: hex_shell RMS 1.55e-5 regions, 2.59e-6 quads (max
+//! 4.2e-4 both).
 //!
 //! Measured 2026-12-02 (Mesa 22.3.6, 2 idle cores), frame after the first
 //! (Vulkan / GL): bluntfin 0.22 / 0.22 s at 512^2 (criterion), 0.39 / 0.39
