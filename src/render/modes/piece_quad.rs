@@ -47,7 +47,7 @@ use crate::tf::TransferFunction;
 
 use super::exact_frag::{bind_integral_stage, integral_stage, longest_segment, ExactFragTwin};
 use super::integral::TfBuffer;
-use super::segment::{ScalarMap, Seg, SegmentMode, SegmentVertex, SegmentView};
+use super::segment::{ScalarMap, Seg, SegmentMode, SegmentPayload, SegmentVertex, SegmentView};
 use super::segment_view::segment_of;
 
 /// Most points of a piece drawn whole (3 bits per corner index).
@@ -525,10 +525,11 @@ impl SegmentMode for ExactFragQuads {
         &self,
         src: &PieceSource,
         part: &Polyhedron,
-        map: &ScalarMap,
+        payload: &mut SegmentPayload,
         rate: &dyn Fn() -> f64,
     ) -> Option<QuadVertex> {
-        QuadVertex::whole(part, map, src.camera, rate)
+        payload.set(src);
+        QuadVertex::whole(part, &payload.map, src.camera, rate)
     }
 
     fn keeps_projection(&self) -> bool {

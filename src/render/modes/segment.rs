@@ -294,13 +294,14 @@ pub trait SegmentMode: Sync {
     /// The stage's bindings on the CPU, drawing through its twin, for one
     /// frame of `src`.
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<Self::Vertex>>;
-    /// The vertex that draws `part` whole ([`ProjectedMode::whole_part`]);
-    /// none by default.
+    /// The vertex that draws `part` whole ([`ProjectedMode::whole_part`];
+    /// a mode that does sets `payload` for the frame first); none by
+    /// default, at no cost per part.
     fn whole_part(
         &self,
         _src: &PieceSource,
         _part: &Polyhedron,
-        _map: &ScalarMap,
+        _payload: &mut SegmentPayload,
         _rate: &dyn Fn() -> f64,
     ) -> Option<Self::Vertex> {
         None
@@ -346,8 +347,7 @@ impl<M: SegmentMode> ProjectedMode for M {
         payload: &mut SegmentPayload,
         rate: &dyn Fn() -> f64,
     ) -> Option<M::Vertex> {
-        payload.set(src);
-        SegmentMode::whole_part(self, src, part, &payload.map, rate)
+        SegmentMode::whole_part(self, src, part, payload, rate)
     }
 
     fn payload(
