@@ -4,7 +4,7 @@
 //! interpolated thickness, extinction, glow) and the ray caster's segments.
 //!
 //! ```sh
-//! cargo run --release --example pixel -- FILE I J [WIDTH] [--height H] [--ortho] [--azimuth A] [--elevation E] [--zoom Z] [--split] [--mode NAME] [--no-cull] [--tf FILE] [--refine-tol T]
+//! cargo run --release --example pixel -- FILE I J [WIDTH] [--height H] [--ortho] [--azimuth A] [--elevation E] [--zoom Z] [--split] [--mode NAME] [--no-cull] [--tf FILE] [--refine-tol T] [--iso V1,V2,..]
 //! ```
 
 use anyhow::{anyhow, Context as _, Result};
@@ -65,9 +65,20 @@ fn main() -> Result<()> {
     };
     let scene = Scene::build(mesh, &spec)?;
     let mut renderer = Renderer::new(scene.geometry());
+    // Surfaces (`--mode iso` draws them alone; the reference below then
+    // draws them with the volume, as `--iso` without `--iso-only`).
+    let iso = match args.iter().position(|a| a == "--iso") {
+        Some(k) => zoovr::render::iso::IsoOptions {
+            surfaces: zoovr::render::iso::parse_list(args.get(k + 1).context("--iso LIST")?)?,
+            alone: mode == Mode::Iso,
+            ..Default::default()
+        },
+        None => Default::default(),
+    };
     let opts = RenderOptions {
         camera,
         mode,
+        iso,
         projected: ProjectedOptions {
             split_all,
             compositor: Compositor::Cpu,

@@ -435,6 +435,20 @@ pub const ISO_LEVEL_ULPS: f64 = 4.0;
 /// within 2e-7 of the range of a surface at 0.9999) from the stages.
 pub const ISO_LEVEL_F32: f64 = 1e-6;
 
+/// How far (in `f32` ulps of the level, with a floor of
+/// [`ISO_DECIDE_FLOOR`]) a vertex's end scalar is put from a GPU level
+/// when its `f32` value falls on the other side of that level than the
+/// exact `f64` value falls of the reference's
+/// (`render::modes::iso::decided_end`): the stage reads `(s q) / q`
+/// interpolated from equal corners (a tie quad), within a few ulps of the
+/// stored quotient.
+pub const ISO_DECIDE_ULPS: f64 = 16.0;
+
+/// The absolute floor of [`ISO_DECIDE_ULPS`]' distance (normalised
+/// scalar), for a level at or near 0, where ulps are denormal (flushed to
+/// zero on GPUs).
+pub const ISO_DECIDE_FLOOR: f64 = 1e-20;
+
 /// How close (relative to the scalar) a sliver's interpolated entry or exit
 /// scalar at a pixel centre must come to an isovalue, beyond the snap's
 /// shift of it, for the centre to be decided on the exact geometry

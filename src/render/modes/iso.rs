@@ -27,7 +27,6 @@ use glam::{DVec2, DVec3};
 
 use crate::gpu::cpu::{lerp, CpuStage};
 use crate::gpu::{Binding, ClipMapper, Context, GpuError, GpuVertex, Resource, Stage, StageDesc};
-use crate::numeric::tolerance::ISO_LEVEL_F32;
 use crate::projection::{Polyhedron, Projected};
 use crate::render::driver::ProjectedMode;
 use crate::render::gradients::{barycentric, boundary_gradient, piece_gradient};
@@ -37,6 +36,7 @@ use crate::tf::{EmissionModel, TransferFunction};
 
 use super::exact_frag::{bind_integral_stage, integral_stage, longest_segment, ExactFragTwin};
 use super::integral::TfBuffer;
+pub use super::iso_levels::{decided_end, gpu_level};
 use super::preint::{PreintMode, PreintTwin};
 use super::preint_tables::{TableKind, TableStats};
 use super::segment::{segment_at, ScalarMap, Seg, SegmentPayload, SegmentVertex, SegmentView};
@@ -221,13 +221,6 @@ pub fn iso_buffers(set: &IsoSet, map: &ScalarMap) -> (IsoParams, Vec<IsoSurface>
         surfaces.push(IsoSurface::default());
     }
     (params, surfaces)
-}
-
-/// The level the stage compares with for normalised isovalue `v`: `v` in
-/// `f32` less [`ISO_LEVEL_F32`] of itself (see [`IsoSet::levels`]): exact at 0.
-pub fn gpu_level(v: f64) -> f32 {
-    let v32 = v as f32;
-    (v32 as f64 - ISO_LEVEL_F32 * v.abs()) as f32
 }
 
 macro_rules! iso_stage {
@@ -760,9 +753,20 @@ impl ProjectedMode for IsoMode {
     }
 
     fn vertex(&self, payload: &IsoPayload, proj: &Projected, i: usize, ndc: [f32; 2]) -> IsoVertex {
-        let seg = SegmentVertex::of(proj, i, ndc, &payload.seg.map, payload.seg.ortho);
+        let mut seg = SegmentVertex::of(proj, i, ndc, &payload.seg.map, payload.seg.ortho);
         let g = payload.grads.get(i).copied().unwrap_or([DVec3::ZERO; 2]);
         let v = &proj.vertices[i];
+        // A tie quad's exact segment (its values come with their faces)
+        // decides its pixel as the ray caster does: its ends on the
+        // reference's side of every level. Not a region vertex's: its
+        // values are interpolated over the region, where the stage's
+        // margin keeps a field that stays within it of a value (a face
+        // whose corners all hold the value) from crossing it.
+        if !proj.tie_faces.is_empty() {
+            let map = &payload.seg.map;
+            seg.front = decided_end(&self.set, map, v.s_front, seg.front);
+            seg.back = decided_end(&self.set, map, v.s_back, seg.back);
+        }
         let (zf, zb) = (v.z_front, v.z_back.max(v.z_front));
         let (qf, qb) = if payload.seg.ortho || !(zf > 0.0 && zb.is_finite()) {
             (1.0, 1.0)

@@ -46,11 +46,15 @@ pub fn iso_lines(face: &FaceTri, values: &[f64], ortho: bool, out: &mut Vec<[DVe
                 continue;
             }
             let t = (v - si) / (sj - si);
+            // In perspective `s / z` and `1 / z` are linear on screen, so
+            // the screen fraction `u` where `s = v` solves
+            // `(1 - u) (v - si) / zi = u (sj - v) / zj`: with
+            // `v - si = t (sj - si)`, `u = t zj / ((1 - t) zi + t zj)`.
             let t = if ortho {
                 t
             } else {
-                let (qi, qj) = (1.0 / face.z[i], 1.0 / face.z[j]);
-                t * qj / ((1.0 - t) * qi + t * qj)
+                let (zi, zj) = (face.z[i], face.z[j]);
+                t * zj / ((1.0 - t) * zi + t * zj)
             };
             if n < 2 && t.is_finite() {
                 ends[n] = face.p[i] + (face.p[j] - face.p[i]) * t.clamp(0.0, 1.0);
@@ -114,10 +118,12 @@ mod iso_line_tests {
 
     #[test]
     fn in_perspective_the_line_divides_edges_by_s_over_z() {
-        // An edge from depth 1 to depth 3 with s from 0 to 1: s = 1/2 at
-        // the 3D midpoint, depth 2, which projects (x / z) to 1/2 of the
-        // way in q-weighted terms: t' = t q_b / ((1 - t) q_a + t q_b) =
-        // (1/6) / (1/2 + 1/6) = 1/4 of the screen edge.
+        // An edge from (0, 0) at depth 1 to (8, 0) at depth 3 on screen
+        // (world x = 0 and 24, screen x = world x / z), with s from 0 to 1:
+        // s = 1/2 at the world midpoint, x = 12 at depth 2, which is
+        // screen x = 6, 3/4 of the screen edge (the far half is drawn
+        // smaller). On the edge from the far corner to (0, 8) at depth 1
+        // with s = 0, s = 1/2 at world (12, 4), depth 2: screen (6, 2).
         let f = face(
             [[0.0, 0.0], [8.0, 0.0], [0.0, 8.0]],
             [1.0, 3.0, 1.0],
@@ -129,7 +135,13 @@ mod iso_line_tests {
         assert!(
             out[0]
                 .iter()
-                .any(|e| (*e - DVec2::new(2.0, 0.0)).length() < 1e-12),
+                .any(|e| (*e - DVec2::new(6.0, 0.0)).length() < 1e-12),
+            "{out:?}"
+        );
+        assert!(
+            out[0]
+                .iter()
+                .any(|e| (*e - DVec2::new(6.0, 2.0)).length() < 1e-12),
             "{out:?}"
         );
     }

@@ -29,6 +29,7 @@ pub mod exact_frag;
 pub mod exact_iso;
 pub mod integral;
 pub mod iso;
+pub mod iso_levels;
 pub mod iso_seams;
 pub mod piece_quad;
 pub mod preint;
