@@ -65,8 +65,8 @@ fn main() -> Result<()> {
     };
     let scene = Scene::build(mesh, &spec)?;
     let mut renderer = Renderer::new(scene.geometry());
-    // Surfaces (`--mode iso` draws them alone; the reference below then
-    // draws them with the volume, as `--iso` without `--iso-only`).
+    // Surfaces: with `--mode iso` alone, in the mode and in the reference
+    // below; with the volume in the other modes.
     let iso = match args.iter().position(|a| a == "--iso") {
         Some(k) => zoovr::render::iso::IsoOptions {
             surfaces: zoovr::render::iso::parse_list(args.get(k + 1).context("--iso LIST")?)?,
