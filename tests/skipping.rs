@@ -478,3 +478,114 @@ fn pieces_behind_opaque_ones_are_left_out_and_the_image_is_unchanged() {
         }
     }
 }
+
+/// A warped grid whose field is the distance from a point inside it, with
+/// a transfer function whose extinction is `tau` everywhere: surfaces of
+/// the field are closed, nested shells.
+fn shells_scene(tau: f64) -> Scene {
+    let mut mesh = warped_hex_grid(
+        14,
+        &Warp {
+            amplitude: 0.08,
+            seed: 7,
+        },
+    );
+    let c = glam::DVec3::new(0.48, 0.52, 0.5);
+    let d: Vec<f64> = mesh.points.iter().map(|&p| (p - c).length()).collect();
+    let f = mesh
+        .point_data
+        .iter_mut()
+        .find(|a| a.name == "f")
+        .expect("generated field");
+    f.data = zoovr::field::ArrayData::F64(d);
+    f.vtk_type = "Float64".into();
+    let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
+    scene.tf = TransferFunction::from_channels(
+        &[(0.0, [tau]), (1.0, [tau])],
+        &[(0.0, [0.9, 0.3, 0.2]), (1.0, [0.2, 0.3, 1.0])],
+        None,
+        EmissionModel::Glow,
+    )
+    .unwrap();
+    scene
+}
+
+/// An opaque isosurface hides what lies behind it (LH's view-dependent
+/// culling): a cell whose chord at a pixel centre enters below the value
+/// and leaves above it (or the other way round, with a margin) credits that
+/// centre as opaque, so the far half of a closed shell and the volume
+/// behind it are left out, in every mode that draws surfaces, alone and
+/// mixed, and the image is the same to 1e-6. A translucent surface, or
+/// RKE's blended mixing (which weighs surfaces down), hides nothing.
+#[test]
+fn pieces_behind_an_opaque_surface_are_left_out_and_the_image_is_unchanged() {
+    use zoovr::render::iso::{parse_list, IsoMix, IsoOptions};
+    for (ortho, azimuth, elevation) in [(false, 30.0, 20.0), (true, 200.0, -35.0)] {
+        let params = zoovr::camera::CameraParams {
+            width: 96,
+            height: 80,
+            azimuth,
+            elevation,
+            ortho,
+            ..Default::default()
+        };
+        for (mode, alone, tau) in [
+            (Mode::Iso, true, 0.0),
+            (Mode::ExactFrag, false, 0.5),
+            (Mode::Exact, false, 0.5),
+            (Mode::ExactFrag, true, 0.5),
+        ] {
+            let scene = shells_scene(tau);
+            let shading = scene.shading();
+            let mut renderer = Renderer::new(scene.geometry());
+            for (list, mix, hides) in [
+                ("0.3", IsoMix::Exact, true),
+                ("0.2:tf:1,0.35", IsoMix::Exact, true),
+                ("0.3:tf:0.99", IsoMix::Exact, false),
+                ("0.3", IsoMix::Blend, false),
+            ] {
+                if mix == IsoMix::Blend && mode == Mode::Exact {
+                    continue;
+                }
+                let case = format!("ortho {ortho} {mode:?} alone {alone} --iso {list} {mix:?}");
+                let mut frame = |occlusion: Option<f64>| {
+                    let opts = RenderOptions {
+                        mode,
+                        camera: params,
+                        projected: ProjectedOptions {
+                            compositor: Compositor::Cpu,
+                            occlusion,
+                            ..Default::default()
+                        },
+                        iso: IsoOptions {
+                            surfaces: parse_list(list).unwrap(),
+                            alone,
+                            mix,
+                            ..Default::default()
+                        },
+                        ..Default::default()
+                    };
+                    let (img, stats) = renderer.render(&shading, &opts, |_, _| {}).unwrap();
+                    let p = stats.projected().unwrap();
+                    (img, p.hidden_pieces, p.pieces)
+                };
+                let (all, none, pieces) = frame(None);
+                assert_eq!(none, 0, "{case}");
+                let (culled, hidden, _) =
+                    frame(Some(zoovr::numeric::tolerance::OCCLUSION_TRANSMITTANCE));
+                eprintln!("{case}: {hidden} of {pieces} pieces hidden");
+                // The volume alone (optical depth 0.5 per unit, a unit
+                // cube) hides nothing.
+                if hides {
+                    assert!(hidden * 20 >= pieces, "{case}: {hidden} of {pieces}");
+                } else {
+                    assert_eq!(hidden, 0, "{case}");
+                }
+                let (d, _) = compare_float(&culled, &all).unwrap();
+                assert!(d.max_abs <= 1e-6, "{case}: {:e}", d.max_abs);
+                let lit = all.pixels.iter().filter(|p| p[3] > 0.5).count();
+                assert!(lit > 200, "{case}: {lit} lit pixels");
+            }
+        }
+    }
+}

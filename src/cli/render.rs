@@ -151,8 +151,9 @@ pub struct ViewArgs {
     /// Projected modes: draw the pieces hidden behind opaque ones too. By
     /// default a front-to-back pass over the order leaves out every piece
     /// whose pixels already lie behind an optical depth that lets through
-    /// less than 1e-7 of its light (the image changes by at most that);
-    /// this flag turns the pass off, to compare or measure it.
+    /// less than 1e-7 of its light, or behind an opaque --iso surface (the
+    /// image changes by at most that); this flag turns the pass off, to
+    /// compare or measure it.
     #[arg(long)]
     pub no_occlusion: bool,
     /// Background colour R,G,B in [0,1] for PNG output.

@@ -85,6 +85,34 @@ pub const FRUSTUM_MARGIN_PX: f64 = 1.0;
 /// image tests allow, and below the ray caster's own
 /// [`RAY_TERMINATION_TRANSMITTANCE`].
 pub const OCCLUSION_TRANSMITTANCE: f64 = 1e-7;
+/// Occlusion behind an opaque isosurface ([`crate::render::occlusion`]): a
+/// cell hides what lies behind a pixel centre where the ray's entry and
+/// exit scalars in it (the `faces` field's, on the triangles its chord
+/// enters and leaves by) lie on opposite sides of an opaque surface's value
+/// `V` by at least this fraction of `|V - lo| + span` (the transfer
+/// function's node range `[lo, lo + span]`): ten times the `f32` stages'
+/// level margin ([`ISO_LEVEL_F32`] of the normalised value), so the stages
+/// draw that crossing in the cell too. Elsewhere the drawn scalars are on
+/// the exact ones' side of `V`: next to the line where a face's scalar is
+/// `V`, and in slivers near it, centres are decided on the exact segment
+/// (whose ends are stored on the reference's side of each level); farther
+/// from it the snap of a region's corners moves the scalar less than the
+/// distance to the line does.
+pub const OCCLUSION_ISO_REL: f64 = 1e-5;
+
+/// How far outside a boundary triangle (in barycentric weight) the point
+/// where a chord through a cell's kernel enters or leaves it may lie and
+/// still be taken as on it (rounding of the plane intersection); beyond,
+/// the kernel's face is not the cell's there and the centre is not
+/// credited.
+pub const OCCLUSION_ISO_BARY: f64 = 1e-9;
+
+/// The least chord through a cell, relative to the mesh's diagonal, at
+/// which its opaque surface hides what lies behind a pixel centre: a ray
+/// through the cell for less is on its outline up to rounding, where the
+/// exact tie decisions may give the centre to the pieces beside it.
+pub const OCCLUSION_ISO_CHORD: f64 = 1e-9;
+
 /// Coverage culling ([`crate::projection::coverage`]): a region triangle is
 /// dropped only when no pixel centre lies within this many pixels of it.
 /// The GPU rasterises `f32` clip coordinates snapped to its sub-pixel grid:

@@ -47,20 +47,38 @@
 //! out of its tests only hides less, and the blocks do not depend on the
 //! number of threads, so the result is the same on every run.
 //!
+//! **Opaque isosurfaces** (Livnat and Hansen's view-dependent culling)
+//! hide what lies behind them, in every mode that draws surfaces, with the
+//! volume or without: at a centre where a cell's chord enters it on one
+//! side of an opaque surface's value and leaves it on the other
+//! ([`Credit::crosses`], with the margin of
+//! [`OCCLUSION_ISO_REL`], the entry and exit scalars the `faces` field's on
+//! the triangles the chord enters and leaves by, [`ends`]), the stages draw
+//! that crossing in the cell, and the cell credits the centre with an
+//! infinite depth. Surfaces opaque on both sides count, mixed exactly (RKE's
+//! blend weighs surfaces down); a chord shorter than
+//! [`OCCLUSION_ISO_CHORD`] of the diagonal (a ray along the outline up to
+//! rounding) credits nothing.
+//!
 //! **What it leaves alone.** Cycle groups are composited per pixel into
 //! one layer: their pieces are never hidden, and their cells never
 //! credited. Independent emission is not bounded by the opacity in front
-//! (no culling there), and neither is a frame that draws no volume (`--mode
-//! iso`) or counts coverage. A transfer function whose largest extinction
-//! times the mesh's diagonal cannot reach the cut skips the pass at once.
+//! (no culling of its volume), and neither is a frame that counts
+//! coverage. A frame that draws no volume (`--mode iso`, `--iso-only`)
+//! credits its opaque surfaces only; a transfer function whose largest
+//! extinction times the mesh's diagonal cannot reach the cut credits no
+//! volume, and without opaque surfaces either skips the pass at once.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::mesh::tetra::triangulate_face;
-use crate::numeric::tolerance::FRUSTUM_MARGIN_PX;
 #[cfg(doc)]
 use crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE;
+use crate::numeric::tolerance::{
+    FRUSTUM_MARGIN_PX, OCCLUSION_ISO_BARY, OCCLUSION_ISO_CHORD, OCCLUSION_ISO_REL,
+};
+use crate::render::iso::IsoMix;
 use crate::tf::EmissionModel;
 use crate::visibility::{Order, Piece};
 
@@ -112,7 +130,7 @@ struct View {
 /// not apply or cannot hide anything.
 pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Option<Occlusion> {
     let tf = src.tf;
-    if !src.volume || tf.model() != EmissionModel::Glow || order.pieces.is_empty() {
+    if (src.volume && tf.model() != EmissionModel::Glow) || order.pieces.is_empty() {
         return None;
     }
     let brightest = tf
@@ -124,7 +142,13 @@ pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Op
     let (lo, hi) = tf.scalar_range();
     let tau_max = src.max_rate(lo.min(hi), hi.max(lo));
     let mesh = src.mesh;
-    if !(cut.is_finite() && tau_max * mesh.diagonal() >= cut) {
+    let credit = Credit {
+        volume: src.volume && cut.is_finite() && tau_max * mesh.diagonal() >= cut,
+        opaque: opaque_values(src),
+        min_chord: OCCLUSION_ISO_CHORD * mesh.diagonal(),
+        tf_range: (lo.min(hi), (hi - lo).abs()),
+    };
+    if !cut.is_finite() || (!credit.volume && credit.opaque.is_empty()) {
         return None;
     }
     let camera = src.camera;
@@ -216,7 +240,7 @@ pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Op
             .fold(
                 || (Vec::new(), Vec::new()),
                 |(mut acc, mut planes), &c| {
-                    cell_credit(src, &view, c, &depth, cut, &mut planes, &mut acc);
+                    cell_credit(src, &credit, &view, c, &depth, cut, &mut planes, &mut acc);
                     (acc, planes)
                 },
             )
@@ -280,11 +304,122 @@ fn points_box(
     Some((i0 as usize, i1 as usize + 1, j0 as usize, j1 as usize + 1))
 }
 
+/// What cells are credited with (see the module docs).
+struct Credit {
+    /// Their volume's least extinction times their chord.
+    volume: bool,
+    /// The values of the surfaces that are opaque on both sides (exact
+    /// mixing), sorted: where a ray's chord through a cell surely crosses
+    /// one ([`Credit::crosses`]), the cell hides what lies behind.
+    opaque: Vec<f64>,
+    /// [`OCCLUSION_ISO_CHORD`] times the mesh's diagonal.
+    min_chord: f64,
+    /// The transfer function's node range `(lo, span)`: the stages' level
+    /// margin is relative to the normalised value.
+    tf_range: (f64, f64),
+}
+
+impl Credit {
+    /// Whether a chord entering a cell at scalar `a` and leaving it at `b`
+    /// (the `faces` field's values on its entry and exit triangles) crosses
+    /// an opaque value `V` as every mode draws it: `a` and `b` on opposite
+    /// sides of `V` by [`OCCLUSION_ISO_REL`] of `|V - lo| + span`. The drawn
+    /// scalars run continuously between values on the exact ones' side of
+    /// `V` (the `faces` field, or the `tets` field through the cell's tets;
+    /// see the tolerance), so the surface is drawn in this cell.
+    fn crosses(&self, a: f64, b: f64) -> bool {
+        let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+        let (tf_lo, span) = self.tf_range;
+        self.opaque.iter().any(|&v| {
+            let m = OCCLUSION_ISO_REL * ((v - tf_lo).abs() + span);
+            lo < v - m && hi > v + m
+        })
+    }
+}
+
+/// The scalar at `x` on a boundary triangle (its corners and their
+/// scalars), by barycentric weights; `None` where `x` is not on it (a
+/// kernel's face beyond a non-convex cell's).
+fn scalar_on(tri: &([DVec3; 3], [f64; 3]), x: DVec3) -> Option<f64> {
+    let ([p0, p1, p2], s) = *tri;
+    let n = (p1 - p0).cross(p2 - p0);
+    let nn = n.length_squared();
+    // False for NaN too.
+    if nn.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    let w = [
+        (p2 - p1).cross(x - p1).dot(n) / nn,
+        (p0 - p2).cross(x - p2).dot(n) / nn,
+        (p1 - p0).cross(x - p0).dot(n) / nn,
+    ];
+    if w.iter().any(|&v| v.is_nan() || v < -OCCLUSION_ISO_BARY) {
+        return None;
+    }
+    Some(w[0] * s[0] + w[1] * s[1] + w[2] * s[2])
+}
+
+/// The `faces` field's scalars where the ray `o + t dir` enters and leaves
+/// the stretch of a cell that holds its chord through the cell's kernel
+/// (`planes` with outward normals times `flip`, and their triangles): the
+/// last entering triangle it meets before the chord and the first leaving
+/// one after it (no leaving plane is met before the chord begins, nor an
+/// entering one after it ends, so no boundary lies between). For a convex
+/// cell the planes of the chord's own ends. `None` where either is not
+/// found.
+fn ends(
+    planes: &[(DVec3, DVec3)],
+    tris: &[([DVec3; 3], [f64; 3])],
+    flip: f64,
+    o: DVec3,
+    dir: DVec3,
+) -> Option<(f64, f64)> {
+    let (mut a, mut ta) = (None, f64::NEG_INFINITY);
+    let (mut b, mut tb) = (None, f64::INFINITY);
+    for (&(n, p), tri) in planes.iter().zip(tris) {
+        let n = n * flip;
+        let nd = n.dot(dir);
+        if nd == 0.0 || nd.is_nan() {
+            continue;
+        }
+        let t = -n.dot(o - p) / nd;
+        if nd < 0.0 && t > ta {
+            if let Some(v) = scalar_on(tri, o + dir * t) {
+                (a, ta) = (Some(v), t);
+            }
+        } else if nd > 0.0 && t < tb {
+            if let Some(v) = scalar_on(tri, o + dir * t) {
+                (b, tb) = (Some(v), t);
+            }
+        }
+    }
+    Some((a?, b?))
+}
+
+/// The values of `src`'s isosurfaces that hide what lies behind them: opaque
+/// on both sides, mixed exactly (RKE's blend weighs surfaces down).
+fn opaque_values(src: &PieceSource) -> Vec<f64> {
+    let Some(set) = src.iso else {
+        return Vec::new();
+    };
+    if set.mix != IsoMix::Exact {
+        return Vec::new();
+    }
+    set.values
+        .iter()
+        .zip(&set.sides)
+        .filter(|(v, sides)| v.is_finite() && sides.iter().all(|side| side[3] >= 1.0))
+        .map(|(&v, _)| v)
+        .collect()
+}
+
 /// Appends cell `c`'s credit at each centre of its box (see the module
 /// docs) to `out` as (pixel index, optical depth), leaving out centres
 /// already behind `cut` in `depth` (`planes` is scratch).
+#[allow(clippy::too_many_arguments)]
 fn cell_credit(
     src: &PieceSource,
+    credit: &Credit,
     view: &View,
     c: u32,
     depth: &[f64],
@@ -295,9 +430,16 @@ fn cell_credit(
     let mesh = src.mesh;
     let nodes = mesh.cells.nodes(c as usize);
     let (lo, hi) = value_range(nodes.iter().map(|&p| src.scalar(c, p)));
-    let tau = src.min_extinction(lo, hi) * CREDIT_SHRINK;
+    let tau = if credit.volume {
+        src.min_extinction(lo, hi) * CREDIT_SHRINK
+    } else {
+        0.0
+    };
     // False for NaN too.
-    if tau.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+    let by_volume = tau.partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater);
+    // A surface may only run through a cell whose range holds its value.
+    let may_hide = credit.opaque.iter().any(|&v| lo < v && v < hi);
+    if !by_volume && !may_hide {
         return;
     }
     // The chord is 0 outside the hull of the projected points.
@@ -320,10 +462,17 @@ fn cell_credit(
         / nodes.len() as f64;
     // Planes (unit normal n, point a), the centre on one side of all.
     planes.clear();
+    let mut tris: Vec<([DVec3; 3], [f64; 3])> = Vec::new();
     let mut sign = 0.0f64;
     let mut ok = true;
     mesh.cells.for_each_face(c as usize, |_, face| {
         triangulate_face(face, |t| {
+            if may_hide {
+                tris.push((
+                    t.map(|i| mesh.points[i as usize]),
+                    t.map(|i| src.scalar(c, i)),
+                ));
+            }
             let [a, b, d] = t.map(|i| mesh.points[i as usize]);
             let n = (b - a).cross(d - a);
             let len = n.length();
@@ -353,21 +502,46 @@ fn cell_credit(
                 continue;
             }
             let (o, dir) = view.rays[j * w + i];
+            // The chord and the planes it enters and leaves by.
             let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
-            for &(n, a) in planes.iter() {
+            let (mut k0, mut k1) = (usize::MAX, usize::MAX);
+            for (k, &(n, a)) in planes.iter().enumerate() {
                 let n = n * flip;
                 let nd = n.dot(dir);
                 let no = n.dot(o - a);
                 if nd > 0.0 {
-                    t1 = t1.min(-no / nd);
+                    let t = -no / nd;
+                    if t < t1 {
+                        (t1, k1) = (t, k);
+                    }
                 } else if nd < 0.0 {
-                    t0 = t0.max(-no / nd);
+                    let t = -no / nd;
+                    if t > t0 {
+                        (t0, k0) = (t, k);
+                    }
                 } else if no > 0.0 {
                     t1 = f64::NEG_INFINITY;
                 }
             }
             if t1 > t0 {
-                out.push(((j * w + i) as u32, tau * (t1 - t0)));
+                // An opaque surface across the chord hides everything
+                // behind the centre; otherwise the volume's credit.
+                let hides = may_hide
+                    && t1 - t0 > credit.min_chord
+                    && k0 != usize::MAX
+                    && k1 != usize::MAX
+                    && match ends(planes, &tris, flip, o, dir) {
+                        Some((sa, sb)) => credit.crosses(sa, sb),
+                        None => false,
+                    };
+                let d = if hides {
+                    f64::INFINITY
+                } else {
+                    tau * (t1 - t0)
+                };
+                if d > 0.0 {
+                    out.push(((j * w + i) as u32, d));
+                }
             }
         }
     }

@@ -383,6 +383,13 @@ fn part_rate(src: &PieceSource, part: &Polyhedron) -> f64 {
     src.max_rate(lo, hi)
 }
 
+/// The corners of a tie's one triangle within its pixel (offsets from the
+/// pixel's corner, on the rasteriser's sub-pixel grid, wound as the region
+/// triangles): it holds the pixel's centre, 0.19 px inside its nearest
+/// edge, and no other centre, with one triangle where a quad over the
+/// pixel takes two.
+const TIE_TRIANGLE: [(f64, f64); 3] = [(0.125, 0.25), (0.875, 0.25), (0.5, 0.875)];
+
 /// Draws the pixel quads of the part's tie decisions (`w.ties`, see
 /// [`super::ties`]) into `out`, before the part's triangles: the mode's
 /// payload of the exact segment at the centre, or a transparent blocker.
@@ -443,16 +450,15 @@ fn emit_tie_quads<M: ProjectedMode>(
         };
         let (i, j) = d.pixel;
         let base = out.vertices.len() as u32;
-        for (di, dj) in [(0, 0), (1, 0), (1, 1), (0, 1)] {
-            let Some((ndc, _)) = mapper.ndc((i + di) as f64, (j + dj) as f64) else {
+        for (di, dj) in TIE_TRIANGLE {
+            let Some((ndc, _)) = mapper.ndc(i as f64 + di, j as f64 + dj) else {
                 continue;
             };
             out.vertices
                 .push(value.with_clip([ndc[0], ndc[1], z, 1.0]).with_piece(piece));
         }
-        if out.vertices.len() as u32 == base + 4 {
-            out.indices
-                .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+        if out.vertices.len() as u32 == base + 3 {
+            out.indices.extend_from_slice(&[base, base + 1, base + 2]);
             quads += 1;
         } else {
             out.vertices.truncate(base as usize);

@@ -494,7 +494,24 @@ impl CpuStage<IsoVertex> for IsoTwin {
 
     fn describe(&self, tri: [&IsoVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {
         let seg = segment_at(&self.view, &self.mapper, tri.map(|v| &v.seg), bary);
-        vec![("s_f", seg.s_f), ("s_b", seg.s_b), ("l", seg.l)]
+        let mut out = vec![("s_f", seg.s_f), ("s_b", seg.s_b), ("l", seg.l)];
+        // The gradients as `fs_iso` reads them (view space, per unit of the
+        // normalised scalar).
+        let (qf, qb) = if self.view.ortho != 1 {
+            (
+                lerp(tri, bary, |v| v.seg.front[1]),
+                lerp(tri, bary, |v| v.seg.back[1]),
+            )
+        } else {
+            (1.0, 1.0)
+        };
+        for (k, name) in ["gf_x", "gf_y", "gf_z"].into_iter().enumerate() {
+            out.push((name, lerp(tri, bary, |v| v.grad_front[k]) / qf));
+        }
+        for (k, name) in ["gb_x", "gb_y", "gb_z"].into_iter().enumerate() {
+            out.push((name, lerp(tri, bary, |v| v.grad_back[k]) / qb));
+        }
+        out
     }
 }
 
