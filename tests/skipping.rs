@@ -514,9 +514,10 @@ fn shells_scene(tau: f64) -> Scene {
 /// culling): a cell whose chord at a pixel centre enters below the value
 /// and leaves above it (or the other way round, with a margin) credits that
 /// centre as opaque, so the far half of a closed shell and the volume
-/// behind it are left out, in every mode that draws surfaces, alone and
-/// mixed, and the image is the same to 1e-6. A translucent surface, or
-/// RKE's blended mixing (which weighs surfaces down), hides nothing.
+/// behind it are left out, in every mode that mixes surfaces with the
+/// volume, and the image is the same to 1e-6. A translucent surface, RKE's
+/// blended mixing (which weighs surfaces down) and a frame of surfaces
+/// alone (cheaper to draw than the pass) hide nothing.
 #[test]
 fn pieces_behind_an_opaque_surface_are_left_out_and_the_image_is_unchanged() {
     use zoovr::render::iso::{parse_list, IsoMix, IsoOptions};
@@ -576,7 +577,7 @@ fn pieces_behind_an_opaque_surface_are_left_out_and_the_image_is_unchanged() {
                 eprintln!("{case}: {hidden} of {pieces} pieces hidden");
                 // The volume alone (optical depth 0.5 per unit, a unit
                 // cube) hides nothing.
-                if hides {
+                if hides && !alone {
                     assert!(hidden * 20 >= pieces, "{case}: {hidden} of {pieces}");
                 } else {
                     assert_eq!(hidden, 0, "{case}");

@@ -48,8 +48,9 @@
 //! number of threads, so the result is the same on every run.
 //!
 //! **Opaque isosurfaces** (Livnat and Hansen's view-dependent culling)
-//! hide what lies behind them, in every mode that draws surfaces, with the
-//! volume or without: at a centre where a cell's chord enters it on one
+//! hide what lies behind them, in every mode that draws surfaces mixed
+//! with the volume (a frame of surfaces alone is cheaper to draw than the
+//! pass): at a centre where a cell's chord enters it on one
 //! side of an opaque surface's value and leaves it on the other
 //! ([`Credit::crosses`], with the margin of
 //! [`OCCLUSION_ISO_REL`], the entry and exit scalars the `faces` field's on
@@ -64,10 +65,10 @@
 //! one layer: their pieces are never hidden, and their cells never
 //! credited. Independent emission is not bounded by the opacity in front
 //! (no culling of its volume), and neither is a frame that counts
-//! coverage. A frame that draws no volume (`--mode iso`, `--iso-only`)
-//! credits its opaque surfaces only; a transfer function whose largest
-//! extinction times the mesh's diagonal cannot reach the cut credits no
-//! volume, and without opaque surfaces either skips the pass at once.
+//! coverage, nor a frame that draws no volume (`--mode iso`,
+//! `--iso-only`). A transfer function whose largest extinction times the
+//! mesh's diagonal cannot reach the cut credits no volume, and without
+//! opaque surfaces skips the pass at once.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -144,7 +145,15 @@ pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Op
     let mesh = src.mesh;
     let credit = Credit {
         volume: src.volume && cut.is_finite() && tau_max * mesh.diagonal() >= cut,
-        opaque: opaque_values(src),
+        // A frame drawing the surfaces alone draws only the pieces holding
+        // a value, so cheaply that the pass would cost more than it saves
+        // (bluntfin, one opaque surface, 512 x 512: 0.16-0.20 s with it
+        // against 0.125 s without).
+        opaque: if src.volume {
+            opaque_values(src)
+        } else {
+            Vec::new()
+        },
         min_chord: OCCLUSION_ISO_CHORD * mesh.diagonal(),
         tf_range: (lo.min(hi), (hi - lo).abs()),
     };
