@@ -23,8 +23,8 @@ pub fn finite(x: f32) -> bool {
     x.is_finite()
 }
 
-/// Clip z of the corners of a blocker quad ([`crate::render::ties`]): a
-/// pixel quad that takes a pixel for its piece without colouring or
+/// Clip z of the corners of a blocker ([`crate::render::ties`]): a
+/// pixel's triangle that takes a pixel for its piece without colouring or
 /// counting it ([`count_of`]). Everything else is drawn at z = 0.5.
 pub const BLOCKER_Z: f32 = 0.25;
 

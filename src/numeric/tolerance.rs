@@ -468,7 +468,7 @@ pub const ISO_LEVEL_F32: f64 = 1e-6;
 /// when its `f32` value falls on the other side of that level than the
 /// exact `f64` value falls of the reference's
 /// (`render::modes::iso::decided_end`): the stage reads `(s q) / q`
-/// interpolated from equal corners (a tie quad), within a few ulps of the
+/// interpolated from equal corners (a tie triangle), within a few ulps of the
 /// stored quotient.
 pub const ISO_DECIDE_ULPS: f64 = 16.0;
 

@@ -34,7 +34,7 @@ pub trait ProjectedMode: Sync {
 
     /// Whether centres next to a part's outline are decided on the exact
     /// geometry ([`super::ties`]): on for every mode (a mode whose stage
-    /// cannot draw a tie quad may say no).
+    /// cannot draw a tie triangle may say no).
     fn decides_ties(&self) -> bool {
         true
     }

@@ -24,7 +24,7 @@ pub struct ProjectedStats {
     pub triangles: usize,
     pub refined_triangles: usize,
     /// Pixel centres next to a part's outline that snapping would have put
-    /// on the wrong side, decided by a pixel quad ([`super::ties`]).
+    /// on the wrong side, decided by a pixel triangle ([`super::ties`]).
     pub tie_pixels: usize,
     /// Triangles steep enough that the snap of their corners would shift
     /// the optical depth, drawn with the exact triangle's values at the

@@ -11,7 +11,7 @@
 //! - pieces whose scalar range maps to zero extinction are skipped (dark);
 //! - pieces behind opaque ones are skipped (occlusion, the least
 //!   extinction on a cell's range);
-//! - the tie decisions draw exact pixel quads inside slivers and steep
+//! - the tie decisions draw exact pixel triangles inside slivers and steep
 //!   triangles where the snap could matter at the piece's largest rate,
 //!   `max(extinction, |source|)`.
 //!

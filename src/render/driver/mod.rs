@@ -28,14 +28,14 @@
 //!    Pixel centres within snapping distance of the part's outline are
 //!    decided on the exact geometry ([`super::ties`]): where the snapped
 //!    triangles would take or leave a centre the exact part does not, a
-//!    pixel quad drawn first in the part decides it. Corners are shared by
+//!    triangle inside the pixel drawn first in the part decides it. Corners are shared by
 //!    the part's triangles and carry the payload of the exact (unsnapped)
 //!    corner: snapping moves them by up to 1/512 px, which costs the
 //!    payload's gradient times that shift. Where that gradient is steep
 //!    enough to shift the optical depth by more than
 //!    [`super::ties::SLIVER_DEPTH_TOL`], two rules take over:
 //!    - in slivers (narrower than [`super::ties::SLIVER_TIE_PX`]) the
-//!      centres are decided exactly, by pixel quads, since extrapolating
+//!      centres are decided exactly, by pixel triangles, since extrapolating
 //!      across a sliver is unbounded;
 //!    - a wider triangle ([`super::ties::snap_is_steep`]: an optically
 //!      thick piece seen nearly along a face) gets its own corners, each
@@ -113,7 +113,7 @@ pub(super) struct ChunkOut<V> {
     /// Triangles dropped as degenerate on the sub-pixel grid
     /// ([`grid_area_positive`]).
     degenerate: usize,
-    /// Pixel quads deciding centres next to a part's outline
+    /// Pixel triangles deciding centres next to a part's outline
     /// ([`super::ties`]).
     tie_pixels: usize,
     /// Triangles whose snapped corners took the exact triangle's values
@@ -170,8 +170,8 @@ struct Worker<P, V> {
     used: Vec<bool>,
     remap: Vec<u32>,
     grid: Vec<[i64; 2]>,
-    /// Triangles drawn, with their snapped corners, and the pixel quads
-    /// of the centres next to the outline ([`super::ties`]).
+    /// Triangles drawn, with their snapped corners, and the pixel
+    /// triangles of the centres next to the outline ([`super::ties`]).
     drawn: Vec<DrawnTriangle>,
     ties: TieScratch,
     /// The transfer function's largest rate anywhere (a bound on every
@@ -311,7 +311,7 @@ fn draw_part<M: ProjectedMode>(
     scan_triangles(&part_tris, ties, &mut w.ties);
     if ties {
         decide_ties(&part_tris, part, &src.ties, &mut w.ties);
-        out.tie_pixels += emit_tie_quads(mode, src, part, piece, &mapper, w, out);
+        out.tie_pixels += emit_tie_triangles(mode, src, part, piece, &mapper, w, out);
     }
     for d in w.drawn.iter() {
         let idx = d.corners.map(|i| w.remap[i as usize]);
@@ -390,11 +390,11 @@ fn part_rate(src: &PieceSource, part: &Polyhedron) -> f64 {
 /// pixel takes two.
 const TIE_TRIANGLE: [(f64, f64); 3] = [(0.125, 0.25), (0.875, 0.25), (0.5, 0.875)];
 
-/// Draws the pixel quads of the part's tie decisions (`w.ties`, see
+/// Draws the pixel triangles of the part's tie decisions (`w.ties`, see
 /// [`super::ties`]) into `out`, before the part's triangles: the mode's
 /// payload of the exact segment at the centre, or a transparent blocker.
-/// Returns the number of quads.
-fn emit_tie_quads<M: ProjectedMode>(
+/// Returns the number of triangles.
+fn emit_tie_triangles<M: ProjectedMode>(
     mode: &M,
     src: &PieceSource,
     part: &Polyhedron,
@@ -435,7 +435,7 @@ fn emit_tie_quads<M: ProjectedMode>(
         .drawn
         .first()
         .map(|d| out.vertices[w.remap[d.corners[0] as usize] as usize].transparent());
-    let mut quads = 0;
+    let mut drawn = 0;
     let mut k = 0;
     for d in &ties.decisions {
         let (value, z) = match d.value {
@@ -459,12 +459,12 @@ fn emit_tie_quads<M: ProjectedMode>(
         }
         if out.vertices.len() as u32 == base + 3 {
             out.indices.extend_from_slice(&[base, base + 1, base + 2]);
-            quads += 1;
+            drawn += 1;
         } else {
             out.vertices.truncate(base as usize);
         }
     }
-    quads
+    drawn
 }
 
 /// Whether the GPU sees the triangle `a, b, c` (region triangles are CCW in

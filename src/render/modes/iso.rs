@@ -736,7 +736,7 @@ impl ProjectedMode for IsoMode {
         }
         // A region vertex lies on its regions' front and back triangles
         // (any of them: the smooth field is continuous): interpolate on the
-        // first region's; a vertex without a region (a tie quad's) searches
+        // first region's; a vertex without a region (a tie triangle's) searches
         // the boundary.
         let mut done = std::mem::take(&mut payload.done);
         done.clear();
@@ -773,7 +773,7 @@ impl ProjectedMode for IsoMode {
         let mut seg = SegmentVertex::of(proj, i, ndc, &payload.seg.map, payload.seg.ortho);
         let g = payload.grads.get(i).copied().unwrap_or([DVec3::ZERO; 2]);
         let v = &proj.vertices[i];
-        // A tie quad's exact segment (its values come with their faces)
+        // A tie triangle's exact segment (its values come with their faces)
         // decides its pixel as the ray caster does: its ends on the
         // reference's side of every level. Not a region vertex's: its
         // values are interpolated over the region, where the stage's

@@ -7,7 +7,7 @@
 //! [`ISO_LEVEL_F32`] of itself, so that a face whose corners all hold `V`
 //! (interpolated to within a few ulps of it) is crossed once, not twice or
 //! never. Within that margin the two can disagree; [`decided_end`] moves
-//! the ends of a tie quad (the exact segment over one pixel) across the
+//! the ends of a tie triangle (the exact segment at one pixel centre) across the
 //! `f32` level to where the reference puts them.
 
 use crate::numeric::tolerance::{ISO_DECIDE_FLOOR, ISO_DECIDE_ULPS, ISO_LEVEL_F32};
@@ -33,7 +33,7 @@ pub fn gpu_level(v: f64) -> f32 {
 /// value does not, and the surface is missing or drawn at the next
 /// crossing. The value read is put [`ISO_DECIDE_ULPS`] beyond the level on
 /// the reference's side (a move of at most `ISO_LEVEL_F32` of the value
-/// and those ulps). For a tie quad's ends only: it carries the exact
+/// and those ulps). For a tie triangle's ends only: it carries the exact
 /// segment over its one pixel, and so decides the pixel as the ray caster
 /// does. Levels closer together than the move are not told apart.
 pub fn decided_end(set: &IsoSet, map: &ScalarMap, s: f64, end: [f32; 2]) -> [f32; 2] {
@@ -74,7 +74,7 @@ mod tests {
     use crate::render::iso::{parse_list, IsoOptions};
     use crate::tf::TransferFunction;
 
-    /// A tie quad's ends are read by the stage (in `f32`, against the GPU
+    /// A tie triangle's ends are read by the stage (in `f32`, against the GPU
     /// levels) on the side of every level that the reference puts the exact
     /// scalar (in `f64`, against [`IsoSet::levels`]), in both projections
     /// and with a few ulps of interpolation rounding, including next to

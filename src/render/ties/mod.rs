@@ -32,7 +32,8 @@
 //! - **as the GPU will draw it**: inside one of the snapped triangles
 //!   (integer grid, the rasteriser's top-left rule).
 //!
-//! Where the two disagree, a pixel quad is drawn first in the part: with
+//! Where the two disagree, a triangle inside the pixel (holding its centre
+//! and no other) is drawn first in the part: with
 //! the mode's payload of the exact segment the ray cuts from the part
 //! (entry and exit depth and scalar from the crossings, the ray caster's
 //! numbers) where the exact part holds the centre, or transparent where it
@@ -48,7 +49,7 @@
 //! run; it decides the rest, as the visibility rasteriser does.
 //!
 //! Two more kinds of centre are decided exactly, and get the exact
-//! segment's quad wherever the part holds them (not only where the two
+//! segment's triangle wherever the part holds them (not only where the two
 //! tests disagree):
 //! - next to a mode's **seams** ([`Projected::seams`],
 //!   [`Projected::seam_lines`]): edges inside the outline across which the
