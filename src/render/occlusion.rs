@@ -411,7 +411,10 @@ fn opaque_values(src: &PieceSource) -> Vec<f64> {
     let Some(set) = src.iso else {
         return Vec::new();
     };
-    if set.mix != IsoMix::Exact {
+    // Without the exact tie decisions (a library switch for measuring
+    // them) the stages may draw a crossing next to a face's iso line in
+    // the next piece instead ([`Credit::crosses`]).
+    if set.mix != IsoMix::Exact || !src.exact_ties {
         return Vec::new();
     }
     set.values
