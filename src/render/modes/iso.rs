@@ -59,11 +59,11 @@ pub static INFO: ModeInfo = ModeInfo {
         // them, more surfaces): f32 crossings and light.
         split_max: 2.0 / 255.0,
         whole_max: 2.0 / 255.0,
-        // Where a ray grazes the surface (its scalars within the f32
-        // stages' rounding of the value) or meets it at the mesh boundary,
-        // the surface's edge may move by a pixel. Measured at most 1 (6
-        // before the face's iso lines were decided exactly).
-        split_outliers: 4,
+        // None: every pixel within the bound on Vulkan and GL (1 before the
+        // perspective iso lines and the tie ends on the reference's side
+        // of each level, 6 before the face's iso lines were decided
+        // exactly).
+        split_outliers: 0,
         // Whole cells against `faces`: in the cells the order splits into
         // tets (zoo_3x3x3's nonplanar cells) the surface is the `tets`
         // field's, elsewhere than the `faces` field's. Measured 41 there,
