@@ -117,20 +117,29 @@ pub fn to_view(g: DVec3, right: DVec3, up: DVec3, forward: DVec3) -> DVec3 {
 }
 
 /// The barycentric weights of `x` (a point of the triangle's plane, up to
-/// rounding) in triangle `t`, clamped to the triangle; the first corner's
-/// when the triangle is degenerate.
-pub fn barycentric(t: [DVec3; 3], x: DVec3) -> [f64; 3] {
+/// rounding) in triangle `t`, unclamped (negative outside it); `None` when
+/// the triangle is degenerate.
+pub fn barycentric_raw(t: [DVec3; 3], x: DVec3) -> Option<[f64; 3]> {
     let n = (t[1] - t[0]).cross(t[2] - t[0]);
     let nn = n.length_squared();
     if nn.is_nan() || nn <= 0.0 {
-        return [1.0, 0.0, 0.0];
+        return None;
     }
-    let w = [
+    Some([
         (t[2] - t[1]).cross(x - t[1]).dot(n) / nn,
         (t[0] - t[2]).cross(x - t[2]).dot(n) / nn,
         (t[1] - t[0]).cross(x - t[0]).dot(n) / nn,
-    ]
-    .map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 });
+    ])
+}
+
+/// The barycentric weights of `x` (a point of the triangle's plane, up to
+/// rounding) in triangle `t`, clamped to the triangle; the first corner's
+/// when the triangle is degenerate.
+pub fn barycentric(t: [DVec3; 3], x: DVec3) -> [f64; 3] {
+    let Some(w) = barycentric_raw(t, x) else {
+        return [1.0, 0.0, 0.0];
+    };
+    let w = w.map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 });
     let sum = w[0] + w[1] + w[2];
     if sum > 0.0 {
         w.map(|v| v / sum)

@@ -79,6 +79,7 @@ use crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE;
 use crate::numeric::tolerance::{
     FRUSTUM_MARGIN_PX, OCCLUSION_ISO_BARY, OCCLUSION_ISO_CHORD, OCCLUSION_ISO_REL,
 };
+use crate::render::gradients::barycentric_raw;
 use crate::render::iso::IsoMix;
 use crate::tf::EmissionModel;
 use crate::visibility::{Order, Piece};
@@ -350,18 +351,8 @@ impl Credit {
 /// scalars), by barycentric weights; `None` where `x` is not on it (a
 /// kernel's face beyond a non-convex cell's).
 fn scalar_on(tri: &([DVec3; 3], [f64; 3]), x: DVec3) -> Option<f64> {
-    let ([p0, p1, p2], s) = *tri;
-    let n = (p1 - p0).cross(p2 - p0);
-    let nn = n.length_squared();
-    // False for NaN too.
-    if nn.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return None;
-    }
-    let w = [
-        (p2 - p1).cross(x - p1).dot(n) / nn,
-        (p0 - p2).cross(x - p2).dot(n) / nn,
-        (p1 - p0).cross(x - p0).dot(n) / nn,
-    ];
+    let (p, s) = tri;
+    let w = barycentric_raw(*p, x)?;
     if w.iter().any(|&v| v.is_nan() || v < -OCCLUSION_ISO_BARY) {
         return None;
     }
