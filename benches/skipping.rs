@@ -16,14 +16,18 @@
 //! 512 x 512 on the same scene with a transfer function opaque below 20 %
 //! of the range (extinction 500 per unit length, the hex_shell's front
 //! layer) and thin above, pieces hidden behind opaque ones left out (the
-//! default) and drawn.
+//! default), left out without the min/max tree's whole nodes, and drawn.
 //!
 //! Dark cells left out of the sort (`zoovr::render::visible`): the exact
 //! mode at 512 x 512 on the generated 1M-hex grid, the default TF against
 //! one dark below 90 % of the range (see `dark_cells`).
 //!
+//! Finding the dark cells with the min/max tree
+//! (`zoovr::render::cell_tree`) against testing every cell: see
+//! `dark_classify`.
+//!
 //! Run: `cargo bench --bench skipping` (one group: `-- occlusion`,
-//! `-- dark_cells`).
+//! `-- dark_cells`, `-- dark_classify`).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use zoovr::camera::CameraParams;
@@ -208,7 +212,7 @@ fn occlusion(c: &mut Criterion) {
     let (name, scene) = frustum_scene();
     let shading = opaque_front(&scene.shading());
     let mut renderer = Renderer::new(scene.geometry());
-    let opts = |occlusion: Option<f64>| RenderOptions {
+    let opts = |occlusion: Option<f64>, tree: bool| RenderOptions {
         mode: Mode::ExactFrag,
         camera: CameraParams {
             width: 512,
@@ -220,20 +224,53 @@ fn occlusion(c: &mut Criterion) {
         },
         projected: ProjectedOptions {
             occlusion,
+            occlusion_tree: tree,
             ..Default::default()
         },
         ..Default::default()
     };
+    let on = ProjectedOptions::default().occlusion;
+    // The pass with and without the tree's whole nodes, alternated (6
+    // pairs): the median pass time of each (criterion's frame times are
+    // too coarse for a pass of a tenth of a second).
+    let mut pass = |tree: bool| {
+        let (_, stats) = renderer.render(&shading, &opts(on, tree), |_, _| {}).ok()?;
+        Some(stats.projected()?.occlusion_s)
+    };
+    let (mut with, mut without) = (Vec::new(), Vec::new());
+    for k in 0..6 {
+        let order = if k % 2 == 0 {
+            [true, false]
+        } else {
+            [false, true]
+        };
+        for tree in order {
+            let v = if tree { &mut with } else { &mut without };
+            v.extend(pass(tree));
+        }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+    };
+    eprintln!(
+        "{name} opaque front: occlusion pass {:.4} s with the tree, {:.4} s without (medians of 6)",
+        median(with),
+        median(without)
+    );
     let mut g = c.benchmark_group("occlusion");
     g.sample_size(10);
-    let on = ProjectedOptions::default().occlusion;
-    for (label, occ) in [("hidden_left_out", on), ("all_drawn", None)] {
-        match renderer.render(&shading, &opts(occ), |_, _| {}) {
+    for (label, occ, tree) in [
+        ("hidden_left_out", on, true),
+        ("hidden_left_out_no_tree", on, false),
+        ("all_drawn", None, false),
+    ] {
+        match renderer.render(&shading, &opts(occ, tree), |_, _| {}) {
             Ok((_, stats)) => {
                 let p = stats.projected().expect("projected");
                 eprintln!(
-                    "{name} opaque front {label}: {} of {} pieces hidden (pass {:.3} s), {} triangles, project+draw {:.3} s, total {:.3} s",
-                    p.hidden_pieces, p.pieces, p.occlusion_s, p.triangles, p.project_s, stats.total_s
+                    "{name} opaque front {label}: {} of {} pieces hidden ({} through {} tree nodes; pass {:.3} s), {} triangles, project+draw {:.3} s, total {:.3} s",
+                    p.hidden_pieces, p.pieces, p.hidden_by_nodes, p.occlusion_nodes_hidden, p.occlusion_s, p.triangles, p.project_s, stats.total_s
                 );
             }
             Err(e) => {
@@ -244,7 +281,7 @@ fn occlusion(c: &mut Criterion) {
         g.bench_function(format!("{name}_opaque_front_{label}"), |b| {
             b.iter(|| {
                 renderer
-                    .render(&shading, &opts(occ), |_, _| {})
+                    .render(&shading, &opts(occ, tree), |_, _| {})
                     .expect("render")
             })
         });
@@ -321,5 +358,77 @@ fn dark_cells(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, frustum, occlusion, dark_cells);
+/// Finding the dark cells (`zoovr::render::cell_tree`): on the generated
+/// 1M-hex grid, the min/max tree's walk against a test of every cell,
+/// for transfer functions visible on 5 % and on 50 % of the range (the
+/// cells' ranges are kept per field either way; building them and the
+/// tree is timed once and printed).
+fn dark_classify(c: &mut Criterion) {
+    use zoovr::render::cell_tree::{CellRanges, CellTree};
+    use zoovr::render::pieces::dark_range;
+    let mesh = warped_hex_grid(
+        100,
+        &Warp {
+            amplitude: 0.05,
+            seed: 1,
+        },
+    );
+    let scene = Scene::build(mesh, &SceneSpec::default()).expect("scene");
+    let t0 = std::time::Instant::now();
+    let tree = CellTree::build(&scene.mesh);
+    let t1 = std::time::Instant::now();
+    let ranges = CellRanges::build(&tree, &scene.mesh, scene.scalars());
+    eprintln!(
+        "1M hexes: tree built in {:.3} s, ranges in {:.3} s, {} nodes",
+        (t1 - t0).as_secs_f64(),
+        t1.elapsed().as_secs_f64(),
+        tree.nodes.len()
+    );
+    let (lo, hi) = scene.shading().tf.scalar_range();
+    let mut g = c.benchmark_group("dark_classify");
+    g.sample_size(10);
+    for frac in [0.05, 0.5] {
+        let a = lo + (hi - lo) * 0.4;
+        let w = (hi - lo) * frac;
+        let tf = TransferFunction::from_channels(
+            &[(a, [0.0]), (a + w * 0.5, [5.0]), (a + w, [0.0])],
+            &[(lo, [0.2, 0.4, 0.9]), (hi, [1.0, 0.5, 0.1])],
+            None,
+            EmissionModel::Glow,
+        )
+        .expect("tf");
+        let test = |l: f64, h: f64| dark_range(&tf, None, true, l, h);
+        let (dark, stats) = tree.classify(&ranges, &test);
+        eprintln!(
+            "band {frac}: {} visible cells; tree: {} of {} nodes visited, {} cells tested",
+            dark.iter().filter(|&&d| !d).count(),
+            stats.nodes_visited,
+            stats.nodes,
+            stats.cells_tested
+        );
+        g.bench_function(format!("grid_100_band_{frac}_tree"), |b| {
+            b.iter(|| tree.classify(&ranges, &test))
+        });
+        g.bench_function(format!("grid_100_band_{frac}_every_cell"), |b| {
+            b.iter(|| {
+                use rayon::prelude::*;
+                ranges
+                    .cell
+                    .par_iter()
+                    .map(|&(l, h)| test(l, h))
+                    .collect::<Vec<bool>>()
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    bench,
+    frustum,
+    occlusion,
+    dark_cells,
+    dark_classify
+);
 criterion_main!(benches);

@@ -501,3 +501,12 @@ pub const QUAD_DEPTH_TOL: f64 = 1e-3;
 /// sheared triangle is a sliver), whatever the rates; the region path and
 /// its exact decisions take such pieces.
 pub const QUAD_MIN_COS: f64 = 1e-3;
+
+/// Occlusion culling over the min/max tree (`render::occlusion`): a node's
+/// screen box, from the projections of its world box's corners, is grown
+/// by this many pixels beyond a piece's margin, so that it holds the box
+/// of every piece of its cells although its corners are not mesh points
+/// and round differently (the rounding of a projection is ~1e-16 of the
+/// coordinates; a millionth of a pixel is far above it at any image
+/// size).
+pub const OCCLUSION_NODE_MARGIN_PX: f64 = 1e-6;

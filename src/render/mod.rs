@@ -16,6 +16,7 @@
 //! ([`group`]) through the mode-independent layer stage.
 
 pub mod breakpoints;
+pub mod cell_tree;
 pub mod driver;
 pub mod gradients;
 mod group;
@@ -397,28 +398,48 @@ impl Renderer {
             pending_gpu,
             kept,
         } = self;
-        let (subset, dark_cells, checked_s) =
+        // The min/max tree, for the occlusion pass where it may hide
+        // something (the visible subset builds it anyway).
+        let occluding = opts.projected.occlusion.is_some_and(|t| {
+            opts.projected.occlusion_tree
+                && opts.projected.draw == crate::gpu::DrawKind::Composite
+                && occlusion::may_hide(
+                    &scene.tf,
+                    mode.isosurfaces(),
+                    mode.draws_volume(),
+                    g.mesh.diagonal(),
+                    t,
+                )
+        });
+        let (tree, tree_s) = if occluding {
+            let (t, s) = visible.tree(&g.mesh);
+            (Some(t), s)
+        } else {
+            (None, 0.0)
+        };
+        let (subset, dark_cells, checked_s, classified) =
             if opts.projected.skip_invisible && opts.projected.dark_subset {
                 visible.prepare(scene, mode.isosurfaces(), mode.draws_volume())
             } else {
-                (None, 0, 0.0)
+                (None, 0, 0.0, Default::default())
             };
         *last_visible = subset.is_some();
         // The visible subset's scene, sorter and order cache, or the
         // geometry's; one driver call either way.
         let sub_scene;
-        let (drawn, sorter, orders, sorter_s) = match subset {
+        let (drawn, sorter, orders, sorter_s, ids) = match subset {
             Some(sub) => {
                 if let Some(s) = sorter.as_ref() {
                     sub.sorter.copy_options(s);
                 }
                 sub_scene = sub.scene_of(scene);
-                (&sub_scene, &mut sub.sorter, &mut sub.orders, checked_s)
+                let ids = Some(&sub.cells[..]);
+                (&sub_scene, &mut sub.sorter, &mut sub.orders, checked_s, ids)
             }
             None => {
                 let sorter =
                     sorter.get_or_insert_with(|| Sorter::new(g.mesh.clone(), g.topology.clone()));
-                (scene, sorter, orders, t0.elapsed().as_secs_f64())
+                (scene, sorter, orders, t0.elapsed().as_secs_f64(), None)
             }
         };
         let (img, mut stats) = driver::render_projected(
@@ -431,12 +452,19 @@ impl Renderer {
             opts,
             camera,
             &scene.mesh,
+            tree.as_deref().map(|tree| occlusion::TreeView {
+                tree,
+                geometry_ids: ids,
+            }),
             kept,
             progress,
         )?;
         stats.dark_cells_left_out = dark_cells;
         stats.visible_subset_s = checked_s;
-        let setup_s = sorter_s + stats.gpu_open_s;
+        stats.dark_nodes_visited = classified.nodes_visited;
+        stats.dark_cells_tested = classified.cells_tested;
+        stats.tree_nodes = classified.nodes;
+        let setup_s = sorter_s + stats.gpu_open_s + tree_s;
         Ok((img, ModeStats::Projected(Box::new(stats)), setup_s))
     }
 }

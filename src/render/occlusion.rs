@@ -78,12 +78,14 @@ use crate::mesh::tetra::triangulate_face;
 use crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE;
 use crate::numeric::tolerance::{
     FRUSTUM_MARGIN_PX, OCCLUSION_ISO_BARY, OCCLUSION_ISO_CHORD, OCCLUSION_ISO_REL,
+    OCCLUSION_NODE_MARGIN_PX,
 };
 use crate::render::gradients::barycentric_raw;
 use crate::render::iso::IsoMix;
 use crate::tf::EmissionModel;
 use crate::visibility::{Order, Piece};
 
+use super::cell_tree::CellTree;
 use super::pieces::{value_range, PieceSource};
 
 /// Credits are shrunk by this factor: the drawn segment differs from the
@@ -108,6 +110,36 @@ pub fn cut_depth(brightest: f64, transmittance: f64) -> f64 {
     (brightest.max(1.0) / transmittance).ln()
 }
 
+/// Whether the pass can hide anything in a frame with transfer function
+/// `tf`, surfaces `iso` and the volume when `volume` over a mesh of
+/// diagonal `diagonal` (a superset of the frames [`hidden_pieces`] runs
+/// for: the renderer builds the min/max tree for those only).
+pub fn may_hide(
+    tf: &crate::tf::TransferFunction,
+    iso: Option<&crate::render::iso::IsoSet>,
+    volume: bool,
+    diagonal: f64,
+    transmittance: f64,
+) -> bool {
+    if !volume || tf.model() != EmissionModel::Glow {
+        return false;
+    }
+    let brightest = tf
+        .nodes()
+        .iter()
+        .flat_map(|n| n.color)
+        .fold(0.0f64, |a, c| a.max(c.abs()));
+    let cut = cut_depth(brightest, transmittance);
+    let tau_max = tf.nodes().iter().fold(0.0f64, |a, n| a.max(n.tau));
+    let opaque = iso.is_some_and(|set| {
+        set.sides
+            .iter()
+            .any(|sides| sides.iter().all(|side| side[3] >= 1.0))
+    });
+    // False for NaN too.
+    cut.is_finite() && (tau_max * diagonal >= cut || opaque)
+}
+
 /// What the pass found.
 #[derive(Clone, Debug, Default)]
 pub struct Occlusion {
@@ -115,6 +147,31 @@ pub struct Occlusion {
     pub hidden: Vec<bool>,
     /// How many are.
     pub count: usize,
+    /// Nodes of the min/max tree found hidden whole, and the pieces they
+    /// hid without a test of their own.
+    pub nodes_hidden: usize,
+    pub hidden_by_nodes: usize,
+}
+
+/// The geometry's min/max tree as the pass reads it
+/// ([`super::cell_tree`]): its nodes' boxes, and the geometry's id of each
+/// cell of the mesh drawn (the visible subset's map,
+/// [`super::visible::VisibleSubset::cells`]; `None`: the same ids).
+#[derive(Clone, Copy)]
+pub struct TreeView<'a> {
+    pub tree: &'a CellTree,
+    pub geometry_ids: Option<&'a [u32]>,
+}
+
+impl TreeView<'_> {
+    /// The leaf of the drawn mesh's cell `c`.
+    fn leaf(&self, c: u32) -> Option<usize> {
+        let g = match self.geometry_ids {
+            Some(ids) => *ids.get(c as usize)?,
+            None => c,
+        };
+        self.tree.leaf_of.get(g as usize).map(|&l| l as usize)
+    }
 }
 
 /// The frame's pixel rays and the points' pixel positions.
@@ -130,7 +187,12 @@ struct View {
 /// Runs the pass over `order` for `src` (see the module docs), hiding what
 /// can change no channel by more than `transmittance`; `None` when it does
 /// not apply or cannot hide anything.
-pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Option<Occlusion> {
+pub fn hidden_pieces(
+    src: &PieceSource,
+    order: &Order,
+    transmittance: f64,
+    tree: Option<TreeView>,
+) -> Option<Occlusion> {
     let tf = src.tf;
     if (src.volume && tf.model() != EmissionModel::Glow) || order.pieces.is_empty() {
         return None;
@@ -210,27 +272,129 @@ pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Op
     let mut count = 0;
     let mut any_opaque = false;
     let mut completed = Vec::new();
+    // The tree's node boxes on screen (`None`: a corner not in front of
+    // the near plane, never hidden), and what it has hidden.
+    let boxes: Vec<Option<(usize, usize, usize, usize)>> = tree.map_or(Vec::new(), |t| {
+        t.tree
+            .nodes
+            .par_iter()
+            .map(|node| node_box(src, node.lo, node.hi))
+            .collect()
+    });
+    let mut node_hidden = vec![false; boxes.len()];
+    let leaves = tree.map_or(0, |t| t.tree.levels.first().map_or(0, |r| r.len()));
+    let mut leaf_hidden = vec![false; leaves];
+    let (mut nodes_hidden, mut hidden_by_nodes) = (0, 0);
+    let mut touched = Vec::new();
+    // Cells with a piece left to draw: only those are credited (every
+    // centre of a hidden piece's box is behind the cut already).
+    let mut shown = vec![false; mesh.cells.len()];
+    let covered = |b: &Option<(usize, usize, usize, usize)>, depth: &[f64]| {
+        b.is_some_and(|(x0, x1, y0, y1)| {
+            (y0..y1).all(|j| depth[j * w + x0..j * w + x1].iter().all(|&d| d >= cut))
+        })
+    };
+    // A node's test: `Ok` when its box lies behind the cut, else the first
+    // pixel in row order that is not (the node's witness). Depths only
+    // grow, so the pixels before the witness stay behind the cut and the
+    // next test resumes there: each node's box is scanned once over the
+    // whole walk, and a node in the open costs one look per block.
+    let mut witness = vec![u32::MAX; boxes.len()];
+    let node_test = |i: usize, witness: &[u32], depth: &[f64]| -> Result<(), u32> {
+        let Some((x0, x1, y0, y1)) = boxes[i] else {
+            return Err(u32::MAX);
+        };
+        let (mut j, mut x) = (y0, x0);
+        if let Some(px) = (witness[i] != u32::MAX).then_some(witness[i] as usize) {
+            (j, x) = (px / w, px % w);
+        }
+        while j < y1 {
+            while x < x1 {
+                if depth[j * w + x] < cut {
+                    return Err((j * w + x) as u32);
+                }
+                x += 1;
+            }
+            (j, x) = (j + 1, x0);
+        }
+        Ok(())
+    };
     let block = (n / BLOCKS).clamp(BLOCK_MIN, BLOCK_MAX);
     let mut end = n;
     while end > 0 {
         let start = end.saturating_sub(block);
+        // Whole nodes first: the leaves of this block's pieces, then up
+        // from each leaf found hidden while its parent is.
+        if let (true, Some(t)) = (any_opaque, tree) {
+            touched.clear();
+            touched.extend(
+                (start..end)
+                    .filter(|&k| !in_group[k])
+                    .filter_map(|k| t.leaf(order.pieces[k].cell()))
+                    .filter(|&l| !leaf_hidden[l]),
+            );
+            touched.sort_unstable();
+            touched.dedup();
+            let tested: Vec<(usize, Result<(), u32>)> = touched
+                .par_iter()
+                .map(|&l| (l, node_test(l, &witness, &depth)))
+                .collect();
+            for (l, r) in tested {
+                if let Err(px) = r {
+                    witness[l] = px;
+                    continue;
+                }
+                let mut at = l;
+                loop {
+                    node_hidden[at] = true;
+                    nodes_hidden += 1;
+                    let r = &t.tree.nodes[at].leaves;
+                    leaf_hidden[r.start as usize..r.end as usize].fill(true);
+                    let p = t.tree.parent.get(at).copied().unwrap_or(u32::MAX) as usize;
+                    if p >= node_hidden.len() || node_hidden[p] {
+                        break;
+                    }
+                    match node_test(p, &witness, &depth) {
+                        Ok(()) => at = p,
+                        Err(px) => {
+                            witness[p] = px;
+                            break;
+                        }
+                    }
+                }
+            }
+        }
         // Tests against the blocks in front.
         if any_opaque {
-            let found: Vec<usize> = (start..end)
+            let by_node = |k: usize| {
+                tree.and_then(|t| t.leaf(order.pieces[k].cell()))
+                    .is_some_and(|l| leaf_hidden[l])
+            };
+            let found: Vec<(usize, bool)> = (start..end)
                 .into_par_iter()
-                .filter(|&k| {
-                    !in_group[k]
-                        && piece_box(src, &order.pieces[k], &view.screen, FRUSTUM_MARGIN_PX)
-                            .is_some_and(|(x0, x1, y0, y1)| {
-                                (y0..y1).all(|j| {
-                                    depth[j * w + x0..j * w + x1].iter().all(|&d| d >= cut)
-                                })
-                            })
+                .filter(|&k| !in_group[k])
+                .filter_map(|k| {
+                    if by_node(k) {
+                        return Some((k, true));
+                    }
+                    piece_box(src, &order.pieces[k], &view.screen, FRUSTUM_MARGIN_PX)
+                        .is_some_and(|b| covered(&Some(b), &depth))
+                        .then_some((k, false))
                 })
                 .collect();
             count += found.len();
-            for k in found {
+            for (k, node) in found {
                 hidden[k] = true;
+                hidden_by_nodes += node as usize;
+            }
+        }
+        for (piece, _) in order.pieces[start..end]
+            .iter()
+            .zip(&hidden[start..end])
+            .filter(|(_, &h)| !h)
+        {
+            if let Some(s) = shown.get_mut(piece.cell() as usize) {
+                *s = true;
             }
         }
         // The cells this block completes, front to back.
@@ -241,7 +405,7 @@ pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Op
                 continue;
             }
             left[c] -= 1;
-            if left[c] == 0 {
+            if left[c] == 0 && shown[c] {
                 completed.push(c as u32);
             }
         }
@@ -265,7 +429,49 @@ pub fn hidden_pieces(src: &PieceSource, order: &Order, transmittance: f64) -> Op
         }
         end = start;
     }
-    Some(Occlusion { hidden, count })
+    Some(Occlusion {
+        hidden,
+        count,
+        nodes_hidden,
+        hidden_by_nodes,
+    })
+}
+
+/// The pixel-centre box ([`points_box`]) of a tree node's world box
+/// `lo`..`hi`: its eight corners' projections, grown by
+/// [`FRUSTUM_MARGIN_PX`] as a piece's box is and by
+/// [`OCCLUSION_NODE_MARGIN_PX`] for the rounding of corners that are not
+/// mesh points; `None` when a corner is not in front of the near plane or
+/// the box is empty (a node without points).
+fn node_box(src: &PieceSource, lo: DVec3, hi: DVec3) -> Option<(usize, usize, usize, usize)> {
+    if !(lo.cmple(hi).all() && lo.is_finite() && hi.is_finite()) {
+        return None;
+    }
+    let camera = src.camera;
+    let he = camera.half_extent();
+    let corners: Vec<Option<(f64, f64)>> = (0..8)
+        .map(|k| {
+            let p = DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            let v = camera.to_view(p);
+            if v.z.is_nan() || v.z <= camera.near.max(0.0) {
+                return None;
+            }
+            camera
+                .view_to_pixel_with(v, he)
+                .map(|(x, y, _)| (x, y))
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+        })
+        .collect();
+    points_box(
+        src,
+        &[0, 1, 2, 3, 4, 5, 6, 7],
+        &corners,
+        FRUSTUM_MARGIN_PX + OCCLUSION_NODE_MARGIN_PX,
+    )
 }
 
 /// The box of [`points_box`] around a piece: its cell's points for a
@@ -549,3 +755,6 @@ fn cell_credit(
         }
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -129,6 +129,11 @@ pub struct ProjectedOptions {
     /// [`crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE`]); `None`
     /// draws them, to check the image and measure what the pass saves.
     pub occlusion: Option<f64>,
+    /// Let the occlusion pass hide whole nodes of the geometry's min/max
+    /// tree ([`super::cell_tree`]) behind opaque pixels, before testing
+    /// pieces one by one (on by default). The same pieces are hidden
+    /// either way; off only to measure what the tree saves.
+    pub occlusion_tree: bool,
     /// Sort and draw only the cells that are not dark when at least
     /// [`super::visible::DARK_SUBSET_MIN`] of them are ([`super::visible`];
     /// on by default, and only with [`Self::skip_invisible`]). Off to
@@ -193,6 +198,7 @@ impl Default for ProjectedOptions {
             refine_tol: crate::numeric::tolerance::COLOR_REFINE_TOL,
             exact_ties: true,
             occlusion: Some(crate::numeric::tolerance::OCCLUSION_TRANSMITTANCE),
+            occlusion_tree: true,
             dark_subset: true,
             keep_projection: false,
             piece_draw: PieceDraw::Auto,

@@ -37,6 +37,11 @@ pub struct ProjectedStats {
     /// ([`super::occlusion`]), and the time the pass took.
     pub hidden_pieces: usize,
     pub occlusion_s: f64,
+    /// Nodes of the min/max tree ([`super::cell_tree`]) the occlusion
+    /// pass found hidden whole, and the hidden pieces it left out through
+    /// them without testing each.
+    pub occlusion_nodes_hidden: usize,
+    pub hidden_by_nodes: usize,
     /// Pixels of the per-pixel layers of cycle groups
     /// ([`super::group`]).
     pub group_pixels: usize,
@@ -46,6 +51,12 @@ pub struct ProjectedStats {
     /// subset this frame (0 when it was reused).
     pub dark_cells_left_out: usize,
     pub visible_subset_s: f64,
+    /// What finding the dark cells looked at when the subset was built
+    /// this frame ([`super::cell_tree`]): nodes of the min/max tree and
+    /// cells tested one by one, of all (zeros when reused or not built).
+    pub dark_nodes_visited: usize,
+    pub dark_cells_tested: usize,
+    pub tree_nodes: usize,
     /// The frame took the renderer's last order, made for the same camera,
     /// split policy, scalars and sorter options, without sorting again
     /// (`order` then holds the statistics of the sort that made it).
@@ -118,14 +129,32 @@ impl fmt::Display for ProjectedStats {
         if e.dark_cells_left_out > 0 {
             writeln!(
                 f,
-                "visible      {:.3} s  ({} dark cells left out of the sort)",
-                e.visible_subset_s, e.dark_cells_left_out
+                "visible      {:.3} s  ({} dark cells left out of the sort{})",
+                e.visible_subset_s,
+                e.dark_cells_left_out,
+                if e.dark_nodes_visited > 0 {
+                    format!(
+                        "; min/max tree: {} of {} nodes visited, {} cells tested",
+                        e.dark_nodes_visited, e.tree_nodes, e.dark_cells_tested
+                    )
+                } else {
+                    String::new()
+                }
             )?;
         }
         writeln!(
             f,
-            "occlusion    {:.3} s  ({} pieces hidden behind opaque ones)",
-            e.occlusion_s, e.hidden_pieces
+            "occlusion    {:.3} s  ({} pieces hidden behind opaque ones{})",
+            e.occlusion_s,
+            e.hidden_pieces,
+            if e.occlusion_nodes_hidden > 0 {
+                format!(
+                    "; min/max tree: {} nodes hidden whole, {} of the pieces through them",
+                    e.occlusion_nodes_hidden, e.hidden_by_nodes
+                )
+            } else {
+                String::new()
+            }
         )?;
         writeln!(
             f,

@@ -32,13 +32,16 @@
 //! What it saves: the sort of the dark cells (face classification,
 //! splits, the topological sort) and, where the renderer has not made the
 //! whole mesh's sorter yet, building it (per geometry). Building the
-//! subset costs a pass over the cells, its topology and its sorter's
-//! planes, for the kept cells only.
+//! subset costs its topology and its sorter's planes, for the kept cells
+//! only, and finding the dark cells: a walk of the geometry's min/max tree
+//! ([`super::cell_tree`], built once per geometry, its ranges once per
+//! field), which tests the cells of the leaves near the visible part of
+//! the range only, so a transfer function covering a narrow band costs
+//! about what that band holds. The tree is kept here for the occlusion
+//! pass too ([`VisibleCache::tree`]).
 
 use std::sync::Arc;
 use std::time::Instant;
-
-use rayon::prelude::*;
 
 use crate::field::{Association, ScalarField};
 use crate::mesh::subset::cells_subset;
@@ -46,10 +49,11 @@ use crate::mesh::topology::Topology;
 use crate::mesh::Mesh;
 use crate::visibility::{Order, Piece, Sorter};
 
+use super::cell_tree::{CellRanges, CellTree, ClassifyStats};
 use super::iso::IsoSet;
 use super::order_cache::OrderCache;
-use super::pieces::{dark_key, dark_range, value_range};
-use super::scene::{ScalarsRef, Scene};
+use super::pieces::{dark_key, dark_range};
+use super::scene::Scene;
 
 /// The smallest fraction of dark cells for which the renderer sorts the
 /// visible subset: below it, building the subset's topology and sorter
@@ -135,6 +139,10 @@ pub struct VisibleCache {
     subset: Option<VisibleSubset>,
     /// Dark cells of the last key.
     dark_cells: usize,
+    /// The geometry's min/max tree, and the ranges of the field they were
+    /// built for (the field held, compared by address).
+    tree: Option<(Arc<Mesh>, Arc<CellTree>)>,
+    ranges: Option<(Option<Arc<ScalarField>>, Arc<CellRanges>)>,
 }
 
 impl VisibleCache {
@@ -143,71 +151,89 @@ impl VisibleCache {
         self.subset.as_ref()
     }
 
-    /// Forgets the subset (a new geometry).
+    /// Forgets the subset and the tree (a new geometry).
     pub fn clear(&mut self) {
         *self = VisibleCache::default();
     }
 
+    /// The min/max tree over `mesh`'s cells ([`super::cell_tree`]), built
+    /// on first use and kept while the geometry is the same, with the
+    /// seconds spent building it (0 when kept).
+    pub fn tree(&mut self, mesh: &Arc<Mesh>) -> (Arc<CellTree>, f64) {
+        let t0 = Instant::now();
+        if let Some((m, t)) = &self.tree {
+            if Arc::ptr_eq(m, mesh) {
+                return (t.clone(), 0.0);
+            }
+        }
+        let tree = Arc::new(CellTree::build(mesh));
+        self.tree = Some((mesh.clone(), tree.clone()));
+        self.ranges = None;
+        (tree, t0.elapsed().as_secs_f64())
+    }
+
+    /// The tree's ranges of `scene`'s field, built once per field.
+    fn ranges(&mut self, scene: &Scene, tree: &CellTree) -> Arc<CellRanges> {
+        if let Some((f, r)) = &self.ranges {
+            let same = match (f, &scene.field) {
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (None, None) => true,
+                _ => false,
+            };
+            if same {
+                return r.clone();
+            }
+        }
+        let r = Arc::new(CellRanges::build(tree, &scene.mesh, scene.scalars()));
+        self.ranges = Some((scene.field.clone(), r.clone()));
+        r
+    }
+
     /// The visible subset of `scene` for a mode drawing surfaces `iso` and
     /// the volume when `volume`, built if its key changed (see the module
-    /// docs), with the number of dark cells it leaves out and the seconds
-    /// spent building it (0 when reused); `None` when too few are dark.
+    /// docs), with the number of dark cells it leaves out, the seconds
+    /// spent building it (0 when reused) and what finding the dark cells
+    /// looked at (zeros when reused); `None` when too few are dark.
     pub fn prepare(
         &mut self,
         scene: &Scene,
         iso: Option<&IsoSet>,
         volume: bool,
-    ) -> (Option<&mut VisibleSubset>, usize, f64) {
+    ) -> (Option<&mut VisibleSubset>, usize, f64, ClassifyStats) {
         let t0 = Instant::now();
         let dark = dark_key(&scene.tf, iso, volume);
+        let mut classified = ClassifyStats::default();
         if !self.key.as_ref().is_some_and(|k| k.matches(scene, dark)) {
-            let (subset, dark_cells) = build(scene, iso, volume);
-            *self = VisibleCache {
-                key: Some(Key {
-                    mesh: scene.mesh.clone(),
-                    field: scene.field.clone(),
-                    dark,
-                }),
-                subset,
-                dark_cells,
-            };
+            let (tree, _) = self.tree(&scene.mesh);
+            let ranges = self.ranges(scene, &tree);
+            let test = |lo: f64, hi: f64| dark_range(&scene.tf, iso, volume, lo, hi);
+            let (dark_flags, stats) = tree.classify(&ranges, &test);
+            classified = stats;
+            let (subset, dark_cells) = build(scene, &dark_flags);
+            self.key = Some(Key {
+                mesh: scene.mesh.clone(),
+                field: scene.field.clone(),
+                dark,
+            });
+            self.subset = subset;
+            self.dark_cells = dark_cells;
         }
         let built = t0.elapsed().as_secs_f64();
         let dark_cells = self.dark_cells;
         match self.subset.as_mut() {
-            Some(s) => (Some(s), dark_cells, built),
-            None => (None, 0, built),
+            Some(s) => (Some(s), dark_cells, built, classified),
+            None => (None, 0, built, classified),
         }
     }
 }
 
-/// The subset of `scene`'s non-dark cells, when at least
-/// [`DARK_SUBSET_MIN`] of them are dark, and the number of dark cells.
-fn build(scene: &Scene, iso: Option<&IsoSet>, volume: bool) -> (Option<VisibleSubset>, usize) {
+/// The subset of `scene`'s cells not flagged in `dark` (by cell id), when
+/// at least [`DARK_SUBSET_MIN`] of them are dark, and the number of dark
+/// cells.
+fn build(scene: &Scene, dark: &[bool]) -> (Option<VisibleSubset>, usize) {
     let mesh = &scene.mesh;
     let cells = &mesh.cells;
     let n = cells.len();
-    let scalars = scene.scalars();
-    let tf = &scene.tf;
-    let dark: Vec<bool> = (0..n)
-        .into_par_iter()
-        .map(|c| {
-            let (lo, hi) = match scalars {
-                ScalarsRef::Point(v) => value_range(
-                    cells
-                        .nodes(c)
-                        .iter()
-                        .map(|&p| v.get(p as usize).copied().unwrap_or(f64::NAN)),
-                ),
-                ScalarsRef::Cell(v) => {
-                    let s = v.get(c).copied().unwrap_or(f64::NAN);
-                    (s, s)
-                }
-                ScalarsRef::Constant(s) => (s, s),
-            };
-            dark_range(tf, iso, volume, lo, hi)
-        })
-        .collect();
     let count = dark.iter().filter(|&&d| d).count();
     if n == 0 || (count as f64) < DARK_SUBSET_MIN * n as f64 {
         return (None, count);

@@ -102,6 +102,8 @@ pub struct KeptCounts {
     pub steep_triangles: usize,
     pub triangles: usize,
     pub hidden_pieces: usize,
+    pub occlusion_nodes_hidden: usize,
+    pub hidden_by_nodes: usize,
 }
 
 impl KeptCounts {
@@ -115,6 +117,8 @@ impl KeptCounts {
             steep_triangles: s.steep_triangles,
             triangles: s.triangles,
             hidden_pieces: s.hidden_pieces,
+            occlusion_nodes_hidden: s.occlusion_nodes_hidden,
+            hidden_by_nodes: s.hidden_by_nodes,
         }
     }
 
@@ -128,6 +132,8 @@ impl KeptCounts {
         s.steep_triangles = self.steep_triangles;
         s.triangles = self.triangles;
         s.hidden_pieces = self.hidden_pieces;
+        s.occlusion_nodes_hidden = self.occlusion_nodes_hidden;
+        s.hidden_by_nodes = self.hidden_by_nodes;
         s.projection_reused = true;
     }
 }

@@ -660,6 +660,7 @@ pub fn render_projected<M: ProjectedMode>(
     opts: &RenderOptions,
     camera: &Camera,
     whole: &crate::mesh::Mesh,
+    tree: Option<super::occlusion::TreeView>,
     kept_frame: &mut Option<KeptProjection>,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<(Image, ProjectedStats), RenderError> {
@@ -806,10 +807,12 @@ pub fn render_projected<M: ProjectedMode>(
         .projected
         .occlusion
         .filter(|_| opts.projected.draw == DrawKind::Composite)
-        .and_then(|t| super::occlusion::hidden_pieces(&src, &order, t))
+        .and_then(|t| super::occlusion::hidden_pieces(&src, &order, t, tree))
         .filter(|o| o.count > 0);
     stats.occlusion_s = t_occ.elapsed().as_secs_f64();
     stats.hidden_pieces = occlusion.as_ref().map_or(0, |o| o.count);
+    stats.occlusion_nodes_hidden = occlusion.as_ref().map_or(0, |o| o.nodes_hidden);
+    stats.hidden_by_nodes = occlusion.as_ref().map_or(0, |o| o.hidden_by_nodes);
     let mut kept: Vec<Piece> = Vec::new();
     for (plain, group) in stretches {
         let pieces = match &occlusion {
@@ -893,4 +896,4 @@ fn finish<V: GpuVertex>(
 pub mod kept;
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -10,7 +10,7 @@ use crate::tf::TransferFunction;
 use crate::visibility::Order;
 
 /// The context of `order` for `scene` seen by `camera`.
-fn test_ctx<'a>(
+pub(crate) fn test_ctx<'a>(
     scene: &'a Scene,
     camera: &'a Camera,
     breakpoints: &'a [f64],
