@@ -1,7 +1,9 @@
-//! A min/max hierarchy over the cells of a geometry (Livnat and Hansen's
-//! view-dependent culling, `docs/papers.md`): what lets a frame skip the
-//! dark cells of a transfer function, and whole groups of cells hidden
-//! behind opaque ones, without a test per cell.
+//! A min/max hierarchy over the cells of a geometry (after Livnat and
+//! Hansen's view-dependent isosurface extraction, whose octree keeps the
+//! scalar range of each subtree and culls subtrees behind an occlusion
+//! mask): what lets a frame skip the dark cells of a transfer function,
+//! and whole groups of cells hidden behind opaque ones, without a test per
+//! cell.
 //!
 //! **The tree.** Cells are put in the Morton order of their bounding
 //! boxes' centres (21 bits per axis over the mesh's bounds), and cut into
