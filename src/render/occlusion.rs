@@ -335,12 +335,10 @@ pub fn hidden_pieces(
             );
             touched.sort_unstable();
             touched.dedup();
-            let tested: Vec<(usize, Result<(), u32>)> = touched
-                .par_iter()
-                .map(|&l| (l, node_test(l, &witness, &depth)))
-                .collect();
-            for (l, r) in tested {
-                if let Err(px) = r {
+            // In order, on this thread: with the witnesses most tests are
+            // one look, less than handing them over would cost.
+            for &l in &touched {
+                if let Err(px) = node_test(l, &witness, &depth) {
                     witness[l] = px;
                     continue;
                 }
