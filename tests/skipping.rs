@@ -479,6 +479,83 @@ fn pieces_behind_opaque_ones_are_left_out_and_the_image_is_unchanged() {
     }
 }
 
+/// The min/max tree's whole nodes in the occlusion pass
+/// (`render::cell_tree`): with the front opaque, the middle dark (so the
+/// visible subset is drawn, and the pass maps its cells to the geometry's
+/// tree) and the back translucent, the pass hides the same pieces with the
+/// nodes as without, some through nodes, and the image is the same; a
+/// wrong map from the subset's cells to the tree's would hide other
+/// pieces.
+#[test]
+fn tree_nodes_hide_the_same_pieces_with_the_visible_subset() {
+    for (ortho, azimuth, elevation) in [(false, 30.0, 20.0), (true, 200.0, -35.0)] {
+        let params = zoovr::camera::CameraParams {
+            width: 96,
+            height: 80,
+            azimuth,
+            elevation,
+            ortho,
+            ..Default::default()
+        };
+        let mut scene = front_opaque_scene(&params);
+        scene.tf = TransferFunction::from_channels(
+            &[
+                (0.0, [400.0]),
+                (0.4, [400.0]),
+                (0.4, [0.0]),
+                (0.9, [0.0]),
+                (0.9, [3.0]),
+                (1.0, [3.0]),
+            ],
+            &[(0.0, [0.9, 0.3, 0.2]), (1.0, [0.2, 0.3, 1.0])],
+            None,
+            EmissionModel::Glow,
+        )
+        .unwrap();
+        let shading = scene.shading();
+        let mut renderer = Renderer::new(scene.geometry());
+        for mode in [Mode::Exact, Mode::ExactFrag] {
+            let case = format!("ortho {ortho} azimuth {azimuth} {mode:?}");
+            let mut frame = |occlusion: Option<f64>, tree: bool| {
+                let opts = RenderOptions {
+                    mode,
+                    camera: params,
+                    projected: ProjectedOptions {
+                        compositor: Compositor::Cpu,
+                        occlusion,
+                        occlusion_tree: tree,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                };
+                let (img, stats) = renderer.render(&shading, &opts, |_, _| {}).unwrap();
+                let p = stats.projected().unwrap().clone();
+                (img, p)
+            };
+            let on = Some(zoovr::numeric::tolerance::OCCLUSION_TRANSMITTANCE);
+            let (all, _) = frame(None, true);
+            let (with, p_with) = frame(on, true);
+            let (without, p_without) = frame(on, false);
+            eprintln!(
+                "{case}: {} dark cells left out, {} of {} pieces hidden, {} through {} nodes",
+                p_with.dark_cells_left_out,
+                p_with.hidden_pieces,
+                p_with.pieces,
+                p_with.hidden_by_nodes,
+                p_with.occlusion_nodes_hidden
+            );
+            assert!(p_with.dark_cells_left_out > 0, "{case}");
+            assert!(p_with.hidden_by_nodes > 0, "{case}");
+            assert_eq!(p_without.hidden_by_nodes, 0, "{case}");
+            assert_eq!(p_with.hidden_pieces, p_without.hidden_pieces, "{case}");
+            let (d, _) = compare_float(&with, &without).unwrap();
+            assert_eq!(d.max_abs, 0.0, "{case}");
+            let (d, _) = compare_float(&with, &all).unwrap();
+            assert!(d.max_abs <= 1e-6, "{case}: {:e}", d.max_abs);
+        }
+    }
+}
+
 /// A warped grid whose field is the distance from a point inside it, with
 /// a transfer function whose extinction is `tau` everywhere: surfaces of
 /// the field are closed, nested shells.
