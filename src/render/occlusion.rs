@@ -110,6 +110,16 @@ pub fn cut_depth(brightest: f64, transmittance: f64) -> f64 {
     (brightest.max(1.0) / transmittance).ln()
 }
 
+/// [`cut_depth`] for `tf`'s brightest colour.
+fn tf_cut_depth(tf: &crate::tf::TransferFunction, transmittance: f64) -> f64 {
+    let brightest = tf
+        .nodes()
+        .iter()
+        .flat_map(|n| n.color)
+        .fold(0.0f64, |a, c| a.max(c.abs()));
+    cut_depth(brightest, transmittance)
+}
+
 /// Whether the pass can hide anything in a frame with transfer function
 /// `tf`, surfaces `iso` and the volume when `volume` over a mesh of
 /// diagonal `diagonal` (a superset of the frames [`hidden_pieces`] runs
@@ -124,13 +134,13 @@ pub fn may_hide(
     if !volume || tf.model() != EmissionModel::Glow {
         return false;
     }
-    let brightest = tf
-        .nodes()
-        .iter()
-        .flat_map(|n| n.color)
-        .fold(0.0f64, |a, c| a.max(c.abs()));
-    let cut = cut_depth(brightest, transmittance);
-    let tau_max = tf.nodes().iter().fold(0.0f64, |a, n| a.max(n.tau));
+    let cut = tf_cut_depth(tf, transmittance);
+    // The pass's own measure (`PieceSource::max_rate` over the whole
+    // range): extinction and glow emission `tau c` at every node.
+    let tau_max = tf.nodes().iter().fold(0.0f64, |a, n| {
+        let c = n.color.iter().fold(1.0f64, |m, c| m.max(c.abs()));
+        a.max(n.tau).max(n.tau * c)
+    });
     let opaque = iso.is_some_and(|set| {
         set.sides
             .iter()
@@ -197,12 +207,7 @@ pub fn hidden_pieces(
     if (src.volume && tf.model() != EmissionModel::Glow) || order.pieces.is_empty() {
         return None;
     }
-    let brightest = tf
-        .nodes()
-        .iter()
-        .flat_map(|n| n.color)
-        .fold(0.0f64, |a, c| a.max(c.abs()));
-    let cut = cut_depth(brightest, transmittance);
+    let cut = tf_cut_depth(tf, transmittance);
     let (lo, hi) = tf.scalar_range();
     let tau_max = src.max_rate(lo.min(hi), hi.max(lo));
     let mesh = src.mesh;
