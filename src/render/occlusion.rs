@@ -260,16 +260,7 @@ pub fn hidden_pieces(
         screen: mesh
             .points
             .par_iter()
-            .map(|&p| {
-                let v = camera.to_view(p);
-                if v.z.is_nan() || v.z <= camera.near.max(0.0) {
-                    return None;
-                }
-                camera
-                    .view_to_pixel_with(v, he)
-                    .map(|(x, y, _)| (x, y))
-                    .filter(|(x, y)| x.is_finite() && y.is_finite())
-            })
+            .map(|&p| screen_of(camera, he, p))
             .collect(),
     };
     let mut depth = vec![0.0f64; w * h];
@@ -452,29 +443,34 @@ fn node_box(src: &PieceSource, lo: DVec3, hi: DVec3) -> Option<(usize, usize, us
     }
     let camera = src.camera;
     let he = camera.half_extent();
-    let corners: Vec<Option<(f64, f64)>> = (0..8)
-        .map(|k| {
-            let p = DVec3::new(
-                if k & 1 == 0 { lo.x } else { hi.x },
-                if k & 2 == 0 { lo.y } else { hi.y },
-                if k & 4 == 0 { lo.z } else { hi.z },
-            );
-            let v = camera.to_view(p);
-            if v.z.is_nan() || v.z <= camera.near.max(0.0) {
-                return None;
-            }
-            camera
-                .view_to_pixel_with(v, he)
-                .map(|(x, y, _)| (x, y))
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
-        })
-        .collect();
+    let corners: [Option<(f64, f64)>; 8] = std::array::from_fn(|k| {
+        let p = DVec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        );
+        screen_of(camera, he, p)
+    });
     points_box(
         src,
         &[0, 1, 2, 3, 4, 5, 6, 7],
         &corners,
         FRUSTUM_MARGIN_PX + OCCLUSION_NODE_MARGIN_PX,
     )
+}
+
+/// The pixel position of world point `p` (`he`: the camera's
+/// half extent); `None` when it is not in front of the near plane or does
+/// not map to a finite position.
+fn screen_of(camera: &crate::camera::Camera, he: (f64, f64), p: DVec3) -> Option<(f64, f64)> {
+    let v = camera.to_view(p);
+    if v.z.is_nan() || v.z <= camera.near.max(0.0) {
+        return None;
+    }
+    camera
+        .view_to_pixel_with(v, he)
+        .map(|(x, y, _)| (x, y))
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
 }
 
 /// The box of [`points_box`] around a piece: its cell's points for a
