@@ -1,7 +1,9 @@
 // The vertex stage and segment of exact-frag's whole-piece quads
 // (src/render/modes/piece_quad.rs, which fills `VertexIn` and is the twin):
 // a convex piece of at most 8 points and 12 boundary triangles is drawn as
-// one screen quad over its pixel bounding box, every vertex carrying the
+// one screen polygon over its outline (its projected points' hull widened
+// a little, or the quad over its pixel bounding box; see
+// src/render/driver/whole.rs), every vertex carrying the
 // whole piece, and each fragment finds where its own ray enters and leaves
 // the piece (view-independent cell projection, Weiler, Kraus, Merz and
 // Ertl 2003): no region subdivision on the CPU.

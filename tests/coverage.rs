@@ -88,7 +88,8 @@ fn counts(
 }
 
 /// [`counts`] of the exact mode (`Regions`) or of exact-frag's whole-piece
-/// quads (`Quads`).
+/// quads (`Quads`), with the number of parts drawn whole and, of them, as
+/// their outline's hull.
 fn counts_with(
     renderer: &mut Renderer,
     shading: &Shading,
@@ -96,7 +97,7 @@ fn counts_with(
     kind: DrawKind,
     compositor: Compositor,
     draw: PieceDraw,
-) -> (Image, usize) {
+) -> (Image, usize, usize) {
     let opts = RenderOptions {
         mode: if draw == PieceDraw::Quads {
             Mode::ExactFrag
@@ -115,11 +116,11 @@ fn counts_with(
     let (img, stats) = renderer
         .render_with_camera(shading, &opts, camera, |_, _| {})
         .unwrap();
-    let whole = match stats.detail {
-        ModeStats::Projected(p) => p.whole_pieces,
-        _ => 0,
+    let (whole, hulls) = match stats.detail {
+        ModeStats::Projected(p) => (p.whole_pieces, p.whole_hulls),
+        _ => (0, 0),
     };
-    (img, whole)
+    (img, whole, hulls)
 }
 
 /// The reference: the ray caster's brute force over the `tets`, built once
@@ -298,6 +299,13 @@ fn check_twin(
 /// pixel centres of a 64 x 64 orthographic view down -z (optionally
 /// sheared so that faces are not edge-on), and that camera.
 fn on_grid(n: usize, shear: f64) -> (Mesh, Camera) {
+    on_grid_scaled(n, shear, 1)
+}
+
+/// [`on_grid`] with its points `scale` times as far from the image's
+/// centre (odd, so that they still project onto pixel centres; the camera
+/// is unchanged, so every coordinate stays exact in binary).
+fn on_grid_scaled(n: usize, shear: f64, scale: u32) -> (Mesh, Camera) {
     let mut mesh = warped_hex_grid(
         n,
         &Warp {
@@ -308,7 +316,7 @@ fn on_grid(n: usize, shear: f64) -> (Mesh, Camera) {
     let k = 2.0 * n as f64;
     for p in &mut mesh.points {
         let (x, y, z) = (p.x * k, p.y * k, (p.z * k).round());
-        *p = DVec3::new(x - n as f64 + 0.5 + shear * z, y - n as f64 + 0.5, z);
+        *p = DVec3::new(x - n as f64 + 0.5 + shear * z, y - n as f64 + 0.5, z) * scale as f64;
     }
     let params = CameraParams {
         width: 64,
@@ -560,6 +568,15 @@ fn whole_piece_quads_cover_what_their_rays_meet() {
         }
         cases.push((format!("on-grid shear {sx}, {sy}"), mesh, vec![camera]));
     }
+    // Pieces tens of pixels wide, drawn as their outlines' hulls, with
+    // points on pixel centres.
+    for (sx, sy) in [(0.5, 0.25), (-1.0, 0.5)] {
+        let (mut mesh, camera) = on_grid_scaled(3, sx, 5);
+        for p in &mut mesh.points {
+            p.y += sy * p.z;
+        }
+        cases.push((format!("on-grid x5 shear {sx}, {sy}"), mesh, vec![camera]));
+    }
     for path in project_and_shared(&[
         "tets_small/CylinderLinear.vtk",
         "prisms_zoo/PentaHexa.vtk",
@@ -583,6 +600,7 @@ fn whole_piece_quads_cover_what_their_rays_meet() {
             .collect();
         cases.push((path.display().to_string(), mesh, cams));
     }
+    let mut all_hulls = 0;
     for (name, mesh, cams) in cases {
         let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
         scene.tf = flat_tf(scene.range);
@@ -601,7 +619,8 @@ fn whole_piece_quads_cover_what_their_rays_meet() {
                     PieceDraw::Quads,
                 )
             };
-            let (twin, whole) = count(&mut renderer, Compositor::Cpu);
+            let (twin, whole, hulls) = count(&mut renderer, Compositor::Cpu);
+            all_hulls += hulls;
             let twin = red(&twin);
             if gpu {
                 let got = red(&count(&mut renderer, Compositor::Gpu).0);
@@ -611,8 +630,11 @@ fn whole_piece_quads_cover_what_their_rays_meet() {
             let want = reference_counts(&brute, camera);
             check_counts(&scene, camera, &twin, &want, &tag);
             let pieces = scene.mesh.cells.len();
-            eprintln!("{tag}: all right, {whole} tets drawn whole of {pieces} cells");
+            eprintln!(
+                "{tag}: all right, {whole} tets drawn whole ({hulls} as hulls) of {pieces} cells"
+            );
             assert!(whole > 0, "{tag}: no piece drawn whole");
         }
     }
+    assert!(all_hulls > 0, "no part drawn as its outline's hull");
 }

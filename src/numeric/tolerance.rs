@@ -124,6 +124,16 @@ pub const OCCLUSION_ISO_CHORD: f64 = 1e-9;
 /// (0.044 px) could differ at centres within 0.03 px of a dropped sliver.
 pub const COVERAGE_MARGIN_PX: f64 = 1.0 / 64.0;
 
+/// Parts drawn whole ([`crate::render::driver`]'s whole-part polygons): the
+/// convex hull of a part's projected points is pushed outward by this many
+/// pixels before its corners are snapped to the sub-pixel grid. Snapping
+/// moves a corner by at most `sqrt(2) / 512 = 0.0028` px, so the drawn
+/// polygon still holds every pixel centre within [`COVERAGE_MARGIN_PX`]
+/// of the hull (the budget for the `f32` rounding of the fragment's own
+/// inside test, as for coverage culling): 1/32 px is that margin plus
+/// more than five times the snap.
+pub const QUAD_HULL_MARGIN_PX: f64 = 1.0 / 32.0;
+
 /// Projection (perspective): region values are interpolated linearly in
 /// screen space. Region edges whose interpolation error bound (screen-space
 /// vs perspective-correct parameter: `|dz| / (4 min z)` per face, plus the

@@ -167,8 +167,9 @@ pub enum PieceDraw {
     /// Each piece projected into regions on the CPU (winged-edge
     /// subdivision), the segment payload at their corners.
     Regions,
-    /// Each piece drawn whole as one quad over its pixel bounding box;
-    /// every fragment intersects its ray with the piece's boundary
+    /// Each piece drawn whole as one polygon over its outline (the convex
+    /// hull of its projected points, widened a little, or, for small
+    /// pieces, the quad over its pixel bounding box); every fragment intersects its ray with the piece's boundary
     /// triangles (view-independent cell projection). Pieces that `f32`
     /// cannot settle (near plane, faces seen nearly edge-on, optically
     /// thick, more than 8 points) are projected as with `regions`.

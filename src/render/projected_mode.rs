@@ -79,9 +79,9 @@ pub trait ProjectedMode: Sync {
     /// The CPU twin of the stage's fragment shader, for one frame of `src`.
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<Self::Vertex>>;
 
-    /// The vertex that draws `part` whole, as one quad over its pixel
-    /// bounding box whose fragments find their own segment through the
-    /// part (exact-frag's `--piece-draw quads`,
+    /// The vertex that draws `part` whole, as one polygon over its outline
+    /// (the driver's `whole` module) whose fragments find their own
+    /// segment through the part (exact-frag's `--piece-draw quads`,
     /// [`super::modes::piece_quad`]), with the clip position left to the
     /// driver; `None` (the default, and for a part the mode cannot draw
     /// whole): the driver projects the part into regions. `rate` is the

@@ -33,6 +33,9 @@ pub struct ProjectedStats {
     /// Parts drawn whole as one quad (exact-frag `--piece-draw quads`,
     /// [`super::modes::piece_quad`]); the others were projected.
     pub whole_pieces: usize,
+    /// Of those, the parts drawn as their outline's widened hull rather
+    /// than their pixel bounding box ([`super::driver`]'s `whole`).
+    pub whole_hulls: usize,
     /// Pieces left out as hidden behind opaque ones
     /// ([`super::occlusion`]), and the time the pass took.
     pub hidden_pieces: usize,
@@ -172,7 +175,10 @@ impl fmt::Display for ProjectedStats {
             e.tie_pixels,
             e.steep_triangles,
             if e.whole_pieces > 0 {
-                format!(", {} pieces drawn whole", e.whole_pieces)
+                format!(
+                    ", {} pieces drawn whole ({} as hulls)",
+                    e.whole_pieces, e.whole_hulls
+                )
             } else {
                 String::new()
             }

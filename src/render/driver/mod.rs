@@ -12,8 +12,8 @@
 //! 2. Each piece becomes its view-space parts ([`PieceSource::parts`]:
 //!    pieces with zero extinction over their range are skipped). A mode
 //!    that draws a part whole ([`ProjectedMode::whole_part`]: exact-frag's
-//!    quads) gets one quad over the part's pixel bounding box
-//!    ([`draw_whole`]); every other part is projected into regions
+//!    quads) gets one polygon over the part's outline, its projected
+//!    points' convex hull widened a little ([`whole`]); every other part is projected into regions
 //!    ([`Projector`]), leaving out pieces and
 //!    triangles that contain no pixel centre
 //!    ([`crate::projection::coverage`],
@@ -91,6 +91,7 @@ use super::ties::{
 use super::workers::run_ordered;
 use super::{Compositor, RenderError, RenderOptions};
 use kept::{KeepKey, KeptCounts, KeptProjection};
+use whole::draw_whole;
 
 /// Pieces processed per chunk (one worker's unit of work).
 const CHUNK: usize = 2048;
@@ -121,6 +122,8 @@ pub(super) struct ChunkOut<V> {
     steep: usize,
     /// Parts drawn whole, as one quad ([`ProjectedMode::whole_part`]).
     whole: usize,
+    /// Of those, the parts drawn as their outline's hull ([`whole`]).
+    hulls: usize,
     pub(super) error: Option<PieceError>,
 }
 
@@ -137,6 +140,7 @@ impl<V> Default for ChunkOut<V> {
             tie_pixels: 0,
             steep: 0,
             whole: 0,
+            hulls: 0,
             error: None,
         }
     }
@@ -155,6 +159,7 @@ impl<V> ChunkOut<V> {
         self.tie_pixels = 0;
         self.steep = 0;
         self.whole = 0;
+        self.hulls = 0;
         self.error = None;
     }
 }
@@ -325,56 +330,6 @@ fn draw_part<M: ProjectedMode>(
         }
     }
     Ok(())
-}
-
-/// Draws `part` whole as one piece: a quad over the whole pixels its
-/// points' bounding box touches (widened by
-/// [`crate::numeric::tolerance::COVERAGE_MARGIN_PX`], clipped to the
-/// image), every corner carrying `v`. Its corners lie on whole pixels, so
-/// the quad holds every pixel centre the part's outline can; the stage
-/// discards the fragments whose ray misses the part. A part whose box
-/// holds no centre is culled.
-fn draw_whole<V: GpuVertex>(camera: &Camera, part: &Polyhedron, v: V, out: &mut ChunkOut<V>) {
-    use crate::numeric::tolerance::COVERAGE_MARGIN_PX;
-    let extent = camera.half_extent();
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in &part.points {
-        let Some((px, py, _)) = camera.view_to_pixel_with(*p, extent) else {
-            out.culled += 1;
-            return;
-        };
-        lo = [lo[0].min(px), lo[1].min(py)];
-        hi = [hi[0].max(px), hi[1].max(py)];
-    }
-    let size = [camera.width as f64, camera.height as f64];
-    let lo = [0, 1].map(|k| (lo[k] - COVERAGE_MARGIN_PX).floor().max(0.0));
-    let hi = [0, 1].map(|k| (hi[k] + COVERAGE_MARGIN_PX).ceil().min(size[k]));
-    if !(hi[0] > lo[0] && hi[1] > lo[1]) {
-        out.culled += 1;
-        return;
-    }
-    let mapper = ClipMapper::for_camera(camera);
-    let base = out.vertices.len() as u32;
-    for (x, y) in [
-        (lo[0], lo[1]),
-        (hi[0], lo[1]),
-        (hi[0], hi[1]),
-        (lo[0], hi[1]),
-    ] {
-        let Some((ndc, _)) = mapper.ndc(x, y) else {
-            out.vertices.truncate(base as usize);
-            out.culled += 1;
-            return;
-        };
-        out.vertices.push(
-            v.with_clip([ndc[0], ndc[1], 0.5, 1.0])
-                .with_piece(out.pieces),
-        );
-    }
-    out.pieces += 1;
-    out.whole += 1;
-    out.indices
-        .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
 }
 
 /// The largest rate on `part`'s scalar range.
@@ -634,6 +589,7 @@ fn push_out<V: GpuVertex>(
     stats.tie_pixels += out.tie_pixels;
     stats.steep_triangles += out.steep;
     stats.whole_pieces += out.whole;
+    stats.whole_hulls += out.hulls;
     stats.triangles += out.indices.len() / 3;
     sink.push(&out.vertices, &out.indices)?;
     if let Some(r) = record {
@@ -894,6 +850,7 @@ fn finish<V: GpuVertex>(
 }
 
 pub mod kept;
+mod whole;
 
 #[cfg(test)]
 pub(crate) mod tests;

@@ -1,5 +1,7 @@
 //! Exact-frag's whole-piece quads (`--piece-draw quads`): a convex piece is
-//! drawn as one screen quad over its pixel bounding box, every vertex
+//! drawn as one screen polygon over its outline (the driver's `whole`
+//! module: its projected points' convex hull widened a little, or the
+//! quad over its pixel bounding box), every vertex
 //! carrying the whole piece, and each fragment finds where its own ray
 //! enters and leaves the piece (view-independent cell projection, Weiler,
 //! Kraus, Merz and Ertl 2003). The CPU does no region subdivision: per
