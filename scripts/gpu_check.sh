@@ -25,10 +25,11 @@
 #    re-sorted and re-projected). Per mode and size: the median next frame's
 #    sort, draw (projection and GPU) and total seconds, and cells per second
 #    (cells / total). Grids above 1M cells run exact-frag and preint3d
-#    only, to fit a 10-minute run.
-# A mode written NAME:HOW is `--mode NAME --piece-draw HOW`: exact-frag runs
-# both ways, its pieces projected into regions and drawn whole as quads
-# (`--piece-draw auto` picks quads on a GPU; this checks that choice).
+#    (both ways) only, to fit a 10-minute run.
+# A mode written NAME:HOW is `--mode NAME --piece-draw HOW`: exact-frag and
+# preint3d run both ways, their pieces projected into regions and drawn
+# whole as quads (`--piece-draw auto` picks quads on a GPU; this checks that
+# choice).
 set -u
 Z=${1:?zoovr binary}
 G=${2:?gen_mesh binary}
@@ -63,7 +64,7 @@ mode_args() {
 }
 
 # 2. Correctness against the ray caster.
-MODES="exact exact-frag:regions exact-frag:quads preint3d preint2d preint2d-cyl"
+MODES="exact exact-frag:regions exact-frag:quads preint3d:regions preint3d:quads preint2d preint2d-cyl"
 say ""
 say "max error over every pixel, --split all against the ray caster on tets"
 say "(bounds, each mode's registry entry: exact and exact-frag 7.8e-3 (2/255),"
@@ -129,7 +130,7 @@ run_grid() {
 }
 for n in $GRIDS; do
     if [ "$n" -gt 1000000 ]; then
-        run_grid "$n" "exact-frag:regions exact-frag:quads preint3d"
+        run_grid "$n" "exact-frag:regions exact-frag:quads preint3d:regions preint3d:quads"
     else
         run_grid "$n" "$MODES"
     fi

@@ -156,7 +156,7 @@ fn usage_errors_say_what_is_wrong() {
         (vec!["--range", "1,1"], ["--range", "1,1"]),
         (
             vec!["--piece-draw", "quads"],
-            ["--piece-draw quads", "--mode exact-frag"],
+            ["--piece-draw quads", "exact-frag, preint3d"],
         ),
         (
             vec![
@@ -203,43 +203,47 @@ fn raycast_stats_and_other_mode_flags() {
     );
 }
 
-/// `--piece-draw quads`: exact-frag draws its pieces whole, reports how
-/// many in `--stats`, and gives the image of `--piece-draw regions`.
+/// `--piece-draw quads`: exact-frag and the table modes draw their pieces
+/// whole, report how many in `--stats`, and give the image of
+/// `--piece-draw regions`.
 #[test]
-fn exact_frag_draws_pieces_whole() {
+fn pieces_are_drawn_whole() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = mesh_file("zoo_3x3x3.vtu");
-    let mut images = Vec::new();
-    for draw in ["regions", "quads"] {
-        let png = dir.path().join(format!("{draw}.png"));
-        let o = render(
-            &mesh,
-            &png,
-            &[
-                "--size",
-                "48x40",
-                "--mode",
-                "exact-frag",
-                "--piece-draw",
-                draw,
-                "--stats",
-            ],
-        );
-        if no_adapter(&o) {
-            return;
+    for mode in ["exact-frag", "preint3d", "preint2d", "preint2d-cyl"] {
+        let mut images = Vec::new();
+        for draw in ["regions", "quads"] {
+            let png = dir.path().join(format!("{mode}_{draw}.png"));
+            let o = render(
+                &mesh,
+                &png,
+                &[
+                    "--size",
+                    "48x40",
+                    "--mode",
+                    mode,
+                    "--piece-draw",
+                    draw,
+                    "--stats",
+                ],
+            );
+            if no_adapter(&o) {
+                return;
+            }
+            assert!(o.status.success(), "{mode}: {}", stderr(&o));
+            assert_eq!(
+                stderr(&o).contains("pieces drawn whole"),
+                draw == "quads",
+                "{mode}: {}",
+                stderr(&o)
+            );
+            images.push(Image::read(&png).unwrap());
         }
-        assert!(o.status.success(), "{}", stderr(&o));
-        assert_eq!(
-            stderr(&o).contains("pieces drawn whole"),
-            draw == "quads",
-            "{}",
-            stderr(&o)
-        );
-        images.push(Image::read(&png).unwrap());
+        let (d, _) = zoovr::image::compare_float(&images[0], &images[1]).unwrap();
+        // Both within 2/255 of the reference (the table modes within their
+        // bounds of 4e-3), 8-bit PNGs.
+        assert!(d.max_abs <= 4.0 / 255.0, "{mode}: {}", d.max_abs);
     }
-    let (d, _) = zoovr::image::compare_float(&images[0], &images[1]).unwrap();
-    // Both within 2/255 of the reference, 8-bit PNGs.
-    assert!(d.max_abs <= 4.0 / 255.0, "{}", d.max_abs);
 }
 
 /// `--stats --json`: one JSON object on stdout with the mode, the times and

@@ -25,6 +25,10 @@ fn stages() -> Vec<&'static StageDesc> {
         // exact-frag's whole-piece quads.
         &zoovr::render::modes::piece_quad::PIECE_QUAD_STAGE,
         &zoovr::render::modes::piece_quad::PIECE_QUAD_THIN_STAGE,
+        // The table modes' whole-piece quads.
+        &zoovr::render::modes::preint_quads::PREINT3D_QUAD_STAGE,
+        &zoovr::render::modes::preint_quads::PREINT2D_QUAD_STAGE,
+        &zoovr::render::modes::preint_quads::PREINT2D_CYL_QUAD_STAGE,
     ]);
     v
 }

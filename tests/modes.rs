@@ -186,9 +186,13 @@ fn every_mode_matches_the_reference(name: &str) {
                 if gpu {
                     compositors.push(Compositor::Gpu);
                 }
-                // exact-frag draws its pieces as regions and whole, as
-                // quads, at the same bounds.
-                let draws: &[PieceDraw] = if mode == Mode::ExactFrag {
+                // exact-frag and the table modes draw their pieces as
+                // regions and whole, as quads, at the same bounds.
+                let quads = matches!(
+                    mode,
+                    Mode::ExactFrag | Mode::Preint3d | Mode::Preint2d | Mode::Preint2dCyl
+                );
+                let draws: &[PieceDraw] = if quads {
                     &[PieceDraw::Regions, PieceDraw::Quads]
                 } else {
                     &[PieceDraw::Regions]

@@ -138,14 +138,16 @@ pub struct ViewArgs {
     /// to the ray caster, higher draws fewer triangles.
     #[arg(long, value_name = "T", value_parser = parse_positive)]
     pub refine_tol: Option<f64>,
-    /// exact-frag: how pieces are drawn. `regions`: each piece projected
-    /// into regions on the CPU. `quads`: each piece drawn whole as one quad
-    /// over its pixel bounding box, every fragment intersecting its own ray
-    /// with the piece (view-independent cell projection): the CPU does no
-    /// subdivision, at the same accuracy (pieces that f32 cannot settle are
-    /// projected as regions). `auto`: quads on a hardware GPU, regions on a
-    /// software adapter (llvmpipe, lavapipe), where triangles cost more
-    /// than the quads' fragments.
+    /// exact-frag and the table modes (preint3d, preint2d, preint2d-cyl):
+    /// how pieces are drawn. `regions`: each piece projected into regions
+    /// on the CPU. `quads`: each piece drawn whole as one polygon over its
+    /// outline (its projected points' hull, or its pixel bounding box),
+    /// every fragment intersecting its own ray with the piece
+    /// (view-independent cell projection): the CPU does no subdivision, at
+    /// the same accuracy (pieces that f32 cannot settle are projected as
+    /// regions). `auto`: quads on a hardware GPU, regions on a software
+    /// adapter (llvmpipe, lavapipe), where triangles cost more than the
+    /// quads' fragments.
     #[arg(long, value_name = "HOW", default_value = "auto")]
     pub piece_draw: PieceDraw,
     /// Projected modes: draw the pieces hidden behind opaque ones too. By
@@ -258,11 +260,15 @@ impl ViewArgs {
         if self.mode == Mode::Iso && self.iso.is_none() {
             return Some("--mode iso draws isosurfaces only: give them with --iso V,V,...".into());
         }
-        if self.piece_draw == PieceDraw::Quads
-            && (self.mode != Mode::ExactFrag || self.iso.is_some())
-        {
+        let quads_mode = matches!(
+            self.mode,
+            Mode::ExactFrag | Mode::Preint3d | Mode::Preint2d | Mode::Preint2dCyl
+        );
+        if self.piece_draw == PieceDraw::Quads && (!quads_mode || self.iso.is_some()) {
             return Some(
-                "--piece-draw quads is exact-frag's (without --iso): give --mode exact-frag".into(),
+                "--piece-draw quads is for exact-frag, preint3d, preint2d and preint2d-cyl \
+                 (without --iso): give one of those with --mode"
+                    .into(),
             );
         }
         if self.traversal == Some(Traversal::Brute) && self.model == Some(FieldModel::Native) {

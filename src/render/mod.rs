@@ -226,8 +226,8 @@ impl Renderer {
         }
     }
 
-    /// How exact-frag draws its pieces for `opts`: `auto` is whole-piece
-    /// quads on a hardware GPU (the CPU then only sorts and packs pieces)
+    /// How exact-frag and the table modes draw their pieces for `opts`:
+    /// `auto` is whole-piece quads on a hardware GPU (the CPU then only sorts and packs pieces)
     /// and regions on a software adapter (its triangle setup dearer than
     /// the quads' fragments) and on the CPU twin.
     fn piece_draw(&mut self, opts: &RenderOptions) -> Result<PieceDraw, RenderError> {
@@ -352,10 +352,19 @@ impl Renderer {
             )?,
             Mode::Preint3d | Mode::Preint2d | Mode::Preint2dCyl => {
                 let mode = modes::preint::PreintMode::for_mode(opts.mode, opts)?;
-                let (img, mut detail, setup) =
-                    self.projected(&mode, &scene, opts, camera, progress)?;
+                let (img, mut detail, setup, table) = if self.piece_draw(opts)? == PieceDraw::Quads
+                {
+                    let mode = modes::preint_quads::PreintQuads(mode);
+                    let (img, detail, setup) =
+                        self.projected(&mode, &scene, opts, camera, progress)?;
+                    (img, detail, setup, mode.take_stats())
+                } else {
+                    let (img, detail, setup) =
+                        self.projected(&mode, &scene, opts, camera, progress)?;
+                    (img, detail, setup, mode.take_stats())
+                };
                 if let ModeStats::Projected(s) = &mut detail {
-                    s.table = mode.take_stats();
+                    s.table = table;
                 }
                 (img, detail, setup)
             }

@@ -145,16 +145,18 @@ pub struct ProjectedOptions {
     /// the table modes; [`super::driver::kept`] says when it applies). Off
     /// by default: a kept frame holds its vertices (tens of bytes each,
     /// at most [`super::driver::kept::KEEP_MAX_BYTES`]). For interactive
-    /// colour editing through the library. exact-frag's whole-piece quads
-    /// are not kept: which pieces go whole depends on the rates.
+    /// colour editing through the library. Whole-piece quads (exact-frag's
+    /// and the table modes') are not kept: which pieces go whole depends on
+    /// the rates.
     pub keep_projection: bool,
-    /// How exact-frag draws a piece (`--piece-draw`): projected into
-    /// regions on the CPU, or whole, as one quad whose fragments find
-    /// their own segment ([`super::modes::piece_quad`]).
+    /// How exact-frag and the table modes draw a piece (`--piece-draw`):
+    /// projected into regions on the CPU, or whole, as one polygon whose
+    /// fragments find their own segment ([`super::modes::piece_quad`],
+    /// [`super::modes::preint_quads`]).
     pub piece_draw: PieceDraw,
 }
 
-/// How exact-frag draws its pieces (`--piece-draw`).
+/// How exact-frag and the table modes draw their pieces (`--piece-draw`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum PieceDraw {
@@ -169,8 +171,8 @@ pub enum PieceDraw {
     Regions,
     /// Each piece drawn whole as one polygon over its outline (the convex
     /// hull of its projected points, widened a little, or, for small
-    /// pieces, the quad over its pixel bounding box); every fragment intersects its ray with the piece's boundary
-    /// triangles (view-independent cell projection). Pieces that `f32`
+    /// pieces, the quad over its pixel bounding box); every fragment
+    /// intersects its ray with the piece's boundary triangles (view-independent cell projection). Pieces that `f32`
     /// cannot settle (near plane, faces seen nearly edge-on, optically
     /// thick, more than 8 points) are projected as with `regions`.
     Quads,

@@ -81,11 +81,11 @@ pub trait ProjectedMode: Sync {
 
     /// The vertex that draws `part` whole, as one polygon over its outline
     /// (the driver's `whole` module) whose fragments find their own
-    /// segment through the part (exact-frag's `--piece-draw quads`,
-    /// [`super::modes::piece_quad`]), with the clip position left to the
-    /// driver; `None` (the default, and for a part the mode cannot draw
-    /// whole): the driver projects the part into regions. `rate` is the
-    /// part's largest rate ([`PieceSource::max_rate`] on its range).
+    /// segment through the part (`--piece-draw quads` of exact-frag and the
+    /// table modes, [`super::modes::piece_quad`]), with the clip position
+    /// left to the driver; `None` (the default, and for a part the mode
+    /// cannot draw whole): the driver projects the part into regions.
+    /// `rate` is the part's largest rate ([`PieceSource::max_rate`] on its range).
     fn whole_part(
         &self,
         _src: &PieceSource,

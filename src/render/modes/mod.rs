@@ -36,6 +36,7 @@ pub mod preint;
 pub mod preint2d;
 pub mod preint2d_cyl;
 pub mod preint3d;
+pub mod preint_quads;
 pub mod preint_tables;
 pub mod raycast;
 pub mod segment;
