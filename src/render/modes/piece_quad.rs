@@ -119,6 +119,19 @@ impl QuadVertex {
         }
     }
 
+    /// The vertex drawing `part` whole for a segment mode
+    /// ([`SegmentMode::whole_part`]): the frame's scalar map set in
+    /// `payload`, then [`QuadVertex::whole`].
+    pub fn for_part(
+        src: &PieceSource,
+        part: &Polyhedron,
+        payload: &mut SegmentPayload,
+        rate: &dyn Fn() -> f64,
+    ) -> Option<QuadVertex> {
+        payload.set(src);
+        QuadVertex::whole(part, &payload.map, src.camera, rate)
+    }
+
     /// The number of triangles (0 for a region vertex).
     pub fn triangles(&self) -> u32 {
         self.topo[0] >> 27
@@ -459,31 +472,59 @@ const fn quad_stage(name: &'static str, constants: &'static [(&'static str, f64)
     }
 }
 
-/// The quad stage's bindings on the CPU, for its twin [`fs_main`]: those
-/// of the exact-frag stage (view, transfer function, the closed form's
-/// constants).
-pub struct QuadTwin(ExactFragTwin);
+/// What a segment stage's CPU bindings give a quad stage's twin: the view
+/// the quad's search works in, and the colour and opacity of a segment
+/// (exact-frag's closed form, a table mode's lookup).
+pub trait SegmentTwin: Sync {
+    /// The stage's view and clip mapping.
+    fn view(&self) -> (SegmentView, ClipMapper);
+    /// The premultiplied colour and opacity of the segment `(l, s_f, s_b)`
+    /// (normalised scalars).
+    fn volume(&self, l: f32, sf: f32, sb: f32) -> [f32; 4];
+}
+
+impl SegmentTwin for ExactFragTwin {
+    fn view(&self) -> (SegmentView, ClipMapper) {
+        ExactFragTwin::view(self)
+    }
+    fn volume(&self, l: f32, sf: f32, sb: f32) -> [f32; 4] {
+        ExactFragTwin::volume(self, l, sf, sb)
+    }
+}
+
+/// A quad stage's bindings on the CPU, for its twin [`fs_main`]: those of
+/// the segment stage it draws with (exact-frag's by default: view, transfer
+/// function, the closed form's constants; a table mode's for
+/// [`super::preint_quads`]).
+pub struct QuadTwin<T = ExactFragTwin>(pub T);
 
 impl QuadTwin {
-    /// The twin for `tf` seen by `camera`.
+    /// The exact-frag twin for `tf` seen by `camera`.
     pub fn new(tf: &TransferFunction, camera: &Camera) -> QuadTwin {
         QuadTwin(ExactFragTwin::new(tf, camera))
     }
+}
 
+impl<T: SegmentTwin> QuadTwin<T> {
     fn segment(&self, tri: [&QuadVertex; 3], bary: [f64; 3]) -> Seg {
         let (view, mapper) = self.0.view();
         segment_at(&view, &mapper, tri, bary)
     }
 }
 
-/// The twin of exact-frag's `fs_main` in the quad stage: the fragment's
-/// segment ([`segment_at`]), integrated.
-pub fn fs_main(stage: &QuadTwin, tri: [&QuadVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
+/// The twin of the fragment entry `fs_main` in a quad stage: the
+/// fragment's segment ([`segment_at`]), integrated by the stage's own
+/// program.
+pub fn fs_main<T: SegmentTwin>(
+    stage: &QuadTwin<T>,
+    tri: [&QuadVertex; 3],
+    bary: [f64; 3],
+) -> Option<[f32; 4]> {
     let seg = stage.segment(tri, bary);
     seg.ok.then(|| stage.0.volume(seg.l, seg.s_f, seg.s_b))
 }
 
-impl CpuStage<QuadVertex> for QuadTwin {
+impl<T: SegmentTwin> CpuStage<QuadVertex> for QuadTwin<T> {
     fn shade(&self, tri: [&QuadVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
         fs_main(self, tri, bary)
     }
@@ -530,8 +571,7 @@ impl SegmentMode for ExactFragQuads {
         payload: &mut SegmentPayload,
         rate: &dyn Fn() -> f64,
     ) -> Option<QuadVertex> {
-        payload.set(src);
-        QuadVertex::whole(part, &payload.map, src.camera, rate)
+        QuadVertex::for_part(src, part, payload, rate)
     }
 
     fn keeps_projection(&self) -> bool {

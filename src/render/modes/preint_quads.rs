@@ -16,14 +16,14 @@
 //! regions into the same stage, with their exact tie decisions.
 
 use crate::gpu::cpu::CpuStage;
-use crate::gpu::{Binding, Context, GpuError, Stage, StageDesc};
+use crate::gpu::{Binding, ClipMapper, Context, GpuError, Stage, StageDesc};
 use crate::projection::Polyhedron;
 use crate::render::pieces::PieceSource;
 
-use super::piece_quad::{segment_at, QuadVertex};
+use super::piece_quad::{QuadTwin, QuadVertex, SegmentTwin};
 use super::preint::{PreintMode, PreintTwin};
 use super::preint_tables::{TableKind, TableStats};
-use super::segment::{SegmentMode, SegmentPayload};
+use super::segment::{SegmentMode, SegmentPayload, SegmentView};
 
 /// A table stage on the quad vertex: the quad vertex and its segment
 /// search, the segment view, the table modes' fragment program and the
@@ -109,9 +109,7 @@ impl SegmentMode for PreintQuads {
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<QuadVertex>> {
-        Box::new(PreintQuadTwin(
-            self.0.twin_for(src.whole, src.tf, src.camera),
-        ))
+        Box::new(QuadTwin(self.0.twin_for(src.whole, src.tf, src.camera)))
     }
 
     fn whole_part(
@@ -121,8 +119,7 @@ impl SegmentMode for PreintQuads {
         payload: &mut SegmentPayload,
         rate: &dyn Fn() -> f64,
     ) -> Option<QuadVertex> {
-        payload.set(src);
-        QuadVertex::whole(part, &payload.map, src.camera, rate)
+        QuadVertex::for_part(src, part, payload, rate)
     }
 
     /// Which pieces go whole depends on the extinction (as for
@@ -132,34 +129,11 @@ impl SegmentMode for PreintQuads {
     }
 }
 
-/// A quad table stage's bindings on the CPU: the table stage's twin, its
-/// segment found by the quad's search ([`segment_at`]).
-pub struct PreintQuadTwin(PreintTwin);
-
-impl PreintQuadTwin {
-    fn segment(&self, tri: [&QuadVertex; 3], bary: [f64; 3]) -> super::segment::Seg {
-        let (view, mapper) = self.0.view();
-        segment_at(&view, &mapper, tri, bary)
+impl SegmentTwin for PreintTwin {
+    fn view(&self) -> (SegmentView, ClipMapper) {
+        PreintTwin::view(self)
     }
-}
-
-impl CpuStage<QuadVertex> for PreintQuadTwin {
-    fn shade(&self, tri: [&QuadVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
-        let seg = self.segment(tri, bary);
-        seg.ok.then(|| self.0.volume(seg.l, seg.s_f, seg.s_b))
-    }
-
-    fn covers(&self, tri: [&QuadVertex; 3], bary: [f64; 3]) -> bool {
-        self.segment(tri, bary).ok
-    }
-
-    fn describe(&self, tri: [&QuadVertex; 3], bary: [f64; 3]) -> Vec<(&'static str, f32)> {
-        let seg = self.segment(tri, bary);
-        vec![
-            ("s_f", seg.s_f),
-            ("s_b", seg.s_b),
-            ("l", seg.l),
-            ("triangles", tri[0].triangles() as f32),
-        ]
+    fn volume(&self, l: f32, sf: f32, sb: f32) -> [f32; 4] {
+        PreintTwin::volume(self, l, sf, sb)
     }
 }
