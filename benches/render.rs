@@ -21,7 +21,11 @@
 //! / 2.20 s; bluntfin 512^2 0.34 / 0.30 s and 0.48 / 0.50 s (criterion);
 //! grid_1m 512^2 5.64 / 7.30 s and 5.40 / 4.88 s, 1024^2 13.0 / 11.0 s and
 //! 8.9 / 9.3 s. Errors: hex_shell RMS 1.55e-5 regions, 2.59e-6 quads (max
-//! 4.2e-4 both).
+//! 4.2e-4 both). Since large pieces are drawn as their outline's hull
+//! (`render::driver::whole`, later that day; paired whole-process runs,
+//! hull against box): hex_shell 0.97 / 0.89 of those quad frames at 512^2
+//! / 1024^2 on lavapipe (1.02 / 0.94 on GL), grid_1m 1.00 at 1024^2, the
+//! images identical.
 //!
 //! Measured 2026-12-02 (Mesa 22.3.6, 2 idle cores), frame after the first
 //! (Vulkan / GL): bluntfin 0.22 / 0.22 s at 512^2 (criterion), 0.39 / 0.39
