@@ -188,11 +188,7 @@ fn every_mode_matches_the_reference(name: &str) {
                 }
                 // exact-frag and the table modes draw their pieces as
                 // regions and whole, as quads, at the same bounds.
-                let quads = matches!(
-                    mode,
-                    Mode::ExactFrag | Mode::Preint3d | Mode::Preint2d | Mode::Preint2dCyl
-                );
-                let draws: &[PieceDraw] = if quads {
+                let draws: &[PieceDraw] = if mode.info().draws_pieces_whole {
                     &[PieceDraw::Regions, PieceDraw::Quads]
                 } else {
                     &[PieceDraw::Regions]

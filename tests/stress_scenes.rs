@@ -188,10 +188,12 @@ fn run(case: Case, gpu: bool) {
             }
         };
         // The table modes: finite everywhere (render() checks), whole
-        // cells and split.
+        // cells and split, their pieces projected and drawn whole.
         for mode in [Mode::Preint3d, Mode::Preint2d, Mode::Preint2dCyl] {
-            render(mode, FieldModel::Faces, false, PieceDraw::Regions);
-            render(mode, FieldModel::Faces, true, PieceDraw::Regions);
+            for draw in [PieceDraw::Regions, PieceDraw::Quads] {
+                render(mode, FieldModel::Faces, false, draw);
+                render(mode, FieldModel::Faces, true, draw);
+            }
         }
         let split = render(Mode::Exact, FieldModel::Faces, true, PieceDraw::Regions);
         let d = check_images_with(

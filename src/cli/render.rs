@@ -260,11 +260,9 @@ impl ViewArgs {
         if self.mode == Mode::Iso && self.iso.is_none() {
             return Some("--mode iso draws isosurfaces only: give them with --iso V,V,...".into());
         }
-        let quads_mode = matches!(
-            self.mode,
-            Mode::ExactFrag | Mode::Preint3d | Mode::Preint2d | Mode::Preint2dCyl
-        );
-        if self.piece_draw == PieceDraw::Quads && (!quads_mode || self.iso.is_some()) {
+        if self.piece_draw == PieceDraw::Quads
+            && (!self.mode.info().draws_pieces_whole || self.iso.is_some())
+        {
             return Some(
                 "--piece-draw quads is for exact-frag, preint3d, preint2d and preint2d-cyl \
                  (without --iso): give one of those with --mode"

@@ -226,10 +226,11 @@ impl Renderer {
         }
     }
 
-    /// How exact-frag and the table modes draw their pieces for `opts`:
-    /// `auto` is whole-piece quads on a hardware GPU (the CPU then only sorts and packs pieces)
-    /// and regions on a software adapter (its triangle setup dearer than
-    /// the quads' fragments) and on the CPU twin.
+    /// How the modes that can draw pieces whole
+    /// ([`modes::ModeInfo::draws_pieces_whole`]) draw them for `opts`:
+    /// `auto` is whole-piece quads on a hardware GPU (the CPU then only
+    /// sorts and packs pieces) and regions on a software adapter (its
+    /// triangle setup dearer than the quads' fragments) and on the CPU twin.
     fn piece_draw(&mut self, opts: &RenderOptions) -> Result<PieceDraw, RenderError> {
         Ok(match opts.projected.piece_draw {
             PieceDraw::Auto => {
@@ -352,19 +353,14 @@ impl Renderer {
             )?,
             Mode::Preint3d | Mode::Preint2d | Mode::Preint2dCyl => {
                 let mode = modes::preint::PreintMode::for_mode(opts.mode, opts)?;
-                let (img, mut detail, setup, table) = if self.piece_draw(opts)? == PieceDraw::Quads
-                {
-                    let mode = modes::preint_quads::PreintQuads(mode);
-                    let (img, detail, setup) =
-                        self.projected(&mode, &scene, opts, camera, progress)?;
-                    (img, detail, setup, mode.take_stats())
+                let (img, mut detail, setup) = if self.piece_draw(opts)? == PieceDraw::Quads {
+                    let quads = modes::preint_quads::PreintQuads(&mode);
+                    self.projected(&quads, &scene, opts, camera, progress)?
                 } else {
-                    let (img, detail, setup) =
-                        self.projected(&mode, &scene, opts, camera, progress)?;
-                    (img, detail, setup, mode.take_stats())
+                    self.projected(&mode, &scene, opts, camera, progress)?
                 };
                 if let ModeStats::Projected(s) = &mut detail {
-                    s.table = table;
+                    s.table = mode.take_stats();
                 }
                 (img, detail, setup)
             }

@@ -100,38 +100,38 @@ pub(super) fn draw_whole<V: GpuVertex>(
     } else {
         None
     };
-    let base = out.vertices.len() as u32;
-    match drawn {
-        Some((k, ndc)) => {
-            for c in &ndc[..k] {
-                out.vertices
-                    .push(v.with_clip([c[0], c[1], 0.5, 1.0]).with_piece(out.pieces));
-            }
-            for i in 1..k as u32 - 1 {
-                out.indices
-                    .extend_from_slice(&[base, base + i, base + i + 1]);
-            }
+    // The polygon's corners in NDC: the hull's, or the box's (on whole
+    // pixels), drawn as one fan either way.
+    let (k, ndc) = match drawn {
+        Some(hull) => {
             out.hulls += 1;
+            hull
         }
         None => {
             if !(hi.x > lo.x && hi.y > lo.y) {
                 out.culled += 1;
                 return;
             }
-            for (x, y) in [(lo.x, lo.y), (hi.x, lo.y), (hi.x, hi.y), (lo.x, hi.y)] {
-                let Some((ndc, _)) = mapper.ndc(x, y) else {
-                    out.vertices.truncate(base as usize);
+            let mut ndc = [[0.0f32; 2]; MAX_CORNERS];
+            let corners = [(lo.x, lo.y), (hi.x, lo.y), (hi.x, hi.y), (lo.x, hi.y)];
+            for ((x, y), c) in corners.into_iter().zip(ndc.iter_mut()) {
+                let Some((n, _)) = mapper.ndc(x, y) else {
                     out.culled += 1;
                     return;
                 };
-                out.vertices.push(
-                    v.with_clip([ndc[0], ndc[1], 0.5, 1.0])
-                        .with_piece(out.pieces),
-                );
+                *c = n;
             }
-            out.indices
-                .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+            (4, ndc)
         }
+    };
+    let base = out.vertices.len() as u32;
+    for c in &ndc[..k] {
+        out.vertices
+            .push(v.with_clip([c[0], c[1], 0.5, 1.0]).with_piece(out.pieces));
+    }
+    for i in 1..k as u32 - 1 {
+        out.indices
+            .extend_from_slice(&[base, base + i, base + i + 1]);
     }
     out.pieces += 1;
     out.whole += 1;

@@ -50,6 +50,7 @@ pub static INFO: ModeInfo = ModeInfo {
     gpu: true,
     emission: &[EmissionModel::Glow, EmissionModel::Independent],
     slices_at_breakpoints: false,
+    draws_pieces_whole: false,
     stage: Some(&ISO_STAGE),
     bounds: Some(Bounds {
         reference: FieldModel::Faces,

@@ -116,6 +116,9 @@ pub struct ModeInfo {
     pub emission: &'static [EmissionModel],
     /// Whether pieces are sliced at TF breakpoints.
     pub slices_at_breakpoints: bool,
+    /// Whether it can draw its pieces whole (`--piece-draw quads`,
+    /// [`piece_quad`], [`preint_quads`]).
+    pub draws_pieces_whole: bool,
     /// Its stage (shader), for a GPU mode.
     pub stage: Option<&'static StageDesc>,
     /// Its bounds against the reference (`None`: it is the reference).

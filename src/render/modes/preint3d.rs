@@ -34,6 +34,7 @@ pub static INFO: ModeInfo = ModeInfo {
     gpu: true,
     emission: &[EmissionModel::Glow, EmissionModel::Independent],
     slices_at_breakpoints: false,
+    draws_pieces_whole: true,
     stage: Some(&PREINT3D_STAGE),
     bounds: Some(Bounds {
         reference: FieldModel::Faces,

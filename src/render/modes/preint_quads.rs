@@ -22,7 +22,7 @@ use crate::render::pieces::PieceSource;
 
 use super::piece_quad::{QuadTwin, QuadVertex, SegmentTwin};
 use super::preint::{PreintMode, PreintTwin};
-use super::preint_tables::{TableKind, TableStats};
+use super::preint_tables::TableKind;
 use super::segment::{SegmentMode, SegmentPayload, SegmentView};
 
 /// A table stage on the quad vertex: the quad vertex and its segment
@@ -80,10 +80,11 @@ pub static PREINT2D_CYL_QUAD_STAGE: StageDesc = quad_table_stage(
     &[Binding::Uniform, Binding::Table2dArray, Binding::Uniform],
 );
 
-/// A table mode with its pieces drawn whole (module docs).
-pub struct PreintQuads(pub PreintMode);
+/// A table mode with its pieces drawn whole (module docs); the table
+/// mode keeps its build statistics ([`PreintMode::take_stats`]).
+pub struct PreintQuads<'a>(pub &'a PreintMode);
 
-impl PreintQuads {
+impl PreintQuads<'_> {
     /// The quad stage of the table kind `kind`.
     pub fn stage(kind: TableKind) -> &'static StageDesc {
         match kind {
@@ -92,14 +93,9 @@ impl PreintQuads {
             TableKind::Cylinder => &PREINT2D_CYL_QUAD_STAGE,
         }
     }
-
-    /// What the last frame's table build did.
-    pub fn take_stats(&self) -> Option<TableStats> {
-        self.0.take_stats()
-    }
 }
 
-impl SegmentMode for PreintQuads {
+impl SegmentMode for PreintQuads<'_> {
     type Vertex = QuadVertex;
 
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {

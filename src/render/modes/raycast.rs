@@ -27,6 +27,7 @@ pub static INFO: ModeInfo = ModeInfo {
     gpu: false,
     emission: &[EmissionModel::Glow, EmissionModel::Independent],
     slices_at_breakpoints: false,
+    draws_pieces_whole: false,
     stage: None,
     bounds: None,
 };

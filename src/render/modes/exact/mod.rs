@@ -55,6 +55,7 @@ pub static INFO: ModeInfo = ModeInfo {
     gpu: true,
     emission: &[EmissionModel::Glow],
     slices_at_breakpoints: true,
+    draws_pieces_whole: false,
     stage: Some(&EXACT_STAGE),
     bounds: Some(Bounds {
         reference: FieldModel::Faces,
