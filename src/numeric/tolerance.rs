@@ -520,3 +520,16 @@ pub const QUAD_MIN_COS: f64 = 1e-3;
 /// coordinates; a millionth of a pixel is far above it at any image
 /// size).
 pub const OCCLUSION_NODE_MARGIN_PX: f64 = 1e-6;
+
+/// How far from a part's outline (pixels) a centre whose side the tie
+/// decisions could change may lie, for their thin-outline test
+/// (`render::ties::thin_outline`): the band the decisions search
+/// ([`crate::render::ties::TIE_BAND_PX`]), plus the snap (the GPU's value
+/// at a centre its snapped triangle covers is the exact triangle's at a
+/// point up to [`crate::render::ties::SNAP_PX`] away), doubled for the
+/// exact thickness's departure from the interpolated one in perspective
+/// (the refinement bounds it to a small part of the change along an edge;
+/// the unit test checks the ray caster's thickness near the outline
+/// against the bound).
+pub const THIN_OUTLINE_PX: f64 =
+    2.0 * (crate::render::ties::TIE_BAND_PX + crate::render::ties::SNAP_PX);

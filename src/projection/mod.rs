@@ -443,6 +443,13 @@ pub struct Projected {
     /// regions): the piece's boundary triangles (indices into
     /// [`Polyhedron::triangles`]) where each vertex's ray enters and leaves.
     pub tie_faces: Vec<[u32; 2]>,
+    /// Whether every vertex on the outline of [`Projected::triangles`]
+    /// (the kept and the culled ones together) is a profile vertex, so
+    /// that the thickness is 0 all along the outline: the fast path's
+    /// regions (a piece in general position: no face edge-on), every
+    /// silhouette vertex a profile vertex, no fan triangle skipped and
+    /// nothing clipped to the image. False where it is not known.
+    pub outline_profile: bool,
     /// Scratch of [`Projected::cull_to_pixels`]: each vertex's
     /// [`coverage::Span`].
     spans: Vec<coverage::Span>,
@@ -462,6 +469,7 @@ impl Projected {
         self.seams.clear();
         self.seam_lines.clear();
         self.tie_faces.clear();
+        self.outline_profile = false;
         self.spans.clear();
         self.culled.clear();
     }
@@ -491,8 +499,9 @@ impl Projected {
 
     /// Fan-triangulates every region, skipping triangles whose exact
     /// orientation is not positive (zero area, or inverted by rounding of a
-    /// crossing point).
-    fn triangulate_regions(&mut self) {
+    /// crossing point); returns whether none was skipped.
+    fn triangulate_regions(&mut self) -> bool {
+        let mut complete = true;
         self.triangles.clear();
         self.triangle_region.clear();
         for (r, reg) in self.regions.iter().enumerate() {
@@ -506,9 +515,12 @@ impl Projected {
                 if orient2d(pa, pb, pc) == Side::Positive {
                     self.triangles.push([a, b, c]);
                     self.triangle_region.push(r as u32);
+                } else {
+                    complete = false;
                 }
             }
         }
+        complete
     }
 
     /// Sum of the areas of the regions (pixel units).

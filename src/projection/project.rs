@@ -165,6 +165,7 @@ impl Default for Projector {
             max_refine_depth: 6,
             clip_to_image: false,
             cull_to_pixels: false,
+
             fast_path: true,
             took_fast_path: false,
             vertex_faces_by_search: false,
@@ -316,7 +317,7 @@ impl Projector {
                 Regions::of_overlay(&self.overlay)
             };
             regions.search = self.vertex_faces_by_search;
-            emit(poly, &self.pix, regions, &mut self.emit, out);
+            emit(poly, &self.pix, regions, true, &mut self.emit, out);
         } else {
             self.general_regions(poly, out)?;
         }
@@ -453,7 +454,7 @@ impl Projector {
             kinds: &[],
             search: true,
         };
-        emit(poly, &self.pix, regions, &mut self.emit, out);
+        emit(poly, &self.pix, regions, false, &mut self.emit, out);
         Ok(())
     }
 
@@ -619,10 +620,13 @@ impl<'a> Regions<'a> {
 }
 
 /// Writes vertices, regions and fan triangles (step 6 of the module docs).
+/// `fast`: the regions are a fast path's (a piece in general position),
+/// whose outline is the silhouette ([`Projected::outline_profile`]).
 fn emit(
     poly: &Polyhedron,
     pix: &[DVec2],
     regions: Regions,
+    fast: bool,
     scratch: &mut EmitScratch,
     out: &mut Projected,
 ) {
@@ -664,6 +668,7 @@ fn emit(
         }
     }
     let view = out.view;
+    let mut profile_hull = true;
     for (f, &ft) in regions.faces.iter().enumerate() {
         for &v in verts(f) {
             let mut id = vmap[v as usize];
@@ -688,6 +693,7 @@ fn emit(
                         on_hull,
                     )
                 });
+                profile_hull &= !on_hull || out.vertices[id as usize].profile;
             }
             out.regions.push_vertex(id);
         }
@@ -695,7 +701,8 @@ fn emit(
     }
     // The triangles go out (the old ones are the next call's scratch).
     std::mem::swap(faces, &mut out.faces);
-    out.triangulate_regions();
+    let complete = out.triangulate_regions();
+    out.outline_profile = fast && profile_hull && complete;
 }
 
 /// The values of fast-path vertex `v` at `q`, first met in a region with

@@ -257,5 +257,7 @@ impl WindowScratch {
         std::mem::swap(&mut out.vertices, &mut self.verts);
         std::mem::swap(&mut out.regions, &mut self.regions);
         out.triangulate_regions();
+        // The outline now runs along the image's edges too.
+        out.outline_profile = false;
     }
 }

@@ -87,6 +87,10 @@ pub struct PieceSource<'a> {
     pub ties: TieRays,
     /// Whether the modes that decide ties do ([`super::ProjectedOptions::exact_ties`]).
     pub exact_ties: bool,
+    /// Whether the frame composites colour (not a counting draw), so the
+    /// tie decisions may leave an optically thin part's outline to the
+    /// rasteriser ([`super::ties::PartTriangles::weighed`]).
+    pub colour_draw: bool,
     /// The isosurfaces drawn ([`super::iso`]): a piece whose scalar range
     /// holds one is drawn even where the volume is dark; cycle groups
     /// composite them.

@@ -66,13 +66,15 @@ use std::sync::Mutex;
 
 use std::time::Instant;
 
+use glam::DVec2;
+
 use crate::camera::Camera;
 use crate::gpu::common::BLOCKER_Z;
 use crate::gpu::cpu::{CpuFrame, CpuStage};
 use crate::gpu::layer::{LayerTwin, LayerVertex, LAYER_STAGE};
 use crate::gpu::{
     ClipMapper, Context, DrawKind, Frame, FrameOptions, FrameStats, GpuError, GpuVertex,
-    PendingContext, Stage, MAX_PIECES,
+    PendingContext, Stage, MAX_PIECES, SUBPIXEL,
 };
 use crate::image::Image;
 use crate::projection::coverage::PixelGrid;
@@ -86,7 +88,8 @@ use super::pieces::{value_range, PartScratch, PieceError, PieceSource};
 use super::scene::{ScalarsRef, Scene};
 use super::stats::ProjectedStats;
 use super::ties::{
-    decide_ties, push_steep, scan_triangles, DrawnTriangle, PartTriangles, TieRays, TieScratch,
+    decide_ties, push_steep, scan_triangles, thin_outline, DrawnTriangle, PartTriangles, TieRays,
+    TieScratch, SNAP_PX,
 };
 use super::workers::run_ordered;
 use super::{Compositor, RenderError, RenderOptions};
@@ -175,6 +178,9 @@ struct Worker<P, V> {
     used: Vec<bool>,
     remap: Vec<u32>,
     grid: Vec<[i64; 2]>,
+    /// How far the snap moved each vertex of the projection (pixels; the
+    /// bound [`super::ties::SNAP_PX`] where it was not snapped).
+    snap: Vec<f64>,
     /// Triangles drawn, with their snapped corners, and the pixel
     /// triangles of the centres next to the outline ([`super::ties`]).
     drawn: Vec<DrawnTriangle>,
@@ -202,6 +208,7 @@ impl<P: Default, V> Worker<P, V> {
             used: Vec::new(),
             remap: Vec::new(),
             grid: Vec::new(),
+            snap: Vec::new(),
             drawn: Vec::new(),
             ties: TieScratch::default(),
             rate_bound: {
@@ -259,6 +266,8 @@ fn draw_part<M: ProjectedMode>(
     let first = out.vertices.len() as u32;
     w.grid.clear();
     w.remap.clear();
+    w.snap.clear();
+    w.snap.resize(proj.vertices.len(), SNAP_PX);
     for (i, v) in proj.vertices.iter().enumerate() {
         if !used[i] {
             w.remap.push(u32::MAX);
@@ -272,6 +281,8 @@ fn draw_part<M: ProjectedMode>(
         };
         w.remap.push(out.vertices.len() as u32);
         w.grid.push(g);
+        let moved = DVec2::new(g[0] as f64, g[1] as f64) / SUBPIXEL - v.pos();
+        w.snap[i] = moved.length();
         out.vertices
             .push(mode.vertex(&w.payload, proj, i, ndc).with_piece(piece));
     }
@@ -306,6 +317,8 @@ fn draw_part<M: ProjectedMode>(
         rate_bound: w.rate_bound,
         rate: &rate,
         l_range,
+        snap: &w.snap,
+        weighed: src.colour_draw && src.iso.is_none() && mode.fragment_isovalues().is_empty(),
         clipped: !std::ptr::eq(projected, part),
         isovalues: mode.fragment_isovalues(),
     };
@@ -313,9 +326,12 @@ fn draw_part<M: ProjectedMode>(
     // at their snapped corners; the others share the exact corners'. The
     // same pass finds the slivers the tie decisions look into.
     let ties = mode.decides_ties() && src.exact_ties;
-    scan_triangles(&part_tris, ties, &mut w.ties);
+    // An optically thin part's outline and slivers are left to the
+    // rasteriser (`thin_outline`).
+    let thin = ties && thin_outline(&part_tris);
+    scan_triangles(&part_tris, ties && !thin, &mut w.ties);
     if ties {
-        decide_ties(&part_tris, part, &src.ties, &mut w.ties);
+        decide_ties(&part_tris, !thin, part, &src.ties, &mut w.ties);
         out.tie_pixels += emit_tie_triangles(mode, src, part, piece, &mapper, w, out);
     }
     for d in w.drawn.iter() {
@@ -663,6 +679,7 @@ pub fn render_projected<M: ProjectedMode>(
         grid: PixelGrid::new(camera.width, camera.height),
         ties: TieRays::new(camera, whole.bounds()),
         exact_ties: opts.projected.exact_ties,
+        colour_draw: opts.projected.draw == DrawKind::Composite,
         iso: mode.isosurfaces(),
         volume: mode.draws_volume(),
         gradients: mode.point_gradients(),

@@ -32,6 +32,7 @@ pub(crate) fn test_ctx<'a>(
         grid: PixelGrid::new(camera.width, camera.height),
         ties: TieRays::new(camera, scene.mesh.bounds()),
         exact_ties: true,
+        colour_draw: true,
         iso: None,
         volume: true,
         gradients: None,

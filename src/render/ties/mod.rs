@@ -68,7 +68,23 @@
 //!   same shift of the entry or exit scalar can put a centre on the other
 //!   side of an isovalue than the piece beside it puts it: a sliver's
 //!   centres whose exact scalars come within that shift of an isovalue
-//!   are decided too ([`PartTriangles::isovalues`]).
+//!   are decided too ([`PartTriangles::isovalues`]). A sliver is weighed
+//!   by how far the snap actually moved its corners
+//!   ([`PartTriangles::snap`]), not by the most it can.
+//!
+//! **Optically thin parts** ([`thin_outline`]) need none of this. Where
+//! the thickness is 0 all along a part's outline (a piece in general
+//! position: [`Projected::outline_profile`]), a centre close enough to the
+//! outline for the decisions to change its side has a segment at most
+//! the thickness's largest gradient times that distance long, by the
+//! GPU's interpolation and by the ray caster alike; where that times the
+//! part's largest rate is at most [`SLIVER_DEPTH_TOL`], either side
+//! changes the pixel by at most that, and the same bound covers what the
+//! snap does to a sliver's values. Such a part's outline and slivers are
+//! left to the rasteriser (most parts of a fine mesh: it made the
+//! decisions about half as dear on the hex_shell scene). Counting draws
+//! (where every centre counts one), isosurfaces and seams are always
+//! decided.
 
 mod band;
 
@@ -79,8 +95,9 @@ use band::{centres_within, in_grown_triangle, inside_by_float, near_centres, nea
 use crate::camera::Camera;
 use crate::gpu::{GpuVertex, SUBPIXEL};
 use crate::numeric::tolerance::{
-    ISO_SLIVER_REL, PLUCKER_FILTER_K, RASTER_FILTER_MAX_COORD_PX, RASTER_FILTER_PX,
+    ISO_SLIVER_REL, PLUCKER_FILTER_K, RASTER_FILTER_MAX_COORD_PX, RASTER_FILTER_PX, THIN_OUTLINE_PX,
 };
+use crate::projection::coverage::PixelGrid;
 use crate::projection::{Polyhedron, Projected, RegionVertex};
 use crate::raycast::geometry::{bounding_sphere, Proj, RayFrame};
 
@@ -101,12 +118,82 @@ pub const TIE_BAND_PX: f64 = 1.0 / 256.0;
 pub const SLIVER_TIE_PX: f64 = 1.0 / 2.0;
 
 /// The largest move of a snapped corner, pixels (`sqrt(2)/512`).
-const SNAP_PX: f64 = std::f64::consts::SQRT_2 / 512.0;
+pub const SNAP_PX: f64 = std::f64::consts::SQRT_2 / 512.0;
 
 /// A sliver's centres are decided exactly where the snap could change the
 /// optical depth (or emitted colour) by more than this: a quarter of an
 /// 8-bit step.
 pub const SLIVER_DEPTH_TOL: f64 = 1e-3;
+
+/// Whether the part's outline can be left to the rasteriser: every
+/// centre there has a segment too thin to matter. Where the thickness is
+/// 0 all along the outline ([`Projected::outline_profile`]), a centre
+/// within [`THIN_OUTLINE_PX`] of it has, by the GPU's interpolation and
+/// by the ray caster alike, a thickness of at most the largest gradient
+/// of the thickness over the part's triangles times that distance (every
+/// triangle between the centre and the outline holds a point that close
+/// to a centre, so coverage culling kept it). Where that times the part's
+/// rate is at most [`SLIVER_DEPTH_TOL`], the pixel's optical depth and
+/// colour change by at most that whichever side the centre goes to
+/// ([`thickness_gradient`]; in perspective, refinement's triangles carry
+/// the exact values at their corners, within the doubled distance's
+/// slack). The same bound settles the part's slivers: the snap shifts
+/// the values at a centre by the gradient times at most [`SNAP_PX`], less
+/// than the distance above, so [`scan_triangles`] need not look for them.
+/// Not for counting draws,
+/// isosurfaces or seams (`part.weighed` false) or parts clipped at the
+/// near plane. Triangles collapsed by the snap are still decided
+/// ([`outline_centres`]).
+pub fn thin_outline(part: &PartTriangles) -> bool {
+    if !part.weighed
+        || part.clipped
+        || !part.proj.outline_profile
+        || !part.proj.seams.is_empty()
+        || !part.proj.seam_lines.is_empty()
+    {
+        return false;
+    }
+    let g = thickness_gradient(part);
+    let thin = |rate: f64| rate * g * THIN_OUTLINE_PX <= SLIVER_DEPTH_TOL;
+    // False for NaN too.
+    thin(part.rate_bound) || thin((part.rate)())
+}
+
+/// The largest gradient of the thickness `l` over the part's triangles
+/// that reach a pixel centre (world units per pixel; NaN where a value is
+/// not a number): the triangles coverage culling keeps, also where it did
+/// not run, so that culling changes no decision. (Culled triangles need
+/// not count: a triangle between a decided centre and the outline lies
+/// within the culling's margin of that centre.) The largest ratio is kept
+/// as a fraction, without a division per triangle (the hot loop of
+/// [`thin_outline`]).
+fn thickness_gradient(part: &PartTriangles) -> f64 {
+    let culled = part.proj.vertex_spans().is_some();
+    let grid = PixelGrid::new(part.width, part.height);
+    let (mut num, mut den) = (0.0f64, 1.0f64);
+    let mut finite = true;
+    for t in part.exact {
+        let v = t.map(|i| &part.proj.vertices[i as usize]);
+        let p = v.map(|v| v.pos());
+        if !culled && !grid.triangle_reaches(p[0], p[1], p[2]) {
+            continue;
+        }
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let area2 = e1.perp_dot(e2);
+        let g = e2 * (v[1].l - v[0].l) - e1 * (v[2].l - v[0].l);
+        let (n, d) = (g.length_squared(), area2 * area2);
+        // Positive areas (fan triangles), finite values: false for NaN.
+        finite &= n >= 0.0 && d > 0.0;
+        if n * den > num * d {
+            (num, den) = (n, d);
+        }
+    }
+    if finite {
+        (num / den).sqrt()
+    } else {
+        f64::NAN
+    }
+}
 
 /// Whether the snap of the corners of the drawn triangle at `p` (pixels),
 /// with thickness `l` at its corners, can shift the optical depth at a
@@ -421,6 +508,17 @@ pub struct PartTriangles<'a> {
     /// (its outline is then not the whole part's): every centre goes to
     /// the exact test.
     pub clipped: bool,
+    /// Whether a centre next to the outline may be left to the rasteriser
+    /// where its segment is optically thin ([`thin_outline`]): colour
+    /// draws without isosurfaces, where a centre's side changes the pixel
+    /// by the segment's colour only (a counting draw counts every centre).
+    pub weighed: bool,
+    /// How far the snap to the rasteriser's grid moved each vertex of
+    /// `proj` (pixels), where it is known: the sliver tests weigh a
+    /// triangle by the largest move of its corners rather than by the
+    /// largest move of any corner ([`SNAP_PX`], taken for vertices past
+    /// the slice's end, and for every vertex when it is empty).
+    pub snap: &'a [f64],
     /// The isovalues the mode finds per fragment (sorted; empty for the
     /// others): in a sliver, the snap of the corners shifts the
     /// interpolated entry and exit scalars by their change across it
@@ -428,6 +526,16 @@ pub struct PartTriangles<'a> {
     /// side of an isovalue than the piece beside it puts it; those centres
     /// are decided exactly too.
     pub isovalues: &'a [f64],
+}
+
+impl PartTriangles<'_> {
+    /// The largest move of the snapped corners of triangle `t`, pixels
+    /// (see [`PartTriangles::snap`]).
+    #[inline]
+    fn snap_of(&self, t: &[u32; 3]) -> f64 {
+        let at = |i: u32| self.snap.get(i as usize).copied().unwrap_or(SNAP_PX);
+        at(t[0]).max(at(t[1])).max(at(t[2]))
+    }
 }
 
 /// The distance from `s` to the nearest of the sorted `values`.
@@ -441,9 +549,11 @@ fn to_nearest(values: &[f64], s: f64) -> f64 {
 /// Decides the centres near the part's outline (see the module docs) into
 /// `scratch.decisions`: the pixels where a quad must be drawn first. The
 /// sliver centres are those [`scan_triangles`] (with `slivers`) left in
-/// `scratch`.
+/// `scratch`. Without `outline` (a [`thin_outline`]) only the sliver and
+/// seam centres, and those of triangles the snap collapsed.
 pub fn decide_ties(
     part: &PartTriangles,
+    outline: bool,
     poly: &Polyhedron,
     rays: &TieRays,
     scratch: &mut TieScratch,
@@ -452,7 +562,13 @@ pub fn decide_ties(
     let pos = |i: u32| part.proj.vertices[i as usize].pos();
     let centres = &mut scratch.centres;
     centres.clear();
-    outline_centres(part, centres, &mut scratch.bits, &mut scratch.edges);
+    outline_centres(
+        part,
+        outline,
+        centres,
+        &mut scratch.bits,
+        &mut scratch.edges,
+    );
     // Centres next to the mode's seams: decided exactly wherever the part
     // holds them, since the two sides carry different values.
     // With the sliver centres ([`scan_triangles`]): both take the exact
@@ -526,11 +642,12 @@ pub fn decide_ties(
 }
 
 /// Appends the centres within the band of the part's outline: edges of
-/// drawn triangles not shared by two of them, and every edge of an exact
-/// triangle that is not drawn. Each is tested for centres within the band
-/// as it is found.
+/// drawn triangles not shared by two of them (with `outline`), and every
+/// edge of an exact triangle that is not drawn. Each is tested for
+/// centres within the band as it is found.
 fn outline_centres(
     part: &PartTriangles,
+    outline: bool,
     centres: &mut Vec<(u32, u32)>,
     bits: &mut Vec<u64>,
     edges: &mut Vec<((u32, u32), bool)>,
@@ -546,7 +663,9 @@ fn outline_centres(
     // within the band (it would be within the culling's margin of that
     // triangle, which would then have been kept): not candidates.
     let culled = part.proj.culled_triangles().unwrap_or(&[]);
-    if part.proj.vertices.len() <= 64 {
+    if !outline {
+        // Only the triangles not drawn, below.
+    } else if part.proj.vertices.len() <= 64 {
         // Small parts (almost all): each directed edge in a bit matrix, no
         // sort. The triangles wind the same way (CCW in pixel
         // coordinates), so an edge shared by two of them appears once in
@@ -671,8 +790,11 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
         }
         let dl = l[0].max(l[1]).max(l[2]) - l[0].min(l[1]).min(l[2]);
         let w = area2 / long;
+        // How far the snap moved this triangle's corners (at most
+        // SNAP_PX): what shifts its interpolated values.
+        let snap = part.snap_of(t);
         // False for NaN too.
-        let matters = |r: f64| r * dl * SNAP_PX > SLIVER_DEPTH_TOL * w;
+        let matters = |r: f64| r * dl * snap > SLIVER_DEPTH_TOL * w;
         // With isovalues: the snap's shift of the entry and exit scalars
         // across this sliver, where its corners bracket one (with that
         // shift); NaN or 0 otherwise.
@@ -682,7 +804,7 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
             let v = t.map(|i| &part.proj.vertices[i as usize]);
             let spread = |s: [f64; 3]| {
                 let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
-                let shift = (hi - lo) * SNAP_PX / w;
+                let shift = (hi - lo) * snap / w;
                 let k = part.isovalues.partition_point(|&x| x < lo - shift);
                 let holds = part.isovalues.get(k).is_some_and(|&x| x <= hi + shift);
                 if holds {

@@ -330,6 +330,8 @@ fn one_pass_finds_the_steep_triangles_and_the_sliver_centres() {
             rate: &rate,
             rate_bound,
             l_range,
+            snap: &[],
+            weighed: false,
             clipped: false,
             isovalues: &[],
         };
@@ -424,6 +426,8 @@ fn a_sliver_holding_an_isovalue_has_its_centres_decided() {
             rate: &rate,
             rate_bound: 0.0,
             l_range: (1e-6, 1e-6),
+            snap: &[],
+            weighed: false,
             clipped: false,
             isovalues,
         };
@@ -434,4 +438,132 @@ fn a_sliver_holding_an_isovalue_has_its_centres_decided() {
     assert_eq!(scan(&[0.3]), vec![(1, 1), (2, 1), (3, 1)]);
     assert!(scan(&[]).is_empty());
     assert!(scan(&[0.9]).is_empty());
+}
+
+/// A tet in general position has its outline at zero thickness
+/// ([`Projected::outline_profile`]); the thickness at positions near the
+/// outline, by the exact test, is within the gradient bound
+/// [`thin_outline`] relies on; the test passes for a thin part and fails
+/// for a thick one, for counting draws and for parts clipped at the near
+/// plane.
+#[test]
+fn thin_outlines_are_left_to_the_rasteriser_only_where_the_bound_holds() {
+    for ortho in [true, false] {
+        let (rays, camera, at) = setup(ortho);
+        let z0 = 4.0;
+        let part = tet(
+            &camera,
+            [
+                at(2.3, 2.1, z0),
+                at(11.7, 3.2, z0 + 0.4),
+                at(3.1, 12.6, z0 + 0.2),
+                at(5.2, 5.9, z0 + 1.3),
+            ],
+        );
+        let mut proj = Projected::default();
+        crate::projection::project(&part, &camera, &mut proj).unwrap();
+        assert!(proj.outline_profile, "ortho {ortho}");
+        // The largest gradient of the thickness over the triangles.
+        let g = proj
+            .triangles
+            .iter()
+            .map(|t| {
+                let v = t.map(|i| proj.vertices[i as usize]);
+                let (e1, e2) = (v[1].pos() - v[0].pos(), v[2].pos() - v[0].pos());
+                let num = e2 * (v[1].l - v[0].l) - e1 * (v[2].l - v[0].l);
+                num.length() / e1.perp_dot(e2).abs()
+            })
+            .fold(0.0, f64::max);
+        assert!(g > 0.0 && g.is_finite());
+        // Positions just inside each outline edge (the silhouette: edges
+        // between profile vertices): thickness at most the gradient times
+        // the distance, within the perspective's slack.
+        let mut scratch = Vec::new();
+        let mut checked = 0;
+        for t in &proj.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let (va, vb) = (proj.vertices[a as usize], proj.vertices[b as usize]);
+                if !(va.profile && vb.profile) {
+                    continue;
+                }
+                let d = vb.pos() - va.pos();
+                let inward = DVec2::new(-d.y, d.x).normalize();
+                for s in [0.2, 0.5, 0.8] {
+                    for dist in [1e-3, THIN_OUTLINE_PX] {
+                        let c = va.pos() + d * s + inward * dist;
+                        let l = length(ray_through(&part, &rays, c, &mut scratch));
+                        assert!(
+                            l <= 2.0 * g * dist,
+                            "ortho {ortho}: l {l} at {dist} px, gradient {g}"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked >= 18, "{checked}");
+        let drawn: Vec<DrawnTriangle> = proj
+            .triangles
+            .iter()
+            .enumerate()
+            .map(|(k, t)| DrawnTriangle {
+                corners: *t,
+                grid: t.map(|i| {
+                    let p = proj.vertices[i as usize].pos() * SUBPIXEL;
+                    [p.x.round() as i64, p.y.round() as i64]
+                }),
+                exact: k as u32,
+            })
+            .collect();
+        let test = |rate: f64, weighed: bool, clipped: bool| {
+            let r = || rate;
+            thin_outline(&PartTriangles {
+                proj: &proj,
+                drawn: &drawn,
+                exact: &proj.triangles,
+                width: 16,
+                height: 16,
+                rate: &r,
+                rate_bound: rate,
+                l_range: (0.0, 1.0),
+                snap: &[],
+                weighed,
+                clipped,
+                isovalues: &[],
+            })
+        };
+        let thin = 0.9 * SLIVER_DEPTH_TOL / (g * THIN_OUTLINE_PX);
+        assert!(test(thin, true, false), "ortho {ortho}");
+        assert!(!test(1.2 * thin / 0.9, true, false), "ortho {ortho}");
+        assert!(!test(thin, false, false), "ortho {ortho}");
+        assert!(!test(thin, true, true), "ortho {ortho}");
+    }
+}
+
+/// A cube seen straight along an axis has faces edge-on: its outline's
+/// thickness is not 0, and the projection does not claim it is.
+#[test]
+fn an_edge_on_face_leaves_the_outline_unknown() {
+    let (_, camera, at) = setup(true);
+    let corners: Vec<DVec3> = (0..8)
+        .map(|k| {
+            let (x, y, z) = ((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2) as f64);
+            at(3.0 + 8.0 * x, 3.0 + 8.0 * y, 4.0 + z)
+        })
+        .collect();
+    // Six tets of the cube, each with faces in the cube's side planes.
+    for tet_corners in [
+        [0, 1, 3, 7],
+        [0, 1, 5, 7],
+        [0, 2, 3, 7],
+        [0, 2, 6, 7],
+        [0, 4, 5, 7],
+        [0, 4, 6, 7],
+    ] {
+        let p = tet(&camera, tet_corners.map(|i| corners[i]));
+        let mut proj = Projected::default();
+        crate::projection::project(&p, &camera, &mut proj).unwrap();
+        assert!(!proj.outline_profile, "{tet_corners:?}");
+    }
 }
