@@ -328,6 +328,9 @@ fn coverage_culling_changes_no_pixel() {
         mesh_file("zoo_3x3x3.vtu"),
     ];
     files.extend(shared_file("bluntfin/bluntfin_converted.vts"));
+    // Parts left thin at their outline ([`zoovr::render::ties`]), with
+    // culling: the images must not depend on culling there either.
+    let mut thin_seen = 0;
     for path in files {
         let mesh = io::read(&path, &ReadOptions::default()).unwrap();
         let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
@@ -338,6 +341,7 @@ fn coverage_culling_changes_no_pixel() {
             }
             for ortho in [false, true] {
                 let mut triangles = [0u64; 2];
+                let mut thin = [0usize; 2];
                 let mut images = Vec::new();
                 for (k, cull) in [false, true].into_iter().enumerate() {
                     let opts = RenderOptions {
@@ -359,6 +363,7 @@ fn coverage_culling_changes_no_pixel() {
                     };
                     let (img, stats) = renderer.render(&scene.shading(), &opts, |_, _| {}).unwrap();
                     triangles[k] = stats.projected().unwrap().gpu.triangles;
+                    thin[k] = stats.projected().unwrap().thin_outlines;
                     images.push(img);
                 }
                 let tag = format!("{} kinked={kinked} ortho={ortho}", path.display());
@@ -366,6 +371,7 @@ fn coverage_culling_changes_no_pixel() {
                     triangles[1] < triangles[0],
                     "{tag}: culling dropped nothing ({triangles:?})"
                 );
+                thin_seen += thin[1];
                 let (a, b) = (&images[0], &images[1]);
                 for j in 0..a.height {
                     for i in 0..a.width {
@@ -375,6 +381,7 @@ fn coverage_culling_changes_no_pixel() {
             }
         }
     }
+    assert!(thin_seen > 0, "no part was left thin at its outline");
 }
 
 /// The exact-frag mode on the same cases: no table, no colour

@@ -26,6 +26,9 @@ pub struct ProjectedStats {
     /// Pixel centres next to a part's outline that snapping would have put
     /// on the wrong side, decided by a pixel triangle ([`super::ties`]).
     pub tie_pixels: usize,
+    /// Parts whose outline and slivers were left to the rasteriser as
+    /// optically thin ([`super::ties::thin_outline`]).
+    pub thin_outlines: usize,
     /// Triangles steep enough that the snap of their corners would shift
     /// the optical depth, drawn with the exact triangle's values at the
     /// snapped corners ([`super::ties::snap_is_steep`]).
@@ -161,7 +164,7 @@ impl fmt::Display for ProjectedStats {
         )?;
         writeln!(
             f,
-            "project+draw {:.3} s{}  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles, {} tie pixels, {} steep triangles{})",
+            "project+draw {:.3} s{}  ({} triangles, {} culled pieces, {} slab pieces, {} refined triangles, {} tie pixels ({} parts thin at their outline), {} steep triangles{})",
             e.project_s,
             if e.projection_reused {
                 ", kept triangles drawn again"
@@ -173,6 +176,7 @@ impl fmt::Display for ProjectedStats {
             e.slabs,
             e.refined_triangles,
             e.tie_pixels,
+            e.thin_outlines,
             e.steep_triangles,
             if e.whole_pieces > 0 {
                 format!(

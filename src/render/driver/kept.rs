@@ -99,6 +99,7 @@ pub struct KeptCounts {
     pub slabs: usize,
     pub refined_triangles: usize,
     pub tie_pixels: usize,
+    pub thin_outlines: usize,
     pub steep_triangles: usize,
     pub triangles: usize,
     pub hidden_pieces: usize,
@@ -114,6 +115,7 @@ impl KeptCounts {
             slabs: s.slabs,
             refined_triangles: s.refined_triangles,
             tie_pixels: s.tie_pixels,
+            thin_outlines: s.thin_outlines,
             steep_triangles: s.steep_triangles,
             triangles: s.triangles,
             hidden_pieces: s.hidden_pieces,
@@ -129,6 +131,7 @@ impl KeptCounts {
         s.slabs = self.slabs;
         s.refined_triangles = self.refined_triangles;
         s.tie_pixels = self.tie_pixels;
+        s.thin_outlines = self.thin_outlines;
         s.steep_triangles = self.steep_triangles;
         s.triangles = self.triangles;
         s.hidden_pieces = self.hidden_pieces;

@@ -123,6 +123,8 @@ pub(super) struct ChunkOut<V> {
     /// Triangles whose snapped corners took the exact triangle's values
     /// ([`super::ties::snap_is_steep`]).
     steep: usize,
+    /// Parts whose outline was left to the rasteriser (`thin_outline`).
+    thin: usize,
     /// Parts drawn whole, as one quad ([`ProjectedMode::whole_part`]).
     whole: usize,
     /// Of those, the parts drawn as their outline's hull ([`whole`]).
@@ -142,6 +144,7 @@ impl<V> Default for ChunkOut<V> {
             degenerate: 0,
             tie_pixels: 0,
             steep: 0,
+            thin: 0,
             whole: 0,
             hulls: 0,
             error: None,
@@ -161,6 +164,7 @@ impl<V> ChunkOut<V> {
         self.degenerate = 0;
         self.tie_pixels = 0;
         self.steep = 0;
+        self.thin = 0;
         self.whole = 0;
         self.hulls = 0;
         self.error = None;
@@ -329,6 +333,7 @@ fn draw_part<M: ProjectedMode>(
     // An optically thin part's outline and slivers are left to the
     // rasteriser (`thin_outline`).
     let thin = ties && thin_outline(&part_tris);
+    out.thin += thin as usize;
     scan_triangles(&part_tris, ties && !thin, &mut w.ties);
     if ties {
         decide_ties(&part_tris, !thin, part, &src.ties, &mut w.ties);
@@ -604,6 +609,7 @@ fn push_out<V: GpuVertex>(
     stats.refined_triangles += out.refined;
     stats.tie_pixels += out.tie_pixels;
     stats.steep_triangles += out.steep;
+    stats.thin_outlines += out.thin;
     stats.whole_pieces += out.whole;
     stats.whole_hulls += out.hulls;
     stats.triangles += out.indices.len() / 3;
