@@ -165,7 +165,6 @@ impl Default for Projector {
             max_refine_depth: 6,
             clip_to_image: false,
             cull_to_pixels: false,
-
             fast_path: true,
             took_fast_path: false,
             vertex_faces_by_search: false,

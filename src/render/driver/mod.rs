@@ -270,8 +270,13 @@ fn draw_part<M: ProjectedMode>(
     let first = out.vertices.len() as u32;
     w.grid.clear();
     w.remap.clear();
+    // The snap's moves, for the sliver tests of the tie decisions only
+    // (without them a vertex counts as moved by the most, `SNAP_PX`).
+    let ties = mode.decides_ties() && src.exact_ties;
     w.snap.clear();
-    w.snap.resize(proj.vertices.len(), SNAP_PX);
+    if ties {
+        w.snap.resize(proj.vertices.len(), SNAP_PX);
+    }
     for (i, v) in proj.vertices.iter().enumerate() {
         if !used[i] {
             w.remap.push(u32::MAX);
@@ -285,8 +290,10 @@ fn draw_part<M: ProjectedMode>(
         };
         w.remap.push(out.vertices.len() as u32);
         w.grid.push(g);
-        let moved = DVec2::new(g[0] as f64, g[1] as f64) / SUBPIXEL - v.pos();
-        w.snap[i] = moved.length();
+        if ties {
+            let moved = DVec2::new(g[0] as f64, g[1] as f64) / SUBPIXEL - v.pos();
+            w.snap[i] = moved.length();
+        }
         out.vertices
             .push(mode.vertex(&w.payload, proj, i, ndc).with_piece(piece));
     }
@@ -329,7 +336,6 @@ fn draw_part<M: ProjectedMode>(
     // Steep triangles (`snap_is_steep`) take the exact triangle's values
     // at their snapped corners; the others share the exact corners'. The
     // same pass finds the slivers the tie decisions look into.
-    let ties = mode.decides_ties() && src.exact_ties;
     // An optically thin part's outline and slivers are left to the
     // rasteriser (`thin_outline`).
     let thin = ties && thin_outline(&part_tris);
