@@ -146,6 +146,53 @@ fn gpu_build_matches_its_twin_and_the_exact_table() {
     }
 }
 
+/// The GPU build's columns (the 3D table: recurrences over the lengths,
+/// spans cut into thin sub-spans, texel by texel where a column is too
+/// thick for the cut) against the exact table, on the GPU and as the CPU
+/// twin: from thin to extinction times length 8e6, lengths that are not a
+/// whole number of chunks, both emission models.
+#[test]
+fn gpu_columns_thin_to_thick() {
+    let ctx = gpu();
+    for model in [EmissionModel::Glow, EmissionModel::Independent] {
+        let tf = jump_tf(model);
+        // At 3.0 a column crossing the extinction-8 node is served by the
+        // recurrences up to about the 21st of 33 lengths, at 40 and 1e6 by
+        // none.
+        for (n, l_table) in [
+            (17, 0.05),
+            (21, 2.0),
+            (33, 3.0),
+            (21, 6.0),
+            (33, 40.0),
+            (9, 1e6),
+        ] {
+            let spec = TableSpec::new(TableKind::Cube, Some(n), l_table).unwrap();
+            let exact = build(&spec, &tf, TableBuild::Exact);
+            let twin = build(&spec, &tf, TableBuild::Gpu);
+            let (e_twin, at) = max_diff(&twin, &exact);
+            assert!(twin.iter().all(|v| v.is_finite()));
+            let mut line = format!(
+                "{model:?} n {n} l {l_table}: twin {e_twin:.2e} (texel {})",
+                at / 4
+            );
+            assert!(e_twin < 4e-6, "{line}");
+            if let Some(ctx) = &ctx {
+                let g = GpuBuilt::new(ctx, &spec).unwrap();
+                let table = Table::empty_rgba(ctx, "t", spec.kind.dim(), spec.size).unwrap();
+                g.build(ctx, &spec, &tf, (f64::NEG_INFINITY, f64::INFINITY), &table)
+                    .unwrap();
+                let got = g.read(ctx, &spec).unwrap();
+                let (e_gpu, _) = max_diff(&got, &exact);
+                let (e_gt, _) = max_diff(&got, &twin);
+                line += &format!(", GPU {e_gpu:.2e}, GPU vs twin {e_gt:.2e}");
+                assert!(e_gpu < 2e-6 && e_gt < 2e-6, "{line}");
+            }
+            eprintln!("{line}");
+        }
+    }
+}
+
 /// An edit of the transfer function confined to one interval: the change
 /// found is that interval, and the local update (CPU and GPU) equals the
 /// full rebuild while touching only part of the table.

@@ -26,7 +26,7 @@ use crate::tf::{EmissionModel, TransferFunction};
 use super::segment::ScalarMap;
 
 const SF_CENTRES: usize = 129;
-const GL6_BASE: usize = 129;
+pub(crate) const GL6_BASE: usize = 129;
 /// Up to this optical thickness (both ends) the basis integrals are the
 /// 6-node Gauss-Legendre rule; above it the closed form (`GAUSS_MAX`).
 pub const GAUSS_MAX: f32 = 2.0;
@@ -48,7 +48,7 @@ const TAYLOR_TERMS: u32 = 9;
 /// Terms of the asymptotic series (argument `t <= 1/128`): below 1e-10.
 const ASYM_TERMS: u32 = 9;
 const ASYM_X: f32 = 8.0;
-const MAX_THICKNESS: f32 = 1e30;
+pub(crate) const MAX_THICKNESS: f32 = 1e30;
 const MAX_SCALAR: f32 = 1e30;
 
 /// The constants buffer of the closed form: `P, Q, B, G` at the 129 centres
@@ -124,7 +124,7 @@ impl TfBuffer {
         b
     }
 
-    fn count(&self) -> u32 {
+    pub(crate) fn count(&self) -> u32 {
         (self.nodes.len() / 2) as u32
     }
 

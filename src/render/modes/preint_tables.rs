@@ -18,10 +18,12 @@
 //! **Builds** ([`TableBuild`]): `Exact` evaluates [`crate::integrate::segment`]
 //! in `f64` on all cores; `Fast` uses the integral functions of
 //! [`crate::integrate::fast`] (EKE 3.5: exact opacity, mean-glow colour);
-//! `Gpu` runs `shaders/table_build.wgsl`, one invocation per texel calling
-//! `integrate_segment` (shaders/integral.wgsl) through the generic compute
-//! facility ([`crate::gpu::compute`], [`super::table_build`]); its CPU
-//! twin is [`super::table_build::build_main`].
+//! `Gpu` runs `shaders/table_build.wgsl` through the generic compute
+//! facility ([`crate::gpu::compute`], [`super::table_build`]): one
+//! invocation per column of the 3D table's lengths, one per texel of the
+//! others (`integrate_segment`, shaders/integral.wgsl); its CPU twins are
+//! [`super::table_build::build_column`] and
+//! [`super::table_build::build_main`].
 //!
 //! **Edits.** A segment's integral depends only on the transfer function
 //! between its two scalars, so after an edit confined to the scalar
@@ -54,7 +56,7 @@ use crate::tf::TransferFunction;
 
 use super::integral::{closed_form_constants, TfBuffer};
 use super::segment::ScalarMap;
-use super::table_build::build_main;
+use super::table_build::{build_column, build_main, BuildParams};
 pub use super::table_build::{row_texels, GpuBuilt, TABLE_BUILD};
 
 /// Largest number of texels a table may have (256 Mi: 4 GiB of RGBA f32).
@@ -329,6 +331,31 @@ pub fn fill_cpu(
                 }
                 v
             })
+        }
+        TableBuild::Gpu if spec.kind == TableKind::Cube => {
+            // The twin of the kernel's columns: one per (i, j), every length.
+            let buf = TfBuffer::new(tf, &map);
+            let consts = closed_form_constants();
+            let params = BuildParams::new(spec, range, spec.size[0]);
+            let nz = spec.size[2] as usize;
+            let columns: Vec<Option<Vec<[f32; 4]>>> = (0..ns * ns)
+                .into_par_iter()
+                .map(|c| {
+                    let mut out = vec![[0.0; 4]; nz];
+                    let (ix, iy) = ((c % ns) as u32, (c / ns) as u32);
+                    build_column(&buf, &consts, &params, ix, iy, &mut out).then_some(out)
+                })
+                .collect();
+            let mut n = 0;
+            for (c, col) in columns.iter().enumerate() {
+                let Some(col) = col else { continue };
+                for (k, v) in col.iter().enumerate() {
+                    let at = 4 * (k * ns * ns + c);
+                    data[at..at + 4].copy_from_slice(v);
+                }
+                n += nz;
+            }
+            n
         }
         TableBuild::Gpu => {
             let buf = TfBuffer::new(tf, &map);

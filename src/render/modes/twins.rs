@@ -100,7 +100,11 @@ pub fn stage_twins() -> Vec<StageTwins> {
         twins!("piece_quad.wgsl": piece_quad::segment_at, piece_quad::corners, piece_quad::edge,
             piece_quad::point, piece_quad::depth, piece_quad::shear, piece_quad::find),
         twins!("table_build.wgsl":
-            cylinder::cyl_to_table, table_build::optical_depth, table_build::build_main),
+            cylinder::cyl_to_table, table_build::optical_depth, table_build::subspans,
+            table_build::span_end, table_build::column_step, table_build::exp_small,
+            table_build::next_powers,
+            table_build::column_subspan, table_build::store_texel, table_build::build_column,
+            table_build::build_main),
     ]
 }
 
