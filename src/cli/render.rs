@@ -91,7 +91,7 @@ pub struct ViewArgs {
     #[arg(long, value_name = "N")]
     pub table: Option<u32>,
     /// How the pre-integrated tables are built: auto (the GPU compute pass
-    /// on a hardware GPU, else exact), exact (exact integrals on the CPU), fast
+    /// when drawing on a GPU, else exact), exact (exact integrals on the CPU), fast
     /// (integral functions on the CPU: exact opacity, approximate colour)
     /// or gpu (exact integrals in a wgpu compute pass).
     #[arg(long, value_enum, default_value_t = TableBuild::Auto)]

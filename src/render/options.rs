@@ -36,9 +36,10 @@ pub struct RenderOptions {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum TableBuild {
-    /// The GPU compute build when drawing on a hardware GPU, else the
-    /// exact CPU build (in `f64`; on the software adapters it is about as
-    /// fast as their compute pass; both are exact).
+    /// The GPU compute build when drawing on a GPU (hardware or software:
+    /// on lavapipe it builds the 128^3 3D table in about 40 ms against
+    /// 0.3-0.37 s for the exact `f64` CPU build, and the other tables 1.3-1.6
+    /// times as fast), the exact CPU build when drawing on the CPU.
     #[default]
     Auto,
     /// The exact integrals in `f64` on the CPU (all cores).

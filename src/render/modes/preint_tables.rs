@@ -56,8 +56,8 @@ use crate::tf::TransferFunction;
 
 use super::integral::{closed_form_constants, TfBuffer};
 use super::segment::ScalarMap;
-use super::table_build::{build_column, build_main, BuildParams};
-pub use super::table_build::{row_texels, GpuBuilt, TABLE_BUILD};
+use super::table_build::{build_main, column_main, BuildParams};
+pub use super::table_build::{row_texels, GpuBuilt, TABLE_BUILD, TABLE_COLUMNS};
 
 /// Largest number of texels a table may have (256 Mi: 4 GiB of RGBA f32).
 pub const MAX_TEXELS: u64 = 1 << 28;
@@ -343,7 +343,7 @@ pub fn fill_cpu(
                 .map(|c| {
                     let mut out = vec![[0.0; 4]; nz];
                     let (ix, iy) = ((c % ns) as u32, (c / ns) as u32);
-                    build_column(&buf, &consts, &params, ix, iy, &mut out).then_some(out)
+                    column_main(&buf, &consts, &params, ix, iy, &mut out).then_some(out)
                 })
                 .collect();
             let mut n = 0;

@@ -81,20 +81,33 @@ pub const MAX_SUBSPANS: u32 = 8;
 /// Fewest lengths the recurrences serve in a column (`MIN_RECURRENCE`).
 pub const MIN_RECURRENCE: u32 = 16;
 
-/// The GPU build kernel.
+const BUILD_BINDINGS: &[ComputeBinding] = &[
+    ComputeBinding::Uniform,
+    ComputeBinding::Storage,
+    ComputeBinding::Storage,
+    ComputeBinding::StorageRw,
+];
+
+const BUILD_WGSL: &str = concat!(
+    include_str!("../../../shaders/integral.wgsl"),
+    include_str!("../../../shaders/table_build.wgsl"),
+);
+
+/// The GPU build kernel, one invocation per texel (the 2D table and the
+/// cylindrical planes).
 pub static TABLE_BUILD: ComputeDesc = ComputeDesc {
     name: "table_build.wgsl",
-    wgsl: concat!(
-        include_str!("../../../shaders/integral.wgsl"),
-        include_str!("../../../shaders/table_build.wgsl"),
-    ),
+    wgsl: BUILD_WGSL,
     entry: "build_main",
-    bindings: &[
-        ComputeBinding::Uniform,
-        ComputeBinding::Storage,
-        ComputeBinding::Storage,
-        ComputeBinding::StorageRw,
-    ],
+    bindings: BUILD_BINDINGS,
+};
+
+/// The GPU build kernel, one invocation per column of the 3D table.
+pub static TABLE_COLUMNS: ComputeDesc = ComputeDesc {
+    name: "table_build.wgsl columns",
+    wgsl: BUILD_WGSL,
+    entry: "column_main",
+    bindings: BUILD_BINDINGS,
 };
 
 /// Texels per padded row of a GPU-built table of `ns` texels per row.
@@ -133,8 +146,13 @@ impl GpuBuilt {
         let params = BuildParams::new(spec, range, self.row_texels);
         let buf = TfBuffer::new(tf, &ScalarMap::of(tf));
         let consts = closed_form_constants();
+        let kernel = if spec.kind == TableKind::Cube {
+            &TABLE_COLUMNS
+        } else {
+            &TABLE_BUILD
+        };
         ctx.dispatch(
-            &TABLE_BUILD,
+            kernel,
             &[
                 ComputeResource::Uniform(bytemuck::bytes_of(&params)),
                 ComputeResource::Storage(&buf.bytes()),
@@ -364,6 +382,19 @@ pub fn store_texel(k: u32, kmax: u32, depth: f32, v: [f32; 4], out: &mut [[f32; 
     } else {
         [0.0; 4]
     };
+}
+
+/// Twin of `column_main` for column `(ix, iy)`: [`build_column`] where
+/// the column lies in the table.
+pub fn column_main(
+    tf: &TfBuffer,
+    consts: &[[f32; 4]],
+    p: &BuildParams,
+    ix: u32,
+    iy: u32,
+    out: &mut [[f32; 4]],
+) -> bool {
+    ix < p.ns && iy < p.ns && build_column(tf, consts, p, ix, iy, out)
 }
 
 /// Twin of `build_column`: writes column `(ix, iy)` of the 3D table

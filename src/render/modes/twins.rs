@@ -104,6 +104,7 @@ pub fn stage_twins() -> Vec<StageTwins> {
             table_build::span_end, table_build::column_step, table_build::exp_small,
             table_build::next_powers,
             table_build::column_subspan, table_build::store_texel, table_build::build_column,
+            table_build::column_main,
             table_build::build_main),
     ]
 }
