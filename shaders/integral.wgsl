@@ -274,6 +274,59 @@ fn add_piece(acc: ptr<function, Composite>, l: f32, m0: Material, m1: Material) 
     (*acc).pieces += 1u;
 }
 
+// The spans of the segment from s_f to s_b through the transfer function:
+// piece i0 holds the lower end, the nodes i0 .. i1 - 1 lie strictly between
+// the ends (a short scan: segments cross few nodes), `count` of them; the
+// spans run front to back, ascending where the scalar grows (`up`),
+// descending where it falls; `inv` is 1 / (s_b - s_f) where a node lies
+// between, the materials at the two ends are `m_first` and `m_last`.
+struct Spans {
+    i0: u32,
+    i1: u32,
+    count: u32,
+    up: bool,
+    inv: f32,
+    m_first: Material,
+    m_last: Material,
+}
+
+fn segment_spans(s_f: f32, s_b: f32) -> Spans {
+    let lo = min(s_f, s_b);
+    let hi = max(s_f, s_b);
+    let i0 = piece_index(lo);
+    var i1 = i0;
+    while i1 < tf.count && node_s(i1) < hi {
+        i1++;
+    }
+    let up = s_b > s_f;
+    let count = i1 - i0;
+    var inv = 0.0;
+    if count > 0u {
+        inv = 1.0 / (s_b - s_f);
+    }
+    let m_first = eval_piece(select(i1, i0, up), s_f);
+    let m_last = eval_piece(select(i0, i1, up), s_b);
+    return Spans(i0, i1, count, up, inv, m_first, m_last);
+}
+
+// The back end of span n (0 ..= count) of a segment starting at s_f: the
+// material there and its fraction of the segment. At each crossed node k
+// the span in front ends and the next begins with node k's own material,
+// so a jump (two nodes at one scalar) is an empty span between its two
+// materials.
+struct SpanEnd {
+    m: Material,
+    x: f32,
+}
+
+fn span_end(sp: Spans, n: u32, s_f: f32) -> SpanEnd {
+    if n < sp.count {
+        let k = select(sp.i1 - 1u - n, sp.i0 + n, sp.up);
+        return SpanEnd(node(k), (node_s(k) - s_f) * sp.inv);
+    }
+    return SpanEnd(sp.m_last, 1.0);
+}
+
 // Premultiplied colour and opacity of a segment of length `l` over which the
 // scalar goes linearly from `s_f` (front) to `s_b` (back), sliced at every
 // node strictly between them (twin: integral::integrate_segment; the f64
@@ -286,46 +339,19 @@ fn integrate_segment(l_in: f32, sf_in: f32, sb_in: f32) -> vec4<f32> {
     let s_f = clamp(sf_in, -MAX_SCALAR, MAX_SCALAR);
     let s_b = clamp(sb_in, -MAX_SCALAR, MAX_SCALAR);
     var acc = Composite(vec3<f32>(0.0), 0.0, 0.0, 0u);
-    let lo = min(s_f, s_b);
-    let hi = max(s_f, s_b);
-    // The piece holding lo, and the nodes strictly between lo and hi:
-    // i0 .. i1 (a short scan: segments cross few nodes).
-    let i0 = piece_index(lo);
-    var i1 = i0;
-    while i1 < tf.count && node_s(i1) < hi {
-        i1++;
-    }
-    // Front to back, count + 1 spans: piece i0 from lo to node i0, the
-    // whole pieces between the crossed nodes, piece i1 from node i1 - 1 to
-    // hi (one span, piece i0 == i1, when no node lies between); in
-    // ascending order where the scalar grows, descending where it falls. At
-    // each crossed node k the span in front ends and the next begins with
-    // node k's own material, so a jump (two nodes at one scalar) is an empty
-    // span between its two materials. One loop with one call of add_piece
-    // keeps the shader small (every lane of a SIMD group runs the loop as
-    // often as its longest segment).
-    let up = s_b > s_f;
-    let count = i1 - i0;
-    var inv = 0.0;
-    if count > 0u {
-        inv = 1.0 / (s_b - s_f);
-    }
-    var m_prev = eval_piece(select(i1, i0, up), s_f);
-    let m_last = eval_piece(select(i0, i1, up), s_b);
+    // Front to back, count + 1 spans (`segment_spans`, `span_end`). One
+    // loop with one call of add_piece keeps the shader small (every lane of
+    // a SIMD group runs the loop as often as its longest segment).
+    let sp = segment_spans(s_f, s_b);
+    var m_prev = sp.m_first;
     var x_prev = 0.0;
-    for (var n = 0u; n <= count; n++) {
-        var m = m_last;
-        var x = 1.0;
-        if n < count {
-            let k = select(i1 - 1u - n, i0 + n, up);
-            m = node(k);
-            x = (node_s(k) - s_f) * inv;
+    for (var n = 0u; n <= sp.count; n++) {
+        let e = span_end(sp, n, s_f);
+        if e.x > x_prev {
+            add_piece(&acc, l * (e.x - x_prev), m_prev, e.m);
         }
-        if x > x_prev {
-            add_piece(&acc, l * (x - x_prev), m_prev, m);
-        }
-        m_prev = m;
-        x_prev = x;
+        m_prev = e.m;
+        x_prev = e.x;
     }
     var alpha = acc.alpha;
     if acc.pieces != 1u {

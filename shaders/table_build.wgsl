@@ -40,7 +40,7 @@
 //
 // Twin: render::modes::table_build (`build_main`, `column_main`, `build_column`,
 // `store_texel`, `column_subspan`, `column_step`, `next_powers`,
-// `exp_small`, `subspans`, `span_end`, `optical_depth`; `cyl_to_table` is
+// `exp_small`, `subspans`, `optical_depth`; `cyl_to_table` is
 // integrate::cylinder::cyl_to_table).
 
 // Keep in sync with `BuildParams` in src/render/modes/table_build.rs.
@@ -174,21 +174,6 @@ fn subspans(t0: f32, t1: f32, len: f32) -> u32 {
     return u32(clamp(ceil(d / GAUSS_MAX), 1.0, f32(MAX_SUBSPANS)));
 }
 
-// One end of span n of a column's segment, as integrate_segment walks them:
-// the material there and its fraction of the segment.
-struct SpanEnd {
-    m: Material,
-    x: f32,
-}
-
-fn span_end(n: u32, count: u32, i0: u32, i1: u32, up: bool, inv: f32, sf: f32, m_last: Material) -> SpanEnd {
-    if n < count {
-        let k = select(i1 - 1u - n, i0 + n, up);
-        return SpanEnd(node(k), (node_s(k) - sf) * inv);
-    }
-    return SpanEnd(m_last, 1.0);
-}
-
 // Adds the linear piece from m0 to m1 of length k ls behind the chunk's
 // composites (k = k0 + t, t < CHUNK): the 6-node rule of `gauss` with each
 // node's exponential a power.
@@ -284,29 +269,15 @@ fn build_column(ix: u32, iy: u32) {
     if build.nz > 1u {
         dl = build.l_table / f32(build.nz - 1u);
     }
-    // The spans, as integrate_segment finds them.
-    let lo = min(sf, sb);
-    let hi = max(sf, sb);
-    let i0 = piece_index(lo);
-    var i1 = i0;
-    while i1 < tf.count && node_s(i1) < hi {
-        i1++;
-    }
-    let up = sb > sf;
-    let count = i1 - i0;
-    var inv = 0.0;
-    if count > 0u {
-        inv = 1.0 / (sb - sf);
-    }
-    let m_first = eval_piece(select(i1, i0, up), sf);
-    let m_last = eval_piece(select(i0, i1, up), sb);
+    // The spans, as integrate_segment walks them.
+    let sp = segment_spans(sf, sb);
     // The thickest sub-span and the whole segment's optical depth at k = 1.
     var dmax = 0.0;
     var depth = 0.0;
-    var m_prev = m_first;
+    var m_prev = sp.m_first;
     var x_prev = 0.0;
-    for (var n = 0u; n <= count; n++) {
-        let e = span_end(n, count, i0, i1, up, inv, sf, m_last);
+    for (var n = 0u; n <= sp.count; n++) {
+        let e = span_end(sp, n, sf);
         if e.x > x_prev {
             let f = e.x - x_prev;
             let q = f32(subspans(m_prev.tau, e.m.tau, build.l_table * f));
@@ -329,10 +300,10 @@ fn build_column(ix: u32, iy: u32) {
     for (var k0 = 0u; k0 <= kmax; k0 += CHUNK) {
         let e = vec4<f32>(0.0, 0.0, 0.0, 1.0);
         var acc = Chunk(e, e, e, e, e, e, e, e, e, e, e, e, e, e, e, e);
-        m_prev = m_first;
+        m_prev = sp.m_first;
         x_prev = 0.0;
-        for (var n = 0u; n <= count; n++) {
-            let e = span_end(n, count, i0, i1, up, inv, sf, m_last);
+        for (var n = 0u; n <= sp.count; n++) {
+            let e = span_end(sp, n, sf);
             if e.x > x_prev {
                 let f = e.x - x_prev;
                 let q = subspans(m_prev.tau, e.m.tau, build.l_table * f);

@@ -219,6 +219,37 @@ impl TfBuffer {
         acc.pieces += 1;
     }
 
+    /// The spans of the segment from `s_f` to `s_b` (`segment_spans`).
+    pub fn segment_spans(&self, s_f: f32, s_b: f32) -> Spans {
+        let (lo, hi) = (s_f.min(s_b), s_f.max(s_b));
+        let i0 = self.piece_index(lo);
+        let mut i1 = i0;
+        while i1 < self.count() && self.node_s(i1) < hi {
+            i1 += 1;
+        }
+        let up = s_b > s_f;
+        let count = i1 - i0;
+        Spans {
+            i0,
+            i1,
+            count,
+            up,
+            inv: if count > 0 { 1.0 / (s_b - s_f) } else { 0.0 },
+            m_first: self.eval_piece(if up { i0 } else { i1 }, s_f),
+            m_last: self.eval_piece(if up { i1 } else { i0 }, s_b),
+        }
+    }
+
+    /// The material at the back end of span `n` (`0..=count`) of a segment
+    /// starting at `s_f`, and its fraction of the segment (`span_end`).
+    pub fn span_end(&self, sp: &Spans, n: u32, s_f: f32) -> (Material, f32) {
+        if n < sp.count {
+            let k = if sp.up { sp.i0 + n } else { sp.i1 - 1 - n };
+            return (self.node(k), (self.node_s(k) - s_f) * sp.inv);
+        }
+        (sp.m_last, 1.0)
+    }
+
     /// Premultiplied colour and opacity of a segment of length `l` over
     /// which the (normalised) scalar goes linearly from `s_f` to `s_b`
     /// (`integrate_segment`).
@@ -237,32 +268,14 @@ impl TfBuffer {
         let s_f = sf_in.clamp(-MAX_SCALAR, MAX_SCALAR);
         let s_b = sb_in.clamp(-MAX_SCALAR, MAX_SCALAR);
         let mut acc = Composite::default();
-        let (lo, hi) = (s_f.min(s_b), s_f.max(s_b));
-        let i0 = self.piece_index(lo);
-        let mut i1 = i0;
-        while i1 < self.count() && self.node_s(i1) < hi {
-            i1 += 1;
-        }
-        // Front to back, `count + 1` spans from node to node (see the
-        // shader's comment); an empty span (a jump) adds nothing.
-        let up = s_b > s_f;
-        let count = i1 - i0;
-        let inv = if count > 0 { 1.0 / (s_b - s_f) } else { 0.0 };
-        let mut m_prev = self.eval_piece(if up { i0 } else { i1 }, s_f);
-        let m_last = self.eval_piece(if up { i1 } else { i0 }, s_b);
-        let mut x_prev = 0.0f32;
-        for n in 0..=count {
-            let (m, x) = if n < count {
-                let k = if up { i0 + n } else { i1 - 1 - n };
-                (self.node(k), (self.node_s(k) - s_f) * inv)
-            } else {
-                (m_last, 1.0)
-            };
+        let sp = self.segment_spans(s_f, s_b);
+        let (mut m_prev, mut x_prev) = (sp.m_first, 0.0f32);
+        for n in 0..=sp.count {
+            let (m, x) = self.span_end(&sp, n, s_f);
             if x > x_prev {
                 self.add_piece(consts, &mut acc, l * (x - x_prev), m_prev, m);
             }
-            m_prev = m;
-            x_prev = x;
+            (m_prev, x_prev) = (m, x);
         }
         let alpha = if acc.pieces != 1 {
             neg_expm1(acc.depth)
@@ -272,6 +285,21 @@ impl TfBuffer {
         let c = acc.color.map(|v| v.min(MAX_THICKNESS));
         [c[0], c[1], c[2], alpha]
     }
+}
+
+/// The spans of a segment through the transfer function (`Spans`): nodes
+/// `i0..i1` lie strictly between its ends, `count` of them, walked
+/// ascending where the scalar grows (`up`); `inv` is `1 / (s_b - s_f)`
+/// where a node lies between; the materials at its two ends.
+#[derive(Clone, Copy, Debug)]
+pub struct Spans {
+    pub i0: u32,
+    pub i1: u32,
+    pub count: u32,
+    pub up: bool,
+    pub inv: f32,
+    pub m_first: Material,
+    pub m_last: Material,
 }
 
 /// The running composite of one segment's pieces (`Composite`).

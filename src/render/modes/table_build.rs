@@ -226,27 +226,6 @@ pub fn subspans(t0: f32, t1: f32, len: f32) -> u32 {
     (d / GAUSS_MAX).ceil().clamp(1.0, MAX_SUBSPANS as f32) as u32
 }
 
-/// Twin of `span_end`: the material at the end of span `n` of a column's
-/// segment and its fraction of the segment.
-#[allow(clippy::too_many_arguments)]
-pub fn span_end(
-    tf: &TfBuffer,
-    n: u32,
-    count: u32,
-    i0: u32,
-    i1: u32,
-    up: bool,
-    inv: f32,
-    sf: f32,
-    m_last: Material,
-) -> (Material, f32) {
-    if n < count {
-        let k = if up { i0 + n } else { i1 - 1 - n };
-        return (tf.node(k), (tf.node_s(k) - sf) * inv);
-    }
-    (m_last, 1.0)
-}
-
 fn mix(a: f32, b: f32, u: f32) -> f32 {
     a * (1.0 - u) + b * u
 }
@@ -418,21 +397,11 @@ pub fn build_column(
     } else {
         0.0
     };
-    let (lo, hi) = (sf.min(sb), sf.max(sb));
-    let i0 = tf.piece_index(lo);
-    let mut i1 = i0;
-    while i1 < tf.count() && tf.node_s(i1) < hi {
-        i1 += 1;
-    }
-    let up = sb > sf;
-    let count = i1 - i0;
-    let inv = if count > 0 { 1.0 / (sb - sf) } else { 0.0 };
-    let m_first = tf.eval_piece(if up { i0 } else { i1 }, sf);
-    let m_last = tf.eval_piece(if up { i1 } else { i0 }, sb);
-    let end = |n: u32| span_end(tf, n, count, i0, i1, up, inv, sf, m_last);
+    let sp = tf.segment_spans(sf, sb);
+    let end = |n: u32| tf.span_end(&sp, n, sf);
     let (mut dmax, mut depth) = (0.0f32, 0.0f32);
-    let (mut m_prev, mut x_prev) = (m_first, 0.0f32);
-    for n in 0..=count {
+    let (mut m_prev, mut x_prev) = (sp.m_first, 0.0f32);
+    for n in 0..=sp.count {
         let (m, x) = end(n);
         if x > x_prev {
             let f = x - x_prev;
@@ -452,8 +421,8 @@ pub fn build_column(
     let mut k0 = 0;
     while k0 <= kmax {
         let mut acc = [[0.0, 0.0, 0.0, 1.0f32]; CHUNK];
-        (m_prev, x_prev) = (m_first, 0.0);
-        for n in 0..=count {
+        (m_prev, x_prev) = (sp.m_first, 0.0);
+        for n in 0..=sp.count {
             let (m, x) = end(n);
             if x > x_prev {
                 let f = x - x_prev;

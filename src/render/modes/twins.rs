@@ -78,6 +78,7 @@ pub fn stage_twins() -> Vec<StageTwins> {
         twins!("exact_frag.wgsl": exact_frag::fs_main),
         twins!("integral.wgsl":
             TfBuffer::node_s, TfBuffer::node, TfBuffer::piece_index, TfBuffer::eval_piece,
+            TfBuffer::segment_spans, TfBuffer::span_end,
             integral::neg_expm1, integral::taylor_sf, integral::asym,
             integral::ends_sf,
             integral::sanitize_thickness, integral::gauss, integral::weights,
@@ -101,7 +102,7 @@ pub fn stage_twins() -> Vec<StageTwins> {
             piece_quad::point, piece_quad::depth, piece_quad::shear, piece_quad::find),
         twins!("table_build.wgsl":
             cylinder::cyl_to_table, table_build::optical_depth, table_build::subspans,
-            table_build::span_end, table_build::column_step, table_build::exp_small,
+            table_build::column_step, table_build::exp_small,
             table_build::next_powers,
             table_build::column_subspan, table_build::store_texel, table_build::build_column,
             table_build::column_main,
