@@ -23,7 +23,7 @@ use zoovr::gpu::{Context, GpuOptions, Table};
 use zoovr::integrate::table2d::{Table2d, Table2dKind};
 use zoovr::integrate::{self};
 use zoovr::render::modes::preint::{preint_segment, CpuTable, LookupFn, PreintParams};
-use zoovr::render::modes::preint_tables::{fill_cpu, GpuBuilt, TableKind, TableSpec};
+use zoovr::render::modes::preint_tables::{fill_cpu, gpu_build, TableKind, TableSpec};
 use zoovr::render::modes::{preint2d, preint2d_cyl, preint3d};
 use zoovr::render::TableBuild;
 use zoovr::tf::TransferFunction;
@@ -135,16 +135,15 @@ fn builds(c: &mut Criterion) {
                 });
             }
             if let Some(ctx) = &gpu {
-                let built = GpuBuilt::new(ctx, &spec).unwrap();
                 let table = Table::empty_rgba(ctx, "bench", kind.dim(), spec.size).unwrap();
                 // Compile the kernel once before timing.
-                built.build(ctx, &spec, &tf, all, &table).unwrap();
+                gpu_build(ctx, &spec, &tf, all, &table).unwrap();
                 ctx.finish().unwrap();
                 g.bench_with_input(BenchmarkId::new("gpu", &label), &spec, |b, spec| {
                     b.iter_custom(|iters| {
                         let t0 = Instant::now();
                         for _ in 0..iters {
-                            built.build(ctx, spec, &tf, all, &table).unwrap();
+                            gpu_build(ctx, spec, &tf, all, &table).unwrap();
                             ctx.finish().unwrap();
                         }
                         t0.elapsed()

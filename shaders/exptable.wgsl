@@ -21,7 +21,12 @@ struct Params {
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var table: texture_2d<f32>;
+@group(0) @binding(1) var<storage, read> table: array<f32>;
+
+// Texel (i, j), x (the length) fastest (src/gpu/table.rs).
+fn texel(i: u32, j: u32) -> f32 {
+    return table[j * params.n + i];
+}
 
 // ln(1 + z) keeping relative accuracy for tiny z (twin: exact::exptable::log1p_).
 fn log1p_(z: f32) -> f32 {
@@ -47,10 +52,10 @@ fn alpha_of(l: f32, tau: f32) -> f32 {
     let j0 = min(u32(v), params.n - 2u);
     let fu = u - f32(i0);
     let fv = v - f32(j0);
-    let t00 = textureLoad(table, vec2<u32>(i0, j0), 0).r;
-    let t10 = textureLoad(table, vec2<u32>(i0 + 1u, j0), 0).r;
-    let t01 = textureLoad(table, vec2<u32>(i0, j0 + 1u), 0).r;
-    let t11 = textureLoad(table, vec2<u32>(i0 + 1u, j0 + 1u), 0).r;
+    let t00 = texel(i0, j0);
+    let t10 = texel(i0 + 1u, j0);
+    let t01 = texel(i0, j0 + 1u);
+    let t11 = texel(i0 + 1u, j0 + 1u);
     let r0 = t00 * (1.0 - fu) + t10 * fu;
     let r1 = t01 * (1.0 - fu) + t11 * fu;
     return r0 * (1.0 - fv) + r1 * fv;

@@ -1,6 +1,7 @@
 // The preint2d stage's lookup: the 2D table at the mean cell thickness
 // l_table (Roettger, Kraus, Ertl 2000, section 4), texels (C, depth) at
-// l_table, filtered bilinearly in f32 (textureLoad). The optical depth is
+// l_table, filtered bilinearly in f32 (a storage buffer,
+// src/gpu/table.rs, x = s_f fastest). The optical depth is
 // exactly linear in l (depth = l * mean extinction over [s_f, s_b]), so the
 // opacity is exact up to interpolation; the colour is C scaled by
 // alpha(l) / alpha(l_table), which is RKE's l / l_table for thin segments
@@ -8,7 +9,12 @@
 //
 // Twin: render::modes::preint2d::table_rgba.
 
-@group(0) @binding(1) var table2d: texture_2d<f32>;
+@group(0) @binding(1) var<storage, read> table2d: array<vec4<f32>>;
+
+// Texel (i, j), x fastest.
+fn texel2d(i: i32, j: i32) -> vec4<f32> {
+    return table2d[j * i32(pre.ns) + i];
+}
 
 fn table_rgba(sf: f32, sb: f32, l: f32) -> vec4<f32> {
     let a = axis(sf, pre.ns);
@@ -16,13 +22,13 @@ fn table_rgba(sf: f32, sb: f32, l: f32) -> vec4<f32> {
     let i = i32(a.x);
     let j = i32(b.x);
     let r0 = lerp4(
-        textureLoad(table2d, vec2<i32>(i, j), 0),
-        textureLoad(table2d, vec2<i32>(i + 1, j), 0),
+        texel2d(i, j),
+        texel2d(i + 1, j),
         a.y,
     );
     let r1 = lerp4(
-        textureLoad(table2d, vec2<i32>(i, j + 1), 0),
-        textureLoad(table2d, vec2<i32>(i + 1, j + 1), 0),
+        texel2d(i, j + 1),
+        texel2d(i + 1, j + 1),
         a.y,
     );
     let t = lerp4(r0, r1, b.y);

@@ -48,8 +48,7 @@ struct BuildParams {
     kind: u32,
     ns: u32,
     nz: u32,
-    // Texels per output row (the row padded for the texture copy).
-    row_texels: u32,
+    _pad0: u32,
     l_table: f32,
     lo: f32,
     hi: f32,
@@ -295,8 +294,8 @@ fn build_column(ix: u32, iy: u32) {
             kmax = 0u;
         }
     }
-    let row = build.ns * build.row_texels;
-    let at = iy * build.row_texels + ix;
+    let row = build.ns * build.ns;
+    let at = iy * build.ns + ix;
     for (var k0 = 0u; k0 <= kmax; k0 += CHUNK) {
         let e = vec4<f32>(0.0, 0.0, 0.0, 1.0);
         var acc = Chunk(e, e, e, e, e, e, e, e, e, e, e, e, e, e, e, e);
@@ -379,5 +378,5 @@ fn build_main(@builtin(global_invocation_id) id: vec3<u32>) {
     if build.kind == 1u {
         v.w = optical_depth(l, c.x, c.y);
     }
-    texels[(id.z * build.ns + id.y) * build.row_texels + id.x] = v;
+    texels[(id.z * build.ns + id.y) * build.ns + id.x] = v;
 }

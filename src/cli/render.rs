@@ -86,8 +86,9 @@ pub struct ViewArgs {
     /// Pre-integrated table modes (preint3d, preint2d, preint2d-cyl):
     /// samples per table axis (default 128 for preint3d and preint2d-cyl,
     /// whose tables are N x N x N and N x N x 2N planes, 512 for preint2d).
-    /// At least 2; at most the adapter's texture limit (3D: 2048 on GL
-    /// llvmpipe, 4096 on lavapipe) and 2^28 texels.
+    /// At least 2; at most what one storage buffer of the adapter holds
+    /// (128 MiB on lavapipe and GL llvmpipe: N = 203 for preint3d, 161 for
+    /// preint2d-cyl, 2896 for preint2d) and 2^28 texels.
     #[arg(long, value_name = "N")]
     pub table: Option<u32>,
     /// How the pre-integrated tables are built: auto (the GPU compute pass

@@ -13,14 +13,13 @@
 //!    one compute pass. It does not wait: later work on the queue (a copy,
 //!    a draw) sees its results in submission order.
 //! 2. A [`GpuBuffer`] outlives dispatches (a table build rewrites only the
-//!    texels that changed), can be copied into a [`Table`]
-//!    ([`GpuBuffer::copy_to_table`]: rows padded to 256 bytes as wgpu
-//!    requires) and read back ([`GpuBuffer::read`], tests and twins).
+//!    texels that changed), is a [`super::Table`]'s storage, which stages
+//!    then read, and can be read back ([`GpuBuffer::read`], tests and
+//!    twins).
 
 use std::sync::{Arc, Mutex};
 
 use super::device::Context;
-use super::table::Table;
 use super::GpuError;
 
 /// What one binding of a kernel's group 0 is.
@@ -68,9 +67,6 @@ struct Kernel {
     pipeline: wgpu::ComputePipeline,
 }
 
-/// Rows copied into a texture are padded to this many bytes.
-pub const ROW_ALIGN: u32 = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-
 impl GpuBuffer {
     /// A zeroed buffer of `len` bytes (a multiple of 4, at least 16).
     pub fn new(ctx: &Context, label: &str, len: u64) -> Result<GpuBuffer, GpuError> {
@@ -93,6 +89,17 @@ impl GpuBuffer {
         Ok(GpuBuffer { buffer, len })
     }
 
+    /// Writes `bytes` at the start of the buffer (through the queue: later
+    /// work sees them in submission order).
+    pub fn write(&self, ctx: &Context, bytes: &[u8]) {
+        ctx.queue.write_buffer(&self.buffer, 0, bytes);
+    }
+
+    /// The wgpu buffer (to bind it read-only in a stage).
+    pub(crate) fn raw(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+
     /// Its size in bytes.
     pub fn len(&self) -> u64 {
         self.len
@@ -101,35 +108,6 @@ impl GpuBuffer {
     /// Whether it holds no bytes (never: buffers have at least 16).
     pub fn is_empty(&self) -> bool {
         self.len == 0
-    }
-
-    /// Copies the buffer into all of `table`: texel rows of
-    /// `row_bytes` (a multiple of [`ROW_ALIGN`], at least the table's row)
-    /// one after another, rows of a layer then layers.
-    pub fn copy_to_table(&self, ctx: &Context, table: &Table, row_bytes: u32) {
-        let mut encoder = ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("copy to table"),
-            });
-        encoder.copy_buffer_to_texture(
-            wgpu::TexelCopyBufferInfo {
-                buffer: &self.buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row_bytes),
-                    rows_per_image: Some(table.size()[1]),
-                },
-            },
-            wgpu::TexelCopyTextureInfo {
-                texture: table.texture(),
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            table.extent(),
-        );
-        ctx.queue.submit([encoder.finish()]);
     }
 
     /// Reads the whole buffer back (waits for the queue).

@@ -184,15 +184,21 @@ pub enum GpuError {
     },
     #[error("image size {width}x{height} is not supported (each side 1..={max})")]
     BadSize { width: u32, height: u32, max: u32 },
-    #[error(
-        "table {what} {value} is not supported by this adapter's {dim} (1..={max}); choose a \
-         smaller --table"
-    )]
+    #[error("table {what} {value} is not supported by a {dim}: each side needs a texel")]
     TableSize {
         dim: &'static str,
         what: &'static str,
         value: u32,
-        max: u32,
+    },
+    #[error(
+        "a {dim} of {size:?} texels needs {mib:.1} MiB, more than one storage buffer of this \
+         adapter holds ({max_mib:.1} MiB); choose a smaller --table"
+    )]
+    TableBytes {
+        dim: &'static str,
+        size: [u32; 3],
+        mib: f64,
+        max_mib: f64,
     },
     #[error("{0}")]
     TableTooLarge(String),

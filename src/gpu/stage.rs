@@ -27,7 +27,7 @@ use wgpu::util::DeviceExt;
 
 use super::device::Context;
 use super::frame::DrawKind;
-use super::table::{Table, TableDim};
+use super::table::Table;
 use super::{AccumFormat, GpuError};
 
 /// WGSL functions shared by every stage (`shaders/common.wgsl`).
@@ -46,12 +46,9 @@ pub(crate) const PIECE_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::
 pub enum Binding {
     /// A uniform buffer (vertex and fragment stages).
     Uniform,
-    /// A 2D `texture_2d<f32>` read with `textureLoad` ([`Table`]).
-    Table2d,
-    /// A 3D `texture_3d<f32>` read with `textureLoad` ([`Table`]).
-    Table3d,
-    /// A `texture_2d_array<f32>` read with `textureLoad` ([`Table`]).
-    Table2dArray,
+    /// A lookup table ([`Table`]): a read-only storage buffer of `f32` or
+    /// `vec4<f32>` texels (fragment stage).
+    Table,
     /// A read-only storage buffer (fragment stage).
     Storage,
 }
@@ -85,7 +82,7 @@ pub struct StageDesc {
 pub enum Resource<'a> {
     /// Bytes of a uniform struct (`#[repr(C)]`, WGSL layout).
     Uniform(&'a [u8]),
-    /// A table texture of the binding's dimension.
+    /// A lookup table.
     Table(&'a Table),
     /// Bytes of a read-only storage buffer.
     Storage(&'a [u8]),
@@ -153,11 +150,7 @@ impl Context {
             let usage = match (b, r) {
                 (Binding::Uniform, Resource::Uniform(_)) => wgpu::BufferUsages::UNIFORM,
                 (Binding::Storage, Resource::Storage(_)) => wgpu::BufferUsages::STORAGE,
-                (Binding::Table2d, Resource::Table(t)) if t.dim() == TableDim::D2 => continue,
-                (Binding::Table3d, Resource::Table(t)) if t.dim() == TableDim::D3 => continue,
-                (Binding::Table2dArray, Resource::Table(t)) if t.dim() == TableDim::D2Array => {
-                    continue
-                }
+                (Binding::Table, Resource::Table(_)) => continue,
                 _ => {
                     return Err(GpuError::BadOption(
                         "a stage's resource does not match its binding",
@@ -176,7 +169,7 @@ impl Context {
             .map(|(k, r)| wgpu::BindGroupEntry {
                 binding: k as u32,
                 resource: match r {
-                    Resource::Table(t) => wgpu::BindingResource::TextureView(t.view()),
+                    Resource::Table(t) => t.buffer().raw().as_entire_binding(),
                     _ => buffers
                         .iter()
                         .find(|(i, _)| *i == k)
@@ -224,22 +217,11 @@ impl Context {
                         has_dynamic_offset: false,
                         min_binding_size: None,
                     },
-                    Binding::Storage => wgpu::BindingType::Buffer {
+                    Binding::Storage | Binding::Table => wgpu::BindingType::Buffer {
                         ty: wgpu::BufferBindingType::Storage { read_only: true },
                         has_dynamic_offset: false,
                         min_binding_size: None,
                     },
-                    Binding::Table2d | Binding::Table3d | Binding::Table2dArray => {
-                        wgpu::BindingType::Texture {
-                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                            view_dimension: match b {
-                                Binding::Table3d => wgpu::TextureViewDimension::D3,
-                                Binding::Table2dArray => wgpu::TextureViewDimension::D2Array,
-                                _ => wgpu::TextureViewDimension::D2,
-                            },
-                            multisampled: false,
-                        }
-                    }
                 },
                 count: None,
             })

@@ -1,40 +1,50 @@
-//! Lookup tables as textures: `R32Float` or `Rgba32Float` texels in a 2D
-//! texture, a 3D texture or a 2D-array texture (one layer per plane), read
-//! by the shaders with `textureLoad` and filtered by hand in `f32` (so the
-//! CPU twins can filter the same way: hardware filtering has 8-bit weights,
-//! and GL cannot filter `f32` textures at all).
+//! Lookup tables as read-only storage buffers: `f32` texels (one channel,
+//! WGSL `array<f32>`) or RGBA texels (`array<vec4<f32>>`), x fastest, then
+//! rows, then layers or slices, read by the shaders by index and filtered
+//! by hand in `f32` (so the CPU twins filter the same way: hardware
+//! filtering has 8-bit weights, and GL cannot filter `f32` textures at
+//! all).
+//!
+//! Why buffers and not textures: on the software rasterisers a texel fetch
+//! goes through the sampler's general path (format, bounds and layout per
+//! fetch), a buffer load is one gather; the 3D table's eight loads per
+//! fragment made the `preint3d` frame 16 % slower as texture fetches
+//! (hex_shell, 512^2, lavapipe). A GPU build writes the table's buffer in
+//! place ([`Table::buffer`]), with no copy into a texture.
 //!
 //! A mode builds its table on the CPU and uploads it ([`Table::upload`],
-//! [`Table::upload_rgba`]), or fills it on the GPU from a storage buffer
-//! ([`Table::empty_rgba`], [`super::compute::GpuBuffer::copy_to_table`]),
-//! and keeps it per device with [`Context::resource`].
+//! [`Table::upload_rgba`]), or fills it on the GPU
+//! ([`Table::empty_rgba`], then a compute pass on [`Table::buffer`]), and
+//! keeps it per device with [`Context::resource`].
 //!
 //! Sizes are checked against the adapter before anything is allocated
-//! ([`Table::check_size`]): a side of zero, or above the adapter's limit for
-//! the texture's dimension (3D: 2048 on GL llvmpipe, 4096 on lavapipe;
-//! array layers: `max_texture_array_layers`), is refused with
-//! [`GpuError::TableSize`], which names the limit.
+//! ([`Table::check_size`]): a side of zero, or a table larger than one
+//! storage-buffer binding of the adapter (`max_storage_buffer_binding_size`:
+//! 128 MiB on lavapipe and GL llvmpipe, a 203^3 RGBA table), is refused
+//! with [`GpuError::TableSize`] or [`GpuError::TableBytes`], which name the
+//! limit.
 
+use super::compute::GpuBuffer;
 use super::device::Context;
 use super::GpuError;
 
-/// The shape of a table texture.
+/// The shape of a table (how its shader indexes it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TableDim {
-    /// `texture_2d<f32>` (`size[2]` is 1).
+    /// One layer (`size[2]` is 1).
     D2,
-    /// `texture_3d<f32>`.
+    /// A volume of `size[2]` slices, interpolated between them.
     D3,
-    /// `texture_2d_array<f32>`, `size[2]` layers.
+    /// `size[2]` separate layers (planes).
     D2Array,
 }
 
 impl TableDim {
     fn name(self) -> &'static str {
         match self {
-            TableDim::D2 => "2D texture",
-            TableDim::D3 => "3D texture",
-            TableDim::D2Array => "2D-array texture",
+            TableDim::D2 => "2D table",
+            TableDim::D3 => "3D table",
+            TableDim::D2Array => "layered table",
         }
     }
 }
@@ -42,16 +52,15 @@ impl TableDim {
 /// A table on the GPU.
 #[derive(Debug)]
 pub struct Table {
-    texture: wgpu::Texture,
-    view: wgpu::TextureView,
+    buffer: GpuBuffer,
     size: [u32; 3],
     dim: TableDim,
     rgba: bool,
 }
 
 impl Table {
-    /// Uploads `R32Float` `data`, `size[0]` texels per row, `size[1]` rows
-    /// per layer, `size[2]` layers (1 makes a 2D table, more a 3D one), x
+    /// Uploads `f32` `data`, `size[0]` texels per row, `size[1]` rows per
+    /// layer, `size[2]` layers (1 makes a 2D table, more a 3D one), x
     /// fastest.
     pub fn upload(
         ctx: &Context,
@@ -67,8 +76,8 @@ impl Table {
         Self::upload_with(ctx, label, dim, size, data, false)
     }
 
-    /// Uploads `Rgba32Float` `data` (four floats per texel, x fastest, then
-    /// rows, then layers or slices) as a table of shape `dim`.
+    /// Uploads RGBA `data` (four floats per texel, x fastest, then rows,
+    /// then layers or slices) as a table of shape `dim`.
     pub fn upload_rgba(
         ctx: &Context,
         label: &str,
@@ -79,52 +88,57 @@ impl Table {
         Self::upload_with(ctx, label, dim, size, data, true)
     }
 
-    /// An `Rgba32Float` table of shape `dim` whose texels are still to be
-    /// written (zero until then).
+    /// An RGBA table of shape `dim` whose texels are still to be written
+    /// (zero until then).
     pub fn empty_rgba(
         ctx: &Context,
         label: &str,
         dim: TableDim,
         size: [u32; 3],
     ) -> Result<Table, GpuError> {
-        Self::check_size(ctx.limits(), dim, size)?;
-        Ok(Self::create(ctx, label, dim, size, true))
+        Self::create(ctx, label, dim, size, true)
     }
 
-    /// Refuses a size the adapter cannot hold: any side zero, a side above
-    /// the dimension's limit, more layers than the adapter allows.
+    /// Bytes of an RGBA table of `size`.
+    fn rgba_bytes(size: [u32; 3]) -> u64 {
+        size.iter().map(|&v| v as u64).product::<u64>() * 16
+    }
+
+    /// Refuses an RGBA table the adapter cannot hold: any side zero, or
+    /// more bytes than one storage-buffer binding.
     pub fn check_size(
         limits: &wgpu::Limits,
         dim: TableDim,
         size: [u32; 3],
     ) -> Result<(), GpuError> {
-        let [w, h, d] = size;
-        let (max_side, max_depth, depth_what) = match dim {
-            TableDim::D2 => (limits.max_texture_dimension_2d, 1, "layers"),
-            TableDim::D3 => (
-                limits.max_texture_dimension_3d,
-                limits.max_texture_dimension_3d,
-                "slices",
-            ),
-            TableDim::D2Array => (
-                limits.max_texture_dimension_2d,
-                limits.max_texture_array_layers,
-                "layers",
-            ),
-        };
-        let bad = |value: u32, max: u32, what: &'static str| GpuError::TableSize {
-            dim: dim.name(),
-            what,
-            value,
-            max,
-        };
-        for (v, what) in [(w, "width"), (h, "height")] {
-            if v == 0 || v > max_side {
-                return Err(bad(v, max_side, what));
+        Self::check_bytes(limits, dim, size, Self::rgba_bytes(size))
+    }
+
+    fn check_bytes(
+        limits: &wgpu::Limits,
+        dim: TableDim,
+        size: [u32; 3],
+        bytes: u64,
+    ) -> Result<(), GpuError> {
+        for (v, what) in size.into_iter().zip(["width", "height", "depth"]) {
+            if v == 0 {
+                return Err(GpuError::TableSize {
+                    dim: dim.name(),
+                    what,
+                    value: v,
+                });
             }
         }
-        if d == 0 || d > max_depth {
-            return Err(bad(d, max_depth, depth_what));
+        let max = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        if bytes > max {
+            return Err(GpuError::TableBytes {
+                dim: dim.name(),
+                size,
+                mib: bytes as f64 / (1u64 << 20) as f64,
+                max_mib: max as f64 / (1u64 << 20) as f64,
+            });
         }
         Ok(())
     }
@@ -137,99 +151,66 @@ impl Table {
         data: &[f32],
         rgba: bool,
     ) -> Result<Table, GpuError> {
-        Self::check_size(ctx.limits(), dim, size)?;
-        let [w, h, d] = size;
         let per = if rgba { 4 } else { 1 };
-        let n = w as usize * h as usize * d as usize * per;
+        let n = size.iter().map(|&v| v as usize).product::<usize>() * per;
         if data.len() != n {
             return Err(GpuError::BadOption("table size does not match its data"));
         }
-        let table = Self::create(ctx, label, dim, size, rgba);
-        table.write(ctx, data);
+        let table = Self::create(ctx, label, dim, size, rgba)?;
+        table.buffer.write(ctx, bytemuck::cast_slice(data));
         ctx.check()?;
         Ok(table)
     }
 
-    /// Overwrites every texel of an `Rgba32Float` table with `data`.
+    /// Overwrites every texel of an RGBA table with `data`.
     pub fn write_rgba(&self, ctx: &Context, data: &[f32]) -> Result<(), GpuError> {
-        let n = self.size.iter().map(|&v| v as usize).product::<usize>() * 4;
+        let n = self.texels() * 4;
         if !self.rgba || data.len() != n {
             return Err(GpuError::BadOption("table size does not match its data"));
         }
-        self.write(ctx, data);
+        self.buffer.write(ctx, bytemuck::cast_slice(data));
         ctx.check()
     }
 
-    fn write(&self, ctx: &Context, data: &[f32]) {
-        let per = if self.rgba { 4 } else { 1 };
-        ctx.queue.write_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture: &self.texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            bytemuck::cast_slice(data),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(4 * per * self.size[0]),
-                rows_per_image: Some(self.size[1]),
-            },
-            self.extent(),
-        );
-    }
-
-    fn create(ctx: &Context, label: &str, dim: TableDim, size: [u32; 3], rgba: bool) -> Table {
-        let extent = wgpu::Extent3d {
-            width: size[0],
-            height: size[1],
-            depth_or_array_layers: size[2],
-        };
-        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: extent,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: if dim == TableDim::D3 {
-                wgpu::TextureDimension::D3
-            } else {
-                wgpu::TextureDimension::D2
-            },
-            format: if rgba {
-                wgpu::TextureFormat::Rgba32Float
-            } else {
-                wgpu::TextureFormat::R32Float
-            },
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(match dim {
-                TableDim::D2 => wgpu::TextureViewDimension::D2,
-                TableDim::D3 => wgpu::TextureViewDimension::D3,
-                TableDim::D2Array => wgpu::TextureViewDimension::D2Array,
-            }),
-            ..Default::default()
-        });
-        Table {
-            texture,
-            view,
+    fn create(
+        ctx: &Context,
+        label: &str,
+        dim: TableDim,
+        size: [u32; 3],
+        rgba: bool,
+    ) -> Result<Table, GpuError> {
+        let per = if rgba { 16 } else { 4 };
+        let bytes = size.iter().map(|&v| v as u64).product::<u64>() * per;
+        Self::check_bytes(ctx.limits(), dim, size, bytes)?;
+        Ok(Table {
+            buffer: GpuBuffer::new(ctx, label, bytes)?,
             size,
             dim,
             rgba,
-        }
+        })
     }
 
-    pub(crate) fn extent(&self) -> wgpu::Extent3d {
-        wgpu::Extent3d {
-            width: self.size[0],
-            height: self.size[1],
-            depth_or_array_layers: self.size[2],
-        }
+    /// The texels (x fastest; four floats each where RGBA), read back
+    /// (waits for the queue; tests and twins).
+    pub fn read(&self, ctx: &Context) -> Result<Vec<f32>, GpuError> {
+        let bytes = self.buffer.read(ctx)?;
+        let per = if self.rgba { 4 } else { 1 };
+        let n = self.texels() * per;
+        Ok(bytes
+            .chunks_exact(4)
+            .take(n)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect())
     }
 
-    pub(crate) fn texture(&self) -> &wgpu::Texture {
-        &self.texture
+    /// Its storage buffer, which a compute pass may write in place (the
+    /// layout of the module docs, no padding).
+    pub fn buffer(&self) -> &GpuBuffer {
+        &self.buffer
+    }
+
+    fn texels(&self) -> usize {
+        self.size.iter().map(|&v| v as usize).product()
     }
 
     /// Texels per axis.
@@ -250,9 +231,5 @@ impl Table {
     /// Whether its texels are RGBA (else one channel).
     pub fn is_rgba(&self) -> bool {
         self.rgba
-    }
-
-    pub(crate) fn view(&self) -> &wgpu::TextureView {
-        &self.view
     }
 }

@@ -169,7 +169,7 @@ pub static EXACT_ISO_STAGE: StageDesc = StageDesc {
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &ExactIsoVertex::ATTRIBUTES,
     },
-    bindings: &[Binding::Uniform, Binding::Table2d, Binding::Uniform],
+    bindings: &[Binding::Uniform, Binding::Table, Binding::Uniform],
     constants: &[],
 };
 

@@ -292,7 +292,7 @@ pub static ISO_PREINT3D_STAGE: StageDesc = iso_stage!(
     "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
     &[
         Binding::Uniform,
-        Binding::Table3d,
+        Binding::Table,
         Binding::Uniform,
         Binding::Uniform,
         Binding::Storage
@@ -306,7 +306,7 @@ pub static ISO_PREINT2D_STAGE: StageDesc = iso_stage!(
     "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
     &[
         Binding::Uniform,
-        Binding::Table2d,
+        Binding::Table,
         Binding::Uniform,
         Binding::Uniform,
         Binding::Storage
@@ -320,7 +320,7 @@ pub static ISO_PREINT2D_CYL_STAGE: StageDesc = iso_stage!(
     "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
     &[
         Binding::Uniform,
-        Binding::Table2dArray,
+        Binding::Table,
         Binding::Uniform,
         Binding::Uniform,
         Binding::Storage

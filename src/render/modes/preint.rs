@@ -10,12 +10,16 @@
 //!    function's node range, where it is constant) are homogeneous and
 //!    integrated in closed form; the part inside goes to the table, so data
 //!    beyond the transfer function's range costs no table resolution;
-//! 3. a part longer than the table's longest length is cut into equal
-//!    steps composited front to back (at most 16; it never happens when
-//!    the table spans the largest cell diameter, as it does here);
-//! 4. the mode's lookup filters the table by hand in `f32`
-//!    (`textureLoad`, so the CPU twin filters identically and GL, which
-//!    cannot filter `f32` textures, works too).
+//! 3. the table spans lengths up to the largest cell diameter (grown by
+//!    [`crate::numeric::tolerance::TABLE_LENGTH_MARGIN`]), which bounds
+//!    every segment through a piece, so each segment is one lookup (a
+//!    length beyond it, only from rounding, reads the last sample); the
+//!    three parts are evaluated without branches, absent ones at length 0
+//!    (exactly 0): on the software rasterisers a branch runs both sides and
+//!    a loop of steps around the lookup cost one more lookup per fragment;
+//! 4. the mode's lookup filters the table by hand in `f32` (a storage
+//!    buffer, [`crate::gpu::Table`], so the CPU twin filters identically
+//!    and GL, which cannot filter `f32` textures, works too).
 //!
 //! [`PreintMode`] is the [`SegmentMode`] of all three; a mode file gives
 //! its registry entry, its stage and its lookup's twin.
@@ -36,9 +40,6 @@ use super::preint_tables::{
 };
 use super::segment::{segment_at, SegmentMode, SegmentVertex, SegmentView};
 
-/// Most steps a segment is cut into (`MAX_STEPS` in the shader).
-const MAX_STEPS: u32 = 16;
-
 /// The parameters of the table stages. Keep in sync with `PreintParams` in
 /// `shaders/preint.wgsl`.
 #[repr(C)]
@@ -54,8 +55,7 @@ pub struct PreintParams {
     pub model: u32,
     pub _pad0: u32,
     pub l_table: f32,
-    pub l_step: f32,
-    pub _pad1: [f32; 2],
+    pub _pad1: [f32; 3],
 }
 
 impl PreintParams {
@@ -75,12 +75,7 @@ impl PreintParams {
             model: (tf.model() == EmissionModel::Independent) as u32,
             _pad0: 0,
             l_table,
-            l_step: if spec.kind == TableKind::Flat {
-                f32::MAX
-            } else {
-                l_table
-            },
-            _pad1: [0.0; 2],
+            _pad1: [0.0; 3],
         }
     }
 }
@@ -93,7 +88,7 @@ pub struct CpuTable {
 }
 
 impl CpuTable {
-    /// Texel `(i, j, k)` (`textureLoad`).
+    /// Texel `(i, j, k)` (the storage buffer's `(k * h + j) * w + i`).
     #[inline]
     pub fn load(&self, i: usize, j: usize, k: usize) -> [f32; 4] {
         let [w, h, _] = self.size.map(|v| v as usize);
@@ -165,31 +160,6 @@ pub fn lerp4(a: [f32; 4], b: [f32; 4], w: f32) -> [f32; 4] {
     std::array::from_fn(|k| a[k] + (b[k] - a[k]) * w)
 }
 
-pub(crate) fn table_steps(
-    p: &PreintParams,
-    t: &CpuTable,
-    lookup: LookupFn,
-    sf: f32,
-    sb: f32,
-    l: f32,
-) -> [f32; 4] {
-    let mut n = 1u32;
-    if l > p.l_step {
-        n = (l / p.l_step).ceil().min(MAX_STEPS as f32) as u32;
-    }
-    if n <= 1 {
-        return lookup(p, t, sf, sb, l);
-    }
-    let dl = l / n as f32;
-    let mut acc = [0.0f32; 4];
-    for k in 0..n {
-        let s0 = sf + (sb - sf) * (k as f32 / n as f32);
-        let s1 = sf + (sb - sf) * ((k + 1) as f32 / n as f32);
-        acc = over(acc, lookup(p, t, s0, s1, dl));
-    }
-    acc
-}
-
 pub(crate) fn extension(p: &PreintParams, s: f32) -> [f32; 4] {
     if s < 0.5 {
         p.below
@@ -209,29 +179,20 @@ pub fn preint_segment(
     l: f32,
 ) -> [f32; 4] {
     let d = sb - sf;
-    let (mut ta, mut tb) = (0.0f32, 1.0f32);
+    let outside = !(0.0..=1.0).contains(&sf);
+    let (mut ta, mut tb) = (if outside { 1.0f32 } else { 0.0 }, 1.0f32);
     if d != 0.0 {
         let t0 = (0.0 - sf) / d;
         let t1 = (1.0 - sf) / d;
         ta = t0.min(t1).clamp(0.0, 1.0);
         tb = t0.max(t1).clamp(0.0, 1.0);
-    } else if !(0.0..=1.0).contains(&sf) {
-        ta = 1.0;
     }
-    if ta >= tb {
-        return homogeneous(p, extension(p, sf), l);
-    }
-    let mut acc = [0.0f32; 4];
-    if ta > 0.0 {
-        acc = homogeneous(p, extension(p, sf), l * ta);
-    }
+    let tb = ta.max(tb);
     let s0 = (sf + d * ta).clamp(0.0, 1.0);
     let s1 = (sf + d * tb).clamp(0.0, 1.0);
-    acc = over(acc, table_steps(p, t, lookup, s0, s1, l * (tb - ta)));
-    if tb < 1.0 {
-        acc = over(acc, homogeneous(p, extension(p, sb), l * (1.0 - tb)));
-    }
-    acc
+    let front = homogeneous(p, extension(p, sf), l * ta);
+    let inside = over(front, lookup(p, t, s0, s1, l * (tb - ta)));
+    over(inside, homogeneous(p, extension(p, sb), l * (1.0 - tb)))
 }
 
 /// A table stage's bindings on the CPU (view, table, parameters and the
@@ -454,5 +415,113 @@ impl SegmentMode for PreintMode {
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {
         Box::new(self.twin_for(src.whole, src.tf, src.camera))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tf::Node;
+
+    use super::super::preint_tables::fill_cpu;
+    use super::super::{preint2d, preint2d_cyl, preint3d};
+
+    /// Nodes on [10, 20] with extinction at both ends (so the parts below
+    /// and above the table's range are not empty).
+    fn tf(model: EmissionModel) -> TransferFunction {
+        let n = |s: f64, tau: f64, c: [f64; 3]| Node {
+            s,
+            tau,
+            color: c,
+            emission: c.map(|v| v * tau),
+        };
+        let nodes = [
+            n(10.0, 0.7, [1.0, 0.0, 0.0]),
+            n(13.5, 5.0, [1.0, 1.0, 0.0]),
+            n(13.5, 0.5, [0.0, 1.0, 0.0]),
+            n(20.0, 2.0, [0.0, 0.0, 1.0]),
+        ];
+        TransferFunction::from_nodes(&nodes, model).unwrap()
+    }
+
+    /// The segment as it was drawn with branches (the parts outside the
+    /// table's range only where present): the reference the branch-free
+    /// `preint_segment` must equal bit for bit.
+    fn branched(p: &PreintParams, t: &CpuTable, f: LookupFn, sf: f32, sb: f32, l: f32) -> [f32; 4] {
+        let d = sb - sf;
+        let (mut ta, mut tb) = (0.0f32, 1.0f32);
+        if d != 0.0 {
+            let t0 = (0.0 - sf) / d;
+            let t1 = (1.0 - sf) / d;
+            ta = t0.min(t1).clamp(0.0, 1.0);
+            tb = t0.max(t1).clamp(0.0, 1.0);
+        } else if !(0.0..=1.0).contains(&sf) {
+            ta = 1.0;
+        }
+        if ta >= tb {
+            return homogeneous(p, extension(p, sf), l);
+        }
+        let mut acc = [0.0f32; 4];
+        if ta > 0.0 {
+            acc = homogeneous(p, extension(p, sf), l * ta);
+        }
+        let s0 = (sf + d * ta).clamp(0.0, 1.0);
+        let s1 = (sf + d * tb).clamp(0.0, 1.0);
+        acc = over(acc, f(p, t, s0, s1, l * (tb - ta)));
+        if tb < 1.0 {
+            acc = over(acc, homogeneous(p, extension(p, sb), l * (1.0 - tb)));
+        }
+        acc
+    }
+
+    /// Every table, built every way, reads exactly 0 at length 0, so the
+    /// absent parts of a segment add nothing, and the branch-free segment
+    /// equals the branched one bit for bit: inside, across either end,
+    /// wholly outside on either side, constant scalars, lengths up to and
+    /// beyond the table's.
+    #[test]
+    fn branch_free_segment_equals_the_branched_one() {
+        let kinds: [(TableKind, LookupFn); 3] = [
+            (TableKind::Cube, preint3d::table_rgba),
+            (TableKind::Flat, preint2d::table_rgba),
+            (TableKind::Cylinder, preint2d_cyl::table_rgba),
+        ];
+        let scalars = [-0.7f32, -0.01, 0.0, 0.2, 0.5, 0.77, 1.0, 1.3, 2.5];
+        for model in [EmissionModel::Glow, EmissionModel::Independent] {
+            let tf = tf(model);
+            for (kind, lookup) in kinds {
+                let spec = TableSpec::new(kind, Some(9), 0.8).unwrap();
+                let p = PreintParams::new(&tf, &spec);
+                for build in [TableBuild::Exact, TableBuild::Fast, TableBuild::Gpu] {
+                    let mut data = vec![0.0; 4 * spec.texels()];
+                    let all = (f64::NEG_INFINITY, f64::INFINITY);
+                    fill_cpu(&spec, &tf, build, all, &mut data);
+                    let t = CpuTable {
+                        size: spec.size,
+                        data,
+                    };
+                    for &a in &scalars {
+                        for &b in &scalars {
+                            let (a, b) = (a.clamp(0.0, 1.0), b.clamp(0.0, 1.0));
+                            let z = lookup(&p, &t, a, b, 0.0);
+                            assert_eq!(z, [0.0; 4], "{kind:?} {build:?} ({a}, {b})");
+                        }
+                    }
+                    for &sf in &scalars {
+                        for &sb in &scalars {
+                            for l in [0.0f32, 1e-12, 0.05, 0.8, 0.9] {
+                                let got = preint_segment(&p, &t, lookup, sf, sb, l);
+                                let want = branched(&p, &t, lookup, sf, sb, l);
+                                assert_eq!(
+                                    got.map(f32::to_bits),
+                                    want.map(f32::to_bits),
+                                    "{kind:?} {build:?} {model:?} ({sf}, {sb}, {l})"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
     }
 }

@@ -69,16 +69,22 @@ pub static PREINT2D_STAGE: StageDesc = StageDesc {
         include_str!("../../../shaders/preint2d.wgsl"),
     ),
     vertex: SegmentVertex::LAYOUT,
-    bindings: &[Binding::Uniform, Binding::Table2d, Binding::Uniform],
+    bindings: &[Binding::Uniform, Binding::Table, Binding::Uniform],
     constants: &[],
 };
+
+/// Twin of `texel2d`: texel `(i, j)` of the table's storage buffer.
+#[inline]
+pub fn texel2d(t: &CpuTable, i: usize, j: usize) -> [f32; 4] {
+    t.load(i, j, 0)
+}
 
 /// Twin of `table_rgba` in `shaders/preint2d.wgsl`.
 pub fn table_rgba(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [f32; 4] {
     let (i, wa) = axis(sf, p.ns);
     let (j, wb) = axis(sb, p.ns);
-    let r0 = lerp4(t.load(i, j, 0), t.load(i + 1, j, 0), wa);
-    let r1 = lerp4(t.load(i, j + 1, 0), t.load(i + 1, j + 1, 0), wa);
+    let r0 = lerp4(texel2d(t, i, j), texel2d(t, i + 1, j), wa);
+    let r1 = lerp4(texel2d(t, i, j + 1), texel2d(t, i + 1, j + 1), wa);
     let v = lerp4(r0, r1, wb);
     let r = l / p.l_table;
     let depth_ref = v[3].max(0.0);

@@ -9,7 +9,7 @@
 //! coordinates `(u, v = S_b)`; the table holds planes `a_k = k / (P - 1)`,
 //! each `N x N` over `(u, v) in [0, 1]^2`, filled at equation 9's
 //! `(S_f, S_b, L)` from the exact integrals ([`TableKind::Cylinder`]), as
-//! the layers of one 2D-array texture (the paper's tiles). A lookup is
+//! consecutive layers of one storage buffer (the paper's tiles). A lookup is
 //! bilinear in each of the two nearest planes and linear between them, by
 //! hand in `f32` ([`table_rgba`], the twin of `table_rgba` in
 //! `shaders/preint2d_cyl.wgsl`). `--table N` gives `N` samples per axis and
@@ -70,7 +70,7 @@ pub static PREINT2D_CYL_STAGE: StageDesc = StageDesc {
         include_str!("../../../shaders/preint2d_cyl.wgsl"),
     ),
     vertex: SegmentVertex::LAYOUT,
-    bindings: &[Binding::Uniform, Binding::Table2dArray, Binding::Uniform],
+    bindings: &[Binding::Uniform, Binding::Table, Binding::Uniform],
     constants: &[],
 };
 
@@ -91,6 +91,13 @@ pub fn table_to_cyl(sf: f32, sb: f32, big_l: f32) -> (f32, f32) {
     }
 }
 
+/// Twin of `plane_texel`: texel `(i, j)` of plane `k` of the table's
+/// storage buffer.
+#[inline]
+pub fn plane_texel(t: &CpuTable, i: usize, j: usize, k: usize) -> [f32; 4] {
+    t.load(i, j, k)
+}
+
 /// Twin of `table_rgba` in `shaders/preint2d_cyl.wgsl`.
 pub fn table_rgba(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [f32; 4] {
     let big_l = (l / p.l_table).clamp(0.0, 1.0);
@@ -99,8 +106,12 @@ pub fn table_rgba(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [
     let (i, wu) = axis(u, p.ns);
     let (j, wv) = axis(sb, p.ns);
     let layer = |k: usize| {
-        let r0 = lerp4(t.load(i, j, k), t.load(i + 1, j, k), wu);
-        let r1 = lerp4(t.load(i, j + 1, k), t.load(i + 1, j + 1, k), wu);
+        let r0 = lerp4(plane_texel(t, i, j, k), plane_texel(t, i + 1, j, k), wu);
+        let r1 = lerp4(
+            plane_texel(t, i, j + 1, k),
+            plane_texel(t, i + 1, j + 1, k),
+            wu,
+        );
         lerp4(r0, r1, wv)
     };
     lerp4(layer(k), layer(k + 1), wp)

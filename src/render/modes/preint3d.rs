@@ -9,7 +9,8 @@
 //! cell diameter of the mesh (a bound of every piece's thickness, computed
 //! once per mesh), so no segment needs more than one lookup; longer ones
 //! would be composited in steps ([`super::preint`]). The lookup is
-//! trilinear, by hand in `f32` ([`table_rgba`], the twin of `table_rgba` in
+//! trilinear, by hand in `f32` on a storage buffer ([`table_rgba`], the
+//! twin of `table_rgba` in
 //! `shaders/preint3d.wgsl`).
 //!
 //! Where the error comes from: the trilinear interpolation of the
@@ -65,9 +66,15 @@ pub static PREINT3D_STAGE: StageDesc = StageDesc {
         include_str!("../../../shaders/preint3d.wgsl"),
     ),
     vertex: SegmentVertex::LAYOUT,
-    bindings: &[Binding::Uniform, Binding::Table3d, Binding::Uniform],
+    bindings: &[Binding::Uniform, Binding::Table, Binding::Uniform],
     constants: &[],
 };
+
+/// Twin of `texel3d`: texel `(i, j, k)` of the table's storage buffer.
+#[inline]
+pub fn texel3d(t: &CpuTable, i: usize, j: usize, k: usize) -> [f32; 4] {
+    t.load(i, j, k)
+}
 
 /// Twin of `table_rgba` in `shaders/preint3d.wgsl`.
 pub fn table_rgba(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [f32; 4] {
@@ -75,8 +82,8 @@ pub fn table_rgba(p: &PreintParams, t: &CpuTable, sf: f32, sb: f32, l: f32) -> [
     let (j, wb) = axis(sb, p.ns);
     let (k, wc) = axis(l / p.l_table, p.nz);
     let plane = |k: usize| {
-        let r0 = lerp4(t.load(i, j, k), t.load(i + 1, j, k), wa);
-        let r1 = lerp4(t.load(i, j + 1, k), t.load(i + 1, j + 1, k), wa);
+        let r0 = lerp4(texel3d(t, i, j, k), texel3d(t, i + 1, j, k), wa);
+        let r1 = lerp4(texel3d(t, i, j + 1, k), texel3d(t, i + 1, j + 1, k), wa);
         lerp4(r0, r1, wb)
     };
     lerp4(plane(k), plane(k + 1), wc)

@@ -53,7 +53,7 @@ pub static PREINT3D_QUAD_STAGE: StageDesc = quad_table_stage(
         include_str!("../../../shaders/preint.wgsl"),
         include_str!("../../../shaders/preint3d.wgsl"),
     ),
-    &[Binding::Uniform, Binding::Table3d, Binding::Uniform],
+    &[Binding::Uniform, Binding::Table, Binding::Uniform],
 );
 
 /// preint2d's stage with whole pieces.
@@ -65,7 +65,7 @@ pub static PREINT2D_QUAD_STAGE: StageDesc = quad_table_stage(
         include_str!("../../../shaders/preint.wgsl"),
         include_str!("../../../shaders/preint2d.wgsl"),
     ),
-    &[Binding::Uniform, Binding::Table2d, Binding::Uniform],
+    &[Binding::Uniform, Binding::Table, Binding::Uniform],
 );
 
 /// preint2d-cyl's stage with whole pieces.
@@ -77,7 +77,7 @@ pub static PREINT2D_CYL_QUAD_STAGE: StageDesc = quad_table_stage(
         include_str!("../../../shaders/preint.wgsl"),
         include_str!("../../../shaders/preint2d_cyl.wgsl"),
     ),
-    &[Binding::Uniform, Binding::Table2dArray, Binding::Uniform],
+    &[Binding::Uniform, Binding::Table, Binding::Uniform],
 );
 
 /// A table mode with its pieces drawn whole (module docs); the table

@@ -33,7 +33,7 @@
 //!
 //! **Cache** ([`TableCache`], one per device through
 //! [`Context::resource`]): tables by (kind, size, length, build); a frame
-//! with the same transfer function reuses the texture, an edit updates the
+//! with the same transfer function reuses the table, an edit updates the
 //! touched texels, anything else (another scalar range, another emission
 //! model) rebuilds.
 
@@ -57,7 +57,7 @@ use crate::tf::TransferFunction;
 use super::integral::{closed_form_constants, TfBuffer};
 use super::segment::ScalarMap;
 use super::table_build::{build_main, column_main, BuildParams};
-pub use super::table_build::{row_texels, GpuBuilt, TABLE_BUILD, TABLE_COLUMNS};
+pub use super::table_build::{gpu_build, TABLE_BUILD, TABLE_COLUMNS};
 
 /// Largest number of texels a table may have (256 Mi: 4 GiB of RGBA f32).
 pub const MAX_TEXELS: u64 = 1 << 28;
@@ -336,7 +336,7 @@ pub fn fill_cpu(
             // The twin of the kernel's columns: one per (i, j), every length.
             let buf = TfBuffer::new(tf, &map);
             let consts = closed_form_constants();
-            let params = BuildParams::new(spec, range, spec.size[0]);
+            let params = BuildParams::new(spec, range);
             let nz = spec.size[2] as usize;
             let columns: Vec<Option<Vec<[f32; 4]>>> = (0..ns * ns)
                 .into_par_iter()
@@ -490,8 +490,9 @@ struct Entry {
     table: Arc<Table>,
     /// The texels, for a local update (CPU builds).
     cpu: Option<Vec<f32>>,
-    /// The storage buffer, for a local update (GPU builds).
-    gpu: Option<GpuBuilt>,
+    /// Whether the GPU built it (a local update then rewrites the touched
+    /// texels in place).
+    gpu: bool,
 }
 
 /// A mesh by its address, cell count and point count.
@@ -558,11 +559,11 @@ impl TableCache {
                     tf: tf.clone(),
                     table: Arc::new(table),
                     cpu: None,
-                    gpu: None,
+                    gpu: false,
                 }
             }
         };
-        let change = match (found, entry.cpu.is_some() || entry.gpu.is_some()) {
+        let change = match (found, entry.cpu.is_some() || entry.gpu) {
             (Some(_), true) => tf_change(&entry.tf, tf),
             _ => TfChange::All,
         };
@@ -574,12 +575,8 @@ impl TableCache {
         let mut built = 0;
         if let Some(range) = range {
             if build == TableBuild::Gpu {
-                if entry.gpu.is_none() {
-                    entry.gpu = Some(GpuBuilt::new(ctx, spec)?);
-                }
-                if let Some(g) = &entry.gpu {
-                    g.build(ctx, spec, tf, range, &entry.table)?;
-                }
+                gpu_build(ctx, spec, tf, range, &entry.table)?;
+                entry.gpu = true;
                 built = count_touched(spec, range);
             } else if change == TfChange::All {
                 // A whole table: every texel written, from the process's

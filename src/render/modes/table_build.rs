@@ -11,15 +11,14 @@
 //! texel), the other tables one invocation per texel (`integrate_segment`);
 //! the 2D table holds the optical depth instead of the opacity
 //! ([`optical_depth`]). The shader's head comment explains the column.
-//! [`GpuBuilt`] holds the kernel's storage buffer (rows padded for the copy
-//! into the table's texture). On the CPU, [`build_main`] and
+//! [`gpu_build`] writes the table's own storage buffer in place. On the CPU, [`build_main`] and
 //! [`build_column`] are the twins of one invocation; `cyl_to_table` is
 //! [`crate::integrate::cylinder::cyl_to_table`] (in `f64`, through
 //! [`TableSpec::texel_point`]).
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::gpu::compute::{ComputeBinding, ComputeDesc, ComputeResource, GpuBuffer, ROW_ALIGN};
+use crate::gpu::compute::{ComputeBinding, ComputeDesc, ComputeResource};
 use crate::gpu::{Context, GpuError, Table};
 use crate::tf::TransferFunction;
 
@@ -37,8 +36,7 @@ pub struct BuildParams {
     kind: u32,
     ns: u32,
     nz: u32,
-    /// Texels per output row (the row padded for the texture copy).
-    row_texels: u32,
+    _pad0: u32,
     l_table: f32,
     lo: f32,
     hi: f32,
@@ -46,15 +44,14 @@ pub struct BuildParams {
 }
 
 impl BuildParams {
-    /// The uniforms that build the texels of `spec` meeting `range`, rows
-    /// of `row_texels`.
-    pub fn new(spec: &TableSpec, range: (f64, f64), row_texels: u32) -> BuildParams {
+    /// The uniforms that build the texels of `spec` meeting `range`.
+    pub fn new(spec: &TableSpec, range: (f64, f64)) -> BuildParams {
         let clamp = |x: f64| x.clamp(-1e30, 1e30) as f32;
         BuildParams {
             kind: spec.kind.code(),
             ns: spec.size[0],
             nz: spec.size[2],
-            row_texels,
+            _pad0: 0,
             l_table: spec.l_table as f32,
             lo: clamp(range.0),
             hi: clamp(range.1),
@@ -110,75 +107,39 @@ pub static TABLE_COLUMNS: ComputeDesc = ComputeDesc {
     bindings: BUILD_BINDINGS,
 };
 
-/// Texels per padded row of a GPU-built table of `ns` texels per row.
-pub fn row_texels(ns: u32) -> u32 {
-    let per_align = ROW_ALIGN / 16;
-    ns.div_ceil(per_align) * per_align
-}
-
-/// A table built on the GPU: its storage buffer (rows padded) and texture.
-pub struct GpuBuilt {
-    pub buffer: GpuBuffer,
-    pub row_texels: u32,
-}
-
-impl GpuBuilt {
-    /// A zeroed buffer for `spec`.
-    pub fn new(ctx: &Context, spec: &TableSpec) -> Result<GpuBuilt, GpuError> {
-        let rt = row_texels(spec.size[0]);
-        let len = rt as u64 * spec.size[1] as u64 * spec.size[2] as u64 * 16;
-        Ok(GpuBuilt {
-            buffer: GpuBuffer::new(ctx, "pre-integration table", len)?,
-            row_texels: rt,
-        })
+/// Integrates the texels of `spec` that meet `range` into `table`'s
+/// storage buffer, in place (the table is what the stages then read).
+pub fn gpu_build(
+    ctx: &Context,
+    spec: &TableSpec,
+    tf: &TransferFunction,
+    range: (f64, f64),
+    table: &Table,
+) -> Result<(), GpuError> {
+    if table.size() != spec.size || !table.is_rgba() {
+        return Err(GpuError::BadOption(
+            "the table does not have the spec's size",
+        ));
     }
-
-    /// Integrates the texels of `spec` that meet `range` into the buffer
-    /// and copies the buffer into `table`.
-    pub fn build(
-        &self,
-        ctx: &Context,
-        spec: &TableSpec,
-        tf: &TransferFunction,
-        range: (f64, f64),
-        table: &Table,
-    ) -> Result<(), GpuError> {
-        let params = BuildParams::new(spec, range, self.row_texels);
-        let buf = TfBuffer::new(tf, &ScalarMap::of(tf));
-        let consts = closed_form_constants();
-        let kernel = if spec.kind == TableKind::Cube {
-            &TABLE_COLUMNS
-        } else {
-            &TABLE_BUILD
-        };
-        ctx.dispatch(
-            kernel,
-            &[
-                ComputeResource::Uniform(bytemuck::bytes_of(&params)),
-                ComputeResource::Storage(&buf.bytes()),
-                ComputeResource::Storage(bytemuck::cast_slice(&consts)),
-                ComputeResource::Buffer(&self.buffer),
-            ],
-            params.groups(),
-        )?;
-        if std::env::var("NOCOPY").is_err() {
-            self.buffer.copy_to_table(ctx, table, self.row_texels * 16);
-        }
-        ctx.check()
-    }
-
-    /// The texels (unpadded, RGBA, x fastest), read back.
-    pub fn read(&self, ctx: &Context, spec: &TableSpec) -> Result<Vec<f32>, GpuError> {
-        let bytes = self.buffer.read(ctx)?;
-        let all: &[f32] = bytemuck::cast_slice(&bytes);
-        let (ns, rt) = (spec.size[0] as usize, self.row_texels as usize);
-        let rows = spec.size[1] as usize * spec.size[2] as usize;
-        let mut out = Vec::with_capacity(4 * ns * rows);
-        for r in 0..rows {
-            out.extend_from_slice(&all[4 * r * rt..4 * (r * rt + ns)]);
-        }
-        Ok(out)
-    }
+    let params = BuildParams::new(spec, range);
+    let buf = TfBuffer::new(tf, &ScalarMap::of(tf));
+    let consts = closed_form_constants();
+    let kernel = if spec.kind == TableKind::Cube {
+        &TABLE_COLUMNS
+    } else {
+        &TABLE_BUILD
+    };
+    ctx.dispatch(
+        kernel,
+        &[
+            ComputeResource::Uniform(bytemuck::bytes_of(&params)),
+            ComputeResource::Storage(&buf.bytes()),
+            ComputeResource::Storage(bytemuck::cast_slice(&consts)),
+            ComputeResource::Buffer(table.buffer()),
+        ],
+        params.groups(),
+    )?;
+    ctx.check()
 }
 
 /// Twin of `build_main` for one texel of a table of `kind`: the `f32`

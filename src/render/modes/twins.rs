@@ -74,7 +74,8 @@ pub fn stage_twins() -> Vec<StageTwins> {
         twins!("common.wgsl": common::piece_depth, common::finite, common::count_of),
         twins!("exact.wgsl": exact::fs_main),
         twins!("exact_iso.wgsl": exact_iso::exact_iso_light, exact_iso::fs_main),
-        twins!("exptable.wgsl": exptable::log1p_, exptable::coord, ExpTable::alpha_of),
+        twins!("exptable.wgsl":
+            exptable::log1p_, exptable::coord, ExpTable::texel, ExpTable::alpha_of),
         twins!("exact_frag.wgsl": exact_frag::fs_main),
         twins!("integral.wgsl":
             TfBuffer::node_s, TfBuffer::node, TfBuffer::piece_index, TfBuffer::eval_piece,
@@ -90,11 +91,11 @@ pub fn stage_twins() -> Vec<StageTwins> {
         twins!("layer.wgsl": layer::fs_main),
         twins!("preint.wgsl":
             preint::one_minus_exp_over, preint::homogeneous, preint::over, preint::axis,
-            preint::lerp4, preint::table_steps, preint::extension, preint::preint_segment,
+            preint::lerp4, preint::extension, preint::preint_segment,
             preint::fs_main),
-        twins!("preint2d.wgsl": preint2d::table_rgba),
-        twins!("preint2d_cyl.wgsl": preint2d_cyl::table_rgba),
-        twins!("preint3d.wgsl": preint3d::table_rgba),
+        twins!("preint2d.wgsl": preint2d::texel2d, preint2d::table_rgba),
+        twins!("preint2d_cyl.wgsl": preint2d_cyl::plane_texel, preint2d_cyl::table_rgba),
+        twins!("preint3d.wgsl": preint3d::texel3d, preint3d::table_rgba),
         twins!("segment.wgsl": segment::segment_at),
         twins!("segment_vertex.wgsl"),
         twins!("segment_view.wgsl": segment_view::segment_of),

@@ -13,8 +13,8 @@
 //! [`super::ExactParams`]). Texel `i` of `N` sits at
 //! `s = i / (N - 1)`, i.e. at `x_i = expm1(s_i ln(1 + X^2)) / X`, and stores
 //! `1 - exp(-x_i x_j)` (computed in f64, stored as f32; the table is symmetric).
-//! The shader reads the four neighbours with `textureLoad` and filters them
-//! bilinearly in f32 itself, so the result does not depend on a GPU's
+//! The shader reads the four neighbours from the table's storage buffer
+//! and filters them bilinearly in f32 itself, so the result does not depend on a GPU's
 //! fixed-point filter weights and [`ExpTable::alpha_of`] reproduces it.
 //!
 //! * Range: each of `l'`, `tau'` in `[0, 1e6]`; optical depths from below
@@ -89,7 +89,8 @@ impl ExpTable {
         &self.data
     }
 
-    fn at(&self, i: u32, j: u32) -> f32 {
+    /// Twin of `texel`: value `(i, j)` (`i` along the length).
+    pub fn texel(&self, i: u32, j: u32) -> f32 {
         self.data
             .get(j as usize * self.n as usize + i as usize)
             .copied()
@@ -107,8 +108,8 @@ impl ExpTable {
         let fu = u - i0 as f32;
         let fv = v - j0 as f32;
         let mix = |a: f32, b: f32, t: f32| a * (1.0 - t) + b * t;
-        let r0 = mix(self.at(i0, j0), self.at(i0 + 1, j0), fu);
-        let r1 = mix(self.at(i0, j0 + 1), self.at(i0 + 1, j0 + 1), fu);
+        let r0 = mix(self.texel(i0, j0), self.texel(i0 + 1, j0), fu);
+        let r1 = mix(self.texel(i0, j0 + 1), self.texel(i0 + 1, j0 + 1), fu);
         mix(r0, r1, fv)
     }
 

@@ -176,7 +176,7 @@ pub static EXACT_STAGE: StageDesc = StageDesc {
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &ExactVertex::ATTRIBUTES,
     },
-    bindings: &[Binding::Uniform, Binding::Table2d],
+    bindings: &[Binding::Uniform, Binding::Table],
     constants: &[],
 };
 
