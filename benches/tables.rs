@@ -74,7 +74,9 @@ fn mode_error(tf: &TransferFunction, kind: TableKind, n: u32) -> (f64, f64) {
         TableKind::Flat => preint2d::table_rgba,
         TableKind::Cylinder => preint2d_cyl::table_rgba,
     };
-    error(tf, |sf, sb, l| preint_segment(&p, &t, lookup, sf, sb, l))
+    error(tf, |sf, sb, l| {
+        preint_segment(&p, &t, lookup, true, sf, sb, l)
+    })
 }
 
 fn print_error_curve() {

@@ -16,7 +16,11 @@
 //!    length beyond it, only from rounding, reads the last sample); the
 //!    three parts are evaluated without branches, absent ones at length 0
 //!    (exactly 0): on the software rasterisers a branch runs both sides and
-//!    a loop of steps around the lookup cost one more lookup per fragment;
+//!    a loop of steps around the lookup cost one more lookup per fragment.
+//!    Where every scalar of the field lies inside the transfer function's
+//!    node range ([`field_inside`], the default range does that), the
+//!    stage is compiled without the parts outside (`EXTENDED` false: one
+//!    lookup at the clamped scalars), 9 % faster on lavapipe;
 //! 4. the mode's lookup filters the table by hand in `f32` (a storage
 //!    buffer, [`crate::gpu::Table`], so the CPU twin filters identically
 //!    and GL, which cannot filter `f32` textures, works too).
@@ -32,6 +36,7 @@ use crate::camera::Camera;
 use crate::gpu::cpu::CpuStage;
 use crate::gpu::{ClipMapper, Context, GpuError, Resource, Stage, StageDesc, Table};
 use crate::render::pieces::PieceSource;
+use crate::render::scene::ScalarsRef;
 use crate::render::{Compositor, RenderOptions, TableBuild, TableOptions};
 use crate::tf::{EmissionModel, TransferFunction};
 
@@ -169,15 +174,20 @@ pub(crate) fn extension(p: &PreintParams, s: f32) -> [f32; 4] {
 }
 
 /// Twin of `preint_segment`: the premultiplied colour and opacity of the
-/// segment `(s_f, s_b, l)` (normalised scalars).
+/// segment `(s_f, s_b, l)` (normalised scalars); `extended` is the stage's
+/// `EXTENDED`.
 pub fn preint_segment(
     p: &PreintParams,
     t: &CpuTable,
     lookup: LookupFn,
+    extended: bool,
     sf: f32,
     sb: f32,
     l: f32,
 ) -> [f32; 4] {
+    if !extended {
+        return lookup(p, t, sf.clamp(0.0, 1.0), sb.clamp(0.0, 1.0), l);
+    }
     let d = sb - sf;
     let outside = !(0.0..=1.0).contains(&sf);
     let (mut ta, mut tb) = (if outside { 1.0f32 } else { 0.0 }, 1.0f32);
@@ -203,6 +213,8 @@ pub struct PreintTwin {
     params: PreintParams,
     table: Arc<CpuTable>,
     lookup: LookupFn,
+    /// The stage's `EXTENDED` (false: the field inside the node range).
+    extended: bool,
 }
 
 /// Twin of `fs_main` in `shaders/preint.wgsl`, the fragment at weights
@@ -217,6 +229,7 @@ pub fn fs_main(stage: &PreintTwin, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> 
         &stage.params,
         &stage.table,
         stage.lookup,
+        stage.extended,
         seg.s_f,
         seg.s_b,
         seg.l,
@@ -225,9 +238,10 @@ pub fn fs_main(stage: &PreintTwin, tri: [&SegmentVertex; 3], bary: [f64; 3]) -> 
 
 impl PreintTwin {
     /// The segment `(l, s_f, s_b)` (normalised scalars) through
-    /// [`preint_segment`].
+    /// [`preint_segment`], with the parts outside the node range (the
+    /// isosurface and whole-piece stages are always `EXTENDED`).
     pub fn volume(&self, l: f32, sf: f32, sb: f32) -> [f32; 4] {
-        preint_segment(&self.params, &self.table, self.lookup, sf, sb, l)
+        preint_segment(&self.params, &self.table, self.lookup, true, sf, sb, l)
     }
 
     /// The stage's view and clip mapping.
@@ -251,17 +265,20 @@ impl CpuStage<SegmentVertex> for PreintTwin {
 pub struct PreintMode {
     kind: TableKind,
     stage: &'static StageDesc,
+    /// The stage for fields inside the node range ([`field_inside`]).
+    inside: &'static StageDesc,
     lookup: LookupFn,
     opts: TableOptions,
     stats: Mutex<Option<TableStats>>,
 }
 
 impl PreintMode {
-    /// The mode of `kind` with `stage` and `lookup`, for a render with
+    /// The mode of `kind` with `stage` (and `inside`, the same compiled
+    /// for fields inside the node range) and `lookup`, for a render with
     /// `opts`; a `--table` size no device could hold is refused here.
     pub fn new(
         kind: TableKind,
-        stage: &'static StageDesc,
+        [stage, inside]: [&'static StageDesc; 2],
         lookup: LookupFn,
         opts: &RenderOptions,
     ) -> Result<PreintMode, TableSizeError> {
@@ -274,6 +291,7 @@ impl PreintMode {
         Ok(PreintMode {
             kind,
             stage,
+            inside,
             lookup,
             opts: opts.tables,
             stats: Mutex::new(None),
@@ -284,24 +302,27 @@ impl PreintMode {
     /// render with `opts`.
     pub fn for_mode(mode: super::Mode, opts: &RenderOptions) -> Result<PreintMode, TableSizeError> {
         use super::{preint2d, preint2d_cyl, preint3d, Mode};
-        let (kind, stage, lookup): (TableKind, &'static StageDesc, LookupFn) = match mode {
+        let (kind, stages, lookup): (TableKind, [&'static StageDesc; 2], LookupFn) = match mode {
             Mode::Preint2d => (
                 TableKind::Flat,
-                &preint2d::PREINT2D_STAGE,
+                [&preint2d::PREINT2D_STAGE, &preint2d::PREINT2D_BARE_STAGE],
                 preint2d::table_rgba,
             ),
             Mode::Preint2dCyl => (
                 TableKind::Cylinder,
-                &preint2d_cyl::PREINT2D_CYL_STAGE,
+                [
+                    &preint2d_cyl::PREINT2D_CYL_STAGE,
+                    &preint2d_cyl::PREINT2D_CYL_BARE_STAGE,
+                ],
                 preint2d_cyl::table_rgba,
             ),
             _ => (
                 TableKind::Cube,
-                &preint3d::PREINT3D_STAGE,
+                [&preint3d::PREINT3D_STAGE, &preint3d::PREINT3D_BARE_STAGE],
                 preint3d::table_rgba,
             ),
         };
-        PreintMode::new(kind, stage, lookup, opts)
+        PreintMode::new(kind, stages, lookup, opts)
     }
 
     /// The kind of table it looks up.
@@ -402,6 +423,7 @@ impl PreintMode {
                 data: data.to_vec(),
             }),
             lookup: self.lookup,
+            extended: true,
         }
     }
 }
@@ -410,11 +432,33 @@ impl SegmentMode for PreintMode {
     type Vertex = SegmentVertex;
 
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
-        self.bind_stage(gpu, None, src.whole, src.tf, src.camera, &[])
+        let stage = if field_inside(src) {
+            self.inside
+        } else {
+            self.stage
+        };
+        self.bind_stage(gpu, Some(stage), src.whole, src.tf, src.camera, &[])
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {
-        Box::new(self.twin_for(src.whole, src.tf, src.camera))
+        let mut twin = self.twin_for(src.whole, src.tf, src.camera);
+        twin.extended = !field_inside(src);
+        Box::new(twin)
+    }
+}
+
+/// Whether every scalar of the frame's field lies inside the transfer
+/// function's node range (NaN counts as outside): the normalised scalars
+/// of its segments then leave [0, 1] only by the rounding of their
+/// interpolation, and the table's part is the whole segment, its scalars
+/// clamped (the stage with `EXTENDED` false). A field reaching beyond the
+/// nodes (`--range` narrower than the data) keeps the parts outside.
+pub fn field_inside(src: &PieceSource) -> bool {
+    let (lo, hi) = src.tf.scalar_range();
+    let inside = |v: &f64| (lo..=hi).contains(v);
+    match src.scalars {
+        ScalarsRef::Point(v) | ScalarsRef::Cell(v) => v.iter().all(inside),
+        ScalarsRef::Constant(s) => inside(&s),
     }
 }
 
@@ -510,7 +554,7 @@ mod tests {
                     for &sf in &scalars {
                         for &sb in &scalars {
                             for l in [0.0f32, 1e-12, 0.05, 0.8, 0.9] {
-                                let got = preint_segment(&p, &t, lookup, sf, sb, l);
+                                let got = preint_segment(&p, &t, lookup, true, sf, sb, l);
                                 let want = branched(&p, &t, lookup, sf, sb, l);
                                 assert_eq!(
                                     got.map(f32::to_bits),
@@ -523,5 +567,50 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// For a field inside the node range the stage without the parts
+    /// outside (`EXTENDED` false: one lookup at the clamped scalars) draws
+    /// what the full one does: within 1e-6 wherever both scalars lie in
+    /// [0, 1] (the full stage rebuilds the back scalar as s_f + (s_b - s_f),
+    /// an ulp away at most).
+    #[test]
+    fn inside_stage_matches_the_full_one_inside_the_range() {
+        let kinds: [(TableKind, LookupFn); 3] = [
+            (TableKind::Cube, preint3d::table_rgba),
+            (TableKind::Flat, preint2d::table_rgba),
+            (TableKind::Cylinder, preint2d_cyl::table_rgba),
+        ];
+        let scalars = [0.0f32, 1e-7, 0.2, 0.5, 0.77, 0.999_999, 1.0];
+        let tf = tf(EmissionModel::Glow);
+        let mut worst = 0.0f32;
+        for (kind, lookup) in kinds {
+            let spec = TableSpec::new(kind, Some(9), 0.8).unwrap();
+            let p = PreintParams::new(&tf, &spec);
+            let mut data = vec![0.0; 4 * spec.texels()];
+            fill_cpu(
+                &spec,
+                &tf,
+                TableBuild::Exact,
+                (f64::NEG_INFINITY, f64::INFINITY),
+                &mut data,
+            );
+            let t = CpuTable {
+                size: spec.size,
+                data,
+            };
+            for &sf in &scalars {
+                for &sb in &scalars {
+                    for l in [0.0f32, 1e-12, 0.05, 0.8] {
+                        let full = preint_segment(&p, &t, lookup, true, sf, sb, l);
+                        let inside = preint_segment(&p, &t, lookup, false, sf, sb, l);
+                        for k in 0..4 {
+                            worst = worst.max((full[k] - inside[k]).abs());
+                        }
+                    }
+                }
+            }
+        }
+        assert!(worst <= 1e-6, "{worst}");
     }
 }
