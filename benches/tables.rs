@@ -5,7 +5,7 @@
 //! `cargo bench --bench tables`. Transfer functions built in code (a
 //! 7-node TF with a jump, extinction up to 8 per unit length; and the
 //! default viridis/ramp TF); segments from a fixed-seed generator. Build
-//! times are wall times (the GPU build: dispatch, copy into the texture
+//! times are wall times (the GPU build: dispatch into the table's buffer
 //! and the wait for the device; the CPU builds on all cores). The error
 //! curve uses each mode's CPU twin (`f32`, the shader's arithmetic) at
 //! 20000 random segments `(s_f, s_b, l)`, `s in [0, 1]`,
