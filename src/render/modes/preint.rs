@@ -45,6 +45,34 @@ use super::preint_tables::{
 };
 use super::segment::{segment_at, SegmentMode, SegmentVertex, SegmentView};
 
+/// A table mode's stage `$name`: the segment vertex and view, the program
+/// the table modes share (`shaders/preint.wgsl`) and the mode's lookup
+/// `shaders/$file`, with the values `$constants` of its `override`
+/// constants.
+macro_rules! preint_stage {
+    ($name:literal, $file:literal, $constants:expr) => {
+        $crate::gpu::StageDesc {
+            name: $name,
+            fragment: "fs_main",
+            wgsl: concat!(
+                include_str!("../../../shaders/segment_vertex.wgsl"),
+                include_str!("../../../shaders/segment_view.wgsl"),
+                include_str!("../../../shaders/segment.wgsl"),
+                include_str!("../../../shaders/preint.wgsl"),
+                include_str!(concat!("../../../shaders/", $file)),
+            ),
+            vertex: $crate::render::modes::segment::SegmentVertex::LAYOUT,
+            bindings: &[
+                $crate::gpu::Binding::Uniform,
+                $crate::gpu::Binding::Table,
+                $crate::gpu::Binding::Uniform,
+            ],
+            constants: $constants,
+        }
+    };
+}
+pub(crate) use preint_stage;
+
 /// The parameters of the table stages. Keep in sync with `PreintParams` in
 /// `shaders/preint.wgsl`.
 #[repr(C)]

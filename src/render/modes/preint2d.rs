@@ -23,12 +23,11 @@
 //! `table_rgba` in `shaders/preint2d.wgsl`). `--table N` sets the samples
 //! per scalar axis (default 512: the table is small).
 
-use crate::gpu::{Binding, StageDesc};
+use crate::gpu::StageDesc;
 use crate::raycast::FieldModel;
 use crate::tf::EmissionModel;
 
-use super::preint::{axis, lerp4, one_minus_exp_over, CpuTable, PreintParams};
-use super::segment::SegmentVertex;
+use super::preint::{axis, lerp4, one_minus_exp_over, preint_stage, CpuTable, PreintParams};
 use super::{Bounds, ModeInfo};
 
 /// The registry entry of the preint2d mode.
@@ -58,34 +57,16 @@ pub static INFO: ModeInfo = ModeInfo {
 };
 
 /// The preint2d stage.
-pub static PREINT2D_STAGE: StageDesc = preint2d_stage("preint2d.wgsl", &[]);
+pub static PREINT2D_STAGE: StageDesc = preint_stage!("preint2d.wgsl", "preint2d.wgsl", &[]);
 
 /// The preint2d stage compiled for fields inside the transfer function's
 /// node range (`EXTENDED` false in `shaders/preint.wgsl`: each segment one
 /// lookup at its clamped scalars, no parts outside).
-pub static PREINT2D_BARE_STAGE: StageDesc =
-    preint2d_stage("preint2d.wgsl+inside", &[("EXTENDED", 0.0)]);
-
-/// The preint2d WGSL as the stage `name` with `constants`.
-const fn preint2d_stage(
-    name: &'static str,
-    constants: &'static [(&'static str, f64)],
-) -> StageDesc {
-    StageDesc {
-        name,
-        fragment: "fs_main",
-        wgsl: concat!(
-            include_str!("../../../shaders/segment_vertex.wgsl"),
-            include_str!("../../../shaders/segment_view.wgsl"),
-            include_str!("../../../shaders/segment.wgsl"),
-            include_str!("../../../shaders/preint.wgsl"),
-            include_str!("../../../shaders/preint2d.wgsl"),
-        ),
-        vertex: SegmentVertex::LAYOUT,
-        bindings: &[Binding::Uniform, Binding::Table, Binding::Uniform],
-        constants,
-    }
-}
+pub static PREINT2D_BARE_STAGE: StageDesc = preint_stage!(
+    "preint2d.wgsl+inside",
+    "preint2d.wgsl",
+    &[("EXTENDED", 0.0)]
+);
 
 /// Twin of `texel2d`: texel `(i, j)` of the table's storage buffer.
 #[inline]

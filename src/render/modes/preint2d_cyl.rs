@@ -25,12 +25,11 @@
 //! samples that the 3D table spends on one axis. Glow and independent
 //! emission are both tabulated.
 
-use crate::gpu::{Binding, StageDesc};
+use crate::gpu::StageDesc;
 use crate::raycast::FieldModel;
 use crate::tf::EmissionModel;
 
-use super::preint::{axis, lerp4, CpuTable, PreintParams};
-use super::segment::SegmentVertex;
+use super::preint::{axis, lerp4, preint_stage, CpuTable, PreintParams};
 use super::{Bounds, ModeInfo};
 
 /// The registry entry of the preint2d-cyl mode.
@@ -59,34 +58,17 @@ pub static INFO: ModeInfo = ModeInfo {
 };
 
 /// The preint2d-cyl stage.
-pub static PREINT2D_CYL_STAGE: StageDesc = preint2d_cyl_stage("preint2d_cyl.wgsl", &[]);
+pub static PREINT2D_CYL_STAGE: StageDesc =
+    preint_stage!("preint2d_cyl.wgsl", "preint2d_cyl.wgsl", &[]);
 
 /// The preint2d-cyl stage compiled for fields inside the transfer function's
 /// node range (`EXTENDED` false in `shaders/preint.wgsl`: each segment one
 /// lookup at its clamped scalars, no parts outside).
-pub static PREINT2D_CYL_BARE_STAGE: StageDesc =
-    preint2d_cyl_stage("preint2d_cyl.wgsl+inside", &[("EXTENDED", 0.0)]);
-
-/// The preint2d-cyl WGSL as the stage `name` with `constants`.
-const fn preint2d_cyl_stage(
-    name: &'static str,
-    constants: &'static [(&'static str, f64)],
-) -> StageDesc {
-    StageDesc {
-        name,
-        fragment: "fs_main",
-        wgsl: concat!(
-            include_str!("../../../shaders/segment_vertex.wgsl"),
-            include_str!("../../../shaders/segment_view.wgsl"),
-            include_str!("../../../shaders/segment.wgsl"),
-            include_str!("../../../shaders/preint.wgsl"),
-            include_str!("../../../shaders/preint2d_cyl.wgsl"),
-        ),
-        vertex: SegmentVertex::LAYOUT,
-        bindings: &[Binding::Uniform, Binding::Table, Binding::Uniform],
-        constants,
-    }
-}
+pub static PREINT2D_CYL_BARE_STAGE: StageDesc = preint_stage!(
+    "preint2d_cyl.wgsl+inside",
+    "preint2d_cyl.wgsl",
+    &[("EXTENDED", 0.0)]
+);
 
 /// Equation 10 in `f32`, as the shader computes it: `(a, u)` of the
 /// normalised segment (`v` is `S_b`).

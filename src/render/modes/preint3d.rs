@@ -20,12 +20,11 @@
 //! `l = 0`). The table holds any source term, so glow and independent
 //! emission are both drawn.
 
-use crate::gpu::{Binding, StageDesc};
+use crate::gpu::StageDesc;
 use crate::raycast::FieldModel;
 use crate::tf::EmissionModel;
 
-use super::preint::{axis, lerp4, CpuTable, PreintParams};
-use super::segment::SegmentVertex;
+use super::preint::{axis, lerp4, preint_stage, CpuTable, PreintParams};
 use super::{Bounds, ModeInfo};
 
 /// The registry entry of the preint3d mode.
@@ -55,34 +54,16 @@ pub static INFO: ModeInfo = ModeInfo {
 };
 
 /// The preint3d stage.
-pub static PREINT3D_STAGE: StageDesc = preint3d_stage("preint3d.wgsl", &[]);
+pub static PREINT3D_STAGE: StageDesc = preint_stage!("preint3d.wgsl", "preint3d.wgsl", &[]);
 
 /// The preint3d stage compiled for fields inside the transfer function's
 /// node range (`EXTENDED` false in `shaders/preint.wgsl`: each segment one
 /// lookup at its clamped scalars, no parts outside).
-pub static PREINT3D_BARE_STAGE: StageDesc =
-    preint3d_stage("preint3d.wgsl+inside", &[("EXTENDED", 0.0)]);
-
-/// The preint3d WGSL as the stage `name` with `constants`.
-const fn preint3d_stage(
-    name: &'static str,
-    constants: &'static [(&'static str, f64)],
-) -> StageDesc {
-    StageDesc {
-        name,
-        fragment: "fs_main",
-        wgsl: concat!(
-            include_str!("../../../shaders/segment_vertex.wgsl"),
-            include_str!("../../../shaders/segment_view.wgsl"),
-            include_str!("../../../shaders/segment.wgsl"),
-            include_str!("../../../shaders/preint.wgsl"),
-            include_str!("../../../shaders/preint3d.wgsl"),
-        ),
-        vertex: SegmentVertex::LAYOUT,
-        bindings: &[Binding::Uniform, Binding::Table, Binding::Uniform],
-        constants,
-    }
-}
+pub static PREINT3D_BARE_STAGE: StageDesc = preint_stage!(
+    "preint3d.wgsl+inside",
+    "preint3d.wgsl",
+    &[("EXTENDED", 0.0)]
+);
 
 /// Twin of `texel3d`: texel `(i, j, k)` of the table's storage buffer.
 #[inline]
