@@ -27,6 +27,32 @@ pub struct ScalarField {
     pub values: Vec<f64>,
     /// Min and max of the finite values (`(0, 0)` when none).
     pub range: (f64, f64),
+    /// Whether every value is finite (no NaN, no infinity): `range` is
+    /// then the min and max of all of them ([`ScalarField::span`]).
+    pub all_finite: bool,
+}
+
+impl ScalarField {
+    /// The field of `values`, with its range and finiteness computed once
+    /// (one pass), so that per-frame questions about the whole field
+    /// ([`ScalarField::span`]) cost nothing.
+    pub fn new(name: String, association: Association, values: Vec<f64>) -> ScalarField {
+        let range = finite_range(&values);
+        let all_finite = values.iter().all(|v| v.is_finite());
+        ScalarField {
+            name,
+            association,
+            values,
+            range,
+            all_finite,
+        }
+    }
+
+    /// Min and max of every value, or `None` where some value is not
+    /// finite.
+    pub fn span(&self) -> Option<(f64, f64)> {
+        self.all_finite.then_some(self.range)
+    }
 }
 
 /// Errors selecting a field.
@@ -161,13 +187,7 @@ fn extract(
             arr.name.clone(),
         ),
     };
-    let range = finite_range(&values);
-    Ok(ScalarField {
-        name,
-        association: assoc,
-        values,
-        range,
-    })
+    Ok(ScalarField::new(name, assoc, values))
 }
 
 /// Min and max of the finite values, `(0, 0)` when there are none.
@@ -318,18 +338,24 @@ pub fn cell_to_point(mesh: &Mesh, field: &ScalarField) -> ScalarField {
         .zip(&cnt)
         .map(|(s, &n)| if n > 0 { s / n as f64 } else { 0.0 })
         .collect();
-    let range = finite_range(&values);
-    ScalarField {
-        name: field.name.clone(),
-        association: Association::Point,
-        values,
-        range,
-    }
+    ScalarField::new(field.name.clone(), Association::Point, values)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn span_is_every_value_or_none() {
+        let f = |v: Vec<f64>| ScalarField::new("f".into(), Association::Point, v);
+        assert_eq!(f(vec![2.0, -1.0, 5.0]).span(), Some((-1.0, 5.0)));
+        assert_eq!(f(vec![]).span(), Some((0.0, 0.0)));
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let g = f(vec![2.0, bad, 5.0]);
+            assert_eq!(g.range, (2.0, 5.0), "the finite range stays");
+            assert_eq!(g.span(), None, "{bad}");
+        }
+    }
 
     #[test]
     fn parse_specs() {

@@ -50,15 +50,12 @@ fn step(geometry: &Geometry, first: &Shading, k: usize) -> Shading {
         .iter()
         .map(|p| (p.x * 1.3 + p.y * 0.4 + phase).sin() + p.z * 0.2)
         .collect();
-    let lo = values.iter().cloned().fold(f64::INFINITY, f64::min);
-    let hi = values.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     Shading {
-        field: Some(Arc::new(ScalarField {
-            name: format!("step{k}"),
-            association: Association::Point,
+        field: Some(Arc::new(ScalarField::new(
+            format!("step{k}"),
+            Association::Point,
             values,
-            range: (lo, hi),
-        })),
+        ))),
         ..first.clone()
     }
 }
@@ -102,12 +99,11 @@ fn a_field_of_another_mesh_is_a_typed_error() {
     let geometry = geometry();
     let mut shading = Shading::build(&geometry, &SceneSpec::default()).unwrap();
     let n = geometry.mesh.points.len();
-    shading.field = Some(Arc::new(ScalarField {
-        name: "short".into(),
-        association: Association::Point,
-        values: vec![0.0; n - 1],
-        range: (0.0, 0.0),
-    }));
+    shading.field = Some(Arc::new(ScalarField::new(
+        "short".into(),
+        Association::Point,
+        vec![0.0; n - 1],
+    )));
     for mode in [Mode::Exact, Mode::Raycast] {
         let err = Renderer::new(geometry.clone())
             .render(&shading, &options(mode), |_, _| {})

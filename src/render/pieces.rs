@@ -64,6 +64,10 @@ pub struct PieceSource<'a> {
     /// which cells are sorted.
     pub whole: &'a Mesh,
     pub scalars: ScalarsRef<'a>,
+    /// Min and max of every scalar of the field (the whole field's, also
+    /// for a visible subset), `None` where some value is not finite
+    /// ([`super::Scene::field_span`]).
+    pub field_span: Option<(f64, f64)>,
     pub tf: &'a TransferFunction,
     pub camera: &'a Camera,
     /// TF values where extinction kinks or jumps, or colour jumps

@@ -261,7 +261,10 @@ fn build(scene: &Scene, dark: &[bool]) -> (Option<VisibleSubset>, usize) {
                 .iter()
                 .map(|&c| f.values.get(c as usize).copied().unwrap_or(f64::NAN))
                 .collect(),
+            // The whole field's: the subset's values are some of its
+            // values, so a span holding all of them holds the subset's.
             range: f.range,
+            all_finite: f.all_finite && old_id.iter().all(|&c| (c as usize) < f.values.len()),
         })),
         _ => None,
     };

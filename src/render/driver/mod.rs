@@ -680,6 +680,7 @@ pub fn render_projected<M: ProjectedMode>(
         mesh: &scene.mesh,
         whole,
         scalars: scene.scalars(),
+        field_span: scene.field_span(),
         tf: &scene.tf,
         camera,
         breakpoints: &breakpoints,

@@ -21,6 +21,7 @@ pub(crate) fn test_ctx<'a>(
         mesh: &scene.mesh,
         whole: &scene.mesh,
         scalars: scene.scalars(),
+        field_span: scene.field_span(),
         tf: &scene.tf,
         camera,
         breakpoints,

@@ -36,7 +36,6 @@ use crate::camera::Camera;
 use crate::gpu::cpu::CpuStage;
 use crate::gpu::{ClipMapper, Context, GpuError, Resource, Stage, StageDesc, Table};
 use crate::render::pieces::PieceSource;
-use crate::render::scene::ScalarsRef;
 use crate::render::{Compositor, RenderOptions, TableBuild, TableOptions};
 use crate::tf::{EmissionModel, TransferFunction};
 
@@ -480,14 +479,13 @@ impl SegmentMode for PreintMode {
 /// of its segments then leave [0, 1] only by the rounding of their
 /// interpolation, and the table's part is the whole segment, its scalars
 /// clamped (the stage with `EXTENDED` false). A field reaching beyond the
-/// nodes (`--range` narrower than the data) keeps the parts outside.
+/// nodes (`--range` narrower than the data) keeps the parts outside. The
+/// field's span is computed once with the field ([`crate::field::ScalarField::span`]),
+/// so the question costs nothing per frame.
 pub fn field_inside(src: &PieceSource) -> bool {
     let (lo, hi) = src.tf.scalar_range();
-    let inside = |v: &f64| (lo..=hi).contains(v);
-    match src.scalars {
-        ScalarsRef::Point(v) | ScalarsRef::Cell(v) => v.iter().all(inside),
-        ScalarsRef::Constant(s) => inside(&s),
-    }
+    src.field_span
+        .is_some_and(|(min, max)| lo <= min && max <= hi)
 }
 
 #[cfg(test)]
