@@ -1,8 +1,7 @@
 //! Isosurfaces: frame time against the number of isovalues (1, 2, 10, 100,
 //! spread over the field's range), alone (`--mode iso`) and mixed with the
-//! volume (`--iso` with exact-frag, and with exact, which slices the cells
-//! at every isovalue so that its cost grows with them), on bluntfin (default field, TF and
-//! camera; skipped when the shared data is absent) and a generated 40^3
+//! volume (`--iso` with exact-frag; the exact mode with surfaces draws
+//! the same frame), on bluntfin (default field, TF and camera; skipped when the shared data is absent) and a generated 40^3
 //! warped hex grid, at 512^2 on the default adapter. The fragment visits
 //! only the isovalues its segment crosses, so the time should stay flat in
 //! their number; `--mode iso` skips the pieces whose range holds no
@@ -103,7 +102,7 @@ fn bench(c: &mut Criterion) {
                 );
             }
         }
-        for mode in [Mode::Iso, Mode::ExactFrag, Mode::Exact] {
+        for mode in [Mode::Iso, Mode::ExactFrag] {
             for n in [1, 2, 10, 100] {
                 let opts = options(mode, isovalues(n, scene.range));
                 group.bench_function(format!("{name}/{mode}/{n}"), |b| {

@@ -2,7 +2,7 @@
 // 2D table of alpha = 1 - exp(-l tau) with its warped, bilinear lookup
 // `alpha_of` (src/render/modes/exact/exptable.rs documents range, warp and
 // clamping; its `ExpTable::alpha_of` is the CPU twin). Put in front of
-// shaders/exact.wgsl and shaders/exact_iso.wgsl.
+// shaders/exact.wgsl.
 
 // Keep in sync with `ExactParams` in src/render/modes/exact/mod.rs.
 struct Params {

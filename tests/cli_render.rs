@@ -484,17 +484,19 @@ fn table_modes_flags_stats_and_refused_sizes() {
         args.extend_from_slice(extra);
         zoovr(&args)
     };
-    for n in ["0", "1", "1000"] {
-        // 1000: 16 GiB of texels, over zoovr's 4 GiB and over any
-        // adapter's storage buffer (whichever is checked first: the
-        // adapter's where a GPU draws).
+    for n in ["0", "1", "x", "1000"] {
+        // 0, 1 and x: usage errors (exit 2). 1000: 16 GiB of texels, over
+        // zoovr's 4 GiB and over any adapter's storage buffer (whichever
+        // is checked first: the adapter's where a GPU draws), exit 1.
         let o = run(&["--mode", "preint3d", "--table", n]);
-        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        let code = if n == "1000" { 1 } else { 2 };
+        assert_eq!(o.status.code(), Some(code), "{n}: {}", stderr(&o));
         let e = stderr(&o);
         let ok = match n {
             "1000" => {
                 e.contains("(4 GiB) zoovr allows") || e.contains("storage buffer of this adapter")
             }
+            "x" => e.contains("not a whole number"),
             _ => e.contains("at least 2"),
         };
         assert!(ok, "{n}: {e}");

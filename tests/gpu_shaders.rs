@@ -15,9 +15,8 @@ use zoovr::render::Mode;
 fn stages() -> Vec<&'static StageDesc> {
     let mut v: Vec<&'static StageDesc> = Mode::ALL.iter().filter_map(|m| m.info().stage).collect();
     v.push(&LAYER_STAGE);
-    // The isosurface stages over each volume, and the exact mode's.
+    // The isosurface stages over each volume.
     v.extend([
-        &zoovr::render::modes::exact_iso::EXACT_ISO_STAGE,
         &iso::ISO_EXACT_FRAG_STAGE,
         &iso::ISO_PREINT3D_STAGE,
         &iso::ISO_PREINT2D_STAGE,

@@ -308,9 +308,8 @@ fn run(case: Case, gpu: bool) {
             surfaces: zoovr::render::iso::parse_list(&list).unwrap(),
             ..Default::default()
         };
-        // The exact mode slices the cells holding an isovalue into tets:
-        // its surfaces are the `tets` field's, drawn with `--split all`.
-        // Whole cells are compared outside the pixels of the cells the
+        // The exact mode with surfaces integrates per fragment, as
+        // exact-frag, split or whole. Whole cells are compared outside the pixels of the cells the
         // order drew as tets (cells with nonplanar faces: their surfaces
         // are the `tets` field's, a model difference), split ones
         // everywhere.
@@ -319,6 +318,7 @@ fn run(case: Case, gpu: bool) {
             (Mode::Iso, true, true),
             (Mode::ExactFrag, false, false),
             (Mode::ExactFrag, false, true),
+            (Mode::Exact, false, false),
             (Mode::Exact, false, true),
         ] {
             let model = if split {

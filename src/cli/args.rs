@@ -68,6 +68,21 @@ pub fn parse_positive(s: &str) -> Result<f64, String> {
     Ok(v)
 }
 
+/// Parses `--table N`: an integer of at least 2 (a table interpolates
+/// between samples); what an adapter can hold is checked when it draws.
+pub fn parse_table_size(s: &str) -> Result<u32, String> {
+    let n: u32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("not a whole number of samples: '{s}'"))?;
+    if n < 2 {
+        return Err(format!(
+            "--table {n}: a table needs at least 2 samples per axis"
+        ));
+    }
+    Ok(n)
+}
+
 /// Parses a comma-separated list of finite floats.
 pub fn parse_floats(s: &str) -> Result<Vec<f64>, String> {
     s.split(',').map(parse_finite).collect()

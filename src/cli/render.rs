@@ -16,7 +16,7 @@ use zoovr::render::{
 
 use zoovr::render::iso::{IsoMix, IsoOptions, IsoSpec, Lighting};
 
-use super::args::{parse_finite, parse_positive, parse_rgb, parse_size};
+use super::args::{parse_finite, parse_positive, parse_rgb, parse_size, parse_table_size};
 use super::scene::SceneArgs;
 
 /// The parsed `--iso` list.
@@ -89,7 +89,7 @@ pub struct ViewArgs {
     /// At least 2; at most what one storage buffer of the adapter holds
     /// (128 MiB on lavapipe and GL llvmpipe: N = 203 for preint3d, 161 for
     /// preint2d-cyl, 2896 for preint2d) and 2^28 texels.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = parse_table_size)]
     pub table: Option<u32>,
     /// How the pre-integrated tables are built: auto (the GPU compute pass
     /// when drawing on a GPU, else exact), exact (exact integrals on the CPU), fast
@@ -101,10 +101,11 @@ pub struct ViewArgs {
     ///
     /// Drawn alone by --mode iso, mixed with the volume in the exact order
     /// by exact, exact-frag, preint3d, preint2d, preint2d-cyl and raycast
-    /// (any --model and --traversal; exact slices the cells at each
-    /// isovalue, as at the transfer function's breakpoints, so its cost
-    /// grows with the surfaces a cell holds; the others find the crossings
-    /// per fragment). COLOUR is #rrggbb or `tf` (the
+    /// (any --model and --traversal). The projected modes find the
+    /// crossings per fragment between the segment's end scalars, on whole
+    /// cells; with surfaces, exact integrates per fragment as exact-frag
+    /// does (its vertex integrals cannot hold a crossing inside a
+    /// segment). COLOUR is #rrggbb or `tf` (the
     /// transfer function's colour at V, the default); OPACITY in [0, 1]
     /// (default 1, opaque). The front side is the one a ray meets while
     /// the field rises; the back side takes the front's style unless

@@ -114,31 +114,16 @@ fn iso_mode(scene: &Scene, opts: &RenderOptions) -> Result<modes::iso::IsoMode, 
     let set = iso::IsoSet::new(&opts.iso, &scene.tf);
     let volume = match opts.mode {
         _ if opts.iso.alone => Volume::None,
-        Mode::Iso | Mode::Exact => Volume::None, // Exact: --iso-only
-        Mode::ExactFrag => Volume::Integral,
+        Mode::Iso => Volume::None,
+        // The exact mode's vertex integrals cannot hold a crossing inside
+        // a segment: with surfaces its frame integrates per fragment, the
+        // same closed form, on whole cells (module docs of `modes::iso`).
+        Mode::Exact | Mode::ExactFrag => Volume::Integral,
         m => Volume::Table(modes::preint::PreintMode::for_mode(m, opts)?),
     };
     let grads = (set.lighting == iso::Lighting::Smooth)
         .then(|| gradients::point_gradients(&scene.mesh, values));
     Ok(IsoMode::new(volume, set, grads))
-}
-
-/// The exact mode with the isosurfaces of `opts.iso` mixed in
-/// ([`modes::exact_iso`]).
-fn exact_iso_mode(
-    scene: &Scene,
-    opts: &RenderOptions,
-) -> Result<modes::exact_iso::ExactIsoMode, RenderError> {
-    let ScalarsRef::Point(values) = scene.scalars() else {
-        return Err(iso::IsoError::CellData.into());
-    };
-    let set = iso::IsoSet::new(&opts.iso, &scene.tf);
-    let grads = (set.lighting == iso::Lighting::Smooth)
-        .then(|| gradients::point_gradients(&scene.mesh, values));
-    let exact = modes::exact::ExactMode {
-        refine_tol: opts.projected.refine_tol,
-    };
-    Ok(modes::exact_iso::ExactIsoMode::new(exact, set, grads))
 }
 
 /// State reused across frames of one geometry: the geometry itself, the
@@ -310,10 +295,6 @@ impl Renderer {
         // The frame's scene: the geometry and the field shared, not copied.
         let scene = Scene::new(self.geometry.clone(), shading.clone());
         let (image, detail, setup_s) = match opts.mode {
-            Mode::Exact if opts.iso.any() && !opts.iso.alone => {
-                let mode = exact_iso_mode(&scene, opts)?;
-                self.projected(&mode, &scene, opts, camera, progress)?
-            }
             Mode::Iso if !opts.iso.any() => return Err(RenderError::IsoMissing),
             Mode::Iso
             | Mode::Exact

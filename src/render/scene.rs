@@ -315,7 +315,9 @@ impl Scene {
     /// Min and max of every scalar integrated (computed with the field,
     /// not per call), or `None` where some value is not finite.
     pub fn field_span(&self) -> Option<(f64, f64)> {
-        self.field.as_deref().map_or(Some((0.0, 0.0)), ScalarField::span)
+        self.field
+            .as_deref()
+            .map_or(Some((0.0, 0.0)), ScalarField::span)
     }
 
     /// The scene as the reference ray caster takes it (mesh, topology and

@@ -26,7 +26,6 @@
 
 pub mod exact;
 pub mod exact_frag;
-pub mod exact_iso;
 pub mod integral;
 pub mod iso;
 pub mod iso_levels;
@@ -189,10 +188,6 @@ impl std::str::FromStr for Mode {
 pub const SHADERS: &[(&str, &str)] = &[
     ("common.wgsl", crate::gpu::stage::COMMON_WGSL),
     ("exact.wgsl", include_str!("../../../shaders/exact.wgsl")),
-    (
-        "exact_iso.wgsl",
-        include_str!("../../../shaders/exact_iso.wgsl"),
-    ),
     (
         "exptable.wgsl",
         include_str!("../../../shaders/exptable.wgsl"),

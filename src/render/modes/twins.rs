@@ -32,8 +32,8 @@ use std::any::type_name_of_val as path;
 use super::exact::exptable::{self, ExpTable};
 use super::integral::{self, TfBuffer};
 use super::{
-    exact, exact_frag, exact_iso, iso, piece_quad, preint, preint2d, preint2d_cyl, preint3d,
-    segment, segment_view, table_build,
+    exact, exact_frag, iso, piece_quad, preint, preint2d, preint2d_cyl, preint3d, segment,
+    segment_view, table_build,
 };
 use crate::gpu::{common, layer};
 use crate::integrate::cylinder;
@@ -73,7 +73,6 @@ pub fn stage_twins() -> Vec<StageTwins> {
     vec![
         twins!("common.wgsl": common::piece_depth, common::finite, common::count_of),
         twins!("exact.wgsl": exact::fs_main),
-        twins!("exact_iso.wgsl": exact_iso::exact_iso_light, exact_iso::fs_main),
         twins!("exptable.wgsl":
             exptable::log1p_, exptable::coord, ExpTable::texel, ExpTable::alpha_of),
         twins!("exact_frag.wgsl": exact_frag::fs_main),
