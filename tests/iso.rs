@@ -572,8 +572,10 @@ const MAX_OFF: usize = 3;
 /// does), so its plain image is exact-frag's; `--split all` as well. The
 /// wide triangles whose scalars reach the value take the exact triangle's
 /// values at their snapped corners (src/render/ties), which moves the
-/// volume's colour there by up to 9.0e-5 (measured): `STEEP_COLOUR_TOL`.
+/// volume's colour there by up to 9.0e-5 (measured; 2.4e-4 where the GPU
+/// accumulates in f16): `STEEP_COLOUR_TOL`, `STEEP_COLOUR_TOL_F16`.
 const STEEP_COLOUR_TOL: f64 = 2e-4;
+const STEEP_COLOUR_TOL_F16: f64 = 1e-3;
 
 #[test]
 fn isovalues_at_the_field_extremes() {
@@ -597,7 +599,12 @@ fn isovalues_at_the_field_extremes() {
                     "isovalue {v} {mode} {c:?}: {} off, max {max:.2e} elsewhere",
                     off.len()
                 );
-                assert!(max <= STEEP_COLOUR_TOL, "{v} {mode}: {max:.3e}");
+                let tol = if f16(c) {
+                    STEEP_COLOUR_TOL_F16
+                } else {
+                    STEEP_COLOUR_TOL
+                };
+                assert!(max <= tol, "{v} {mode}: {max:.3e}");
                 assert!(
                     off.len() <= if v == lo { 0 } else { 2 },
                     "{v} {mode}: {off:?}"
