@@ -48,6 +48,54 @@ fn surfaces_render_alone_and_mixed() {
     }
 }
 
+/// With surfaces the exact mode draws exact-frag's frame (its vertex
+/// integrals cannot hold a crossing inside a segment): the same image,
+/// byte for byte, on whole cells and split into tets; split, it agrees
+/// with `--mode raycast --model tets --iso` (the same field; zoo_3x3x3's
+/// nonplanar faces make its whole cells' field differ from `faces`).
+#[test]
+fn the_exact_mode_with_surfaces_is_exact_frags_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = mesh_file("zoo_3x3x3.vtu");
+    let args = ["--iso", "0.5:tf:0.6", "--size", "80x64", "--azimuth", "30"];
+    let run = |name: &str, extra: &[&str]| -> Option<std::path::PathBuf> {
+        let out = dir.path().join(format!("{name}.png"));
+        let mut a: Vec<&str> = extra.to_vec();
+        a.extend(args);
+        let o = render(&file, &out, &a);
+        if no_adapter(&o) {
+            return None;
+        }
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        Some(out)
+    };
+    for split in [&[][..], &["--split", "all"][..]] {
+        let mut exact = vec!["--mode", "exact"];
+        exact.extend(split);
+        let mut frag = vec!["--mode", "exact-frag"];
+        frag.extend(split);
+        let (Some(a), Some(b)) = (run("exact", &exact), run("exact-frag", &frag)) else {
+            return;
+        };
+        assert!(
+            std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+            "{split:?}: exact --iso differs from exact-frag --iso"
+        );
+    }
+    let reference = run("raycast", &["--mode", "raycast", "--model", "tets"]).unwrap();
+    let a = Image::read(&dir.path().join("exact.png")).unwrap();
+    let r = Image::read(&reference).unwrap();
+    let worst = a
+        .pixels
+        .iter()
+        .zip(&r.pixels)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+        .fold(0.0f32, f32::max);
+    // Linear values of 8-bit PNGs: within 2/255 of the reference's at
+    // every pixel.
+    assert!(worst <= 2.0 / 255.0, "{worst}");
+}
+
 /// The reference draws surfaces with every field model and traversal: the
 /// native field and the brute force, mixed with the volume and alone, in
 /// both lights and both mixes.
