@@ -44,8 +44,9 @@ const ISO_OFF_MAX: usize = 8;
 /// `f64` values in its range (one ulp is 2.2e-4 of it), and the ray caster
 /// interpolates the raw values, so its crossings move by ulps (and by the
 /// level's margin, `ISO_LEVEL_ULPS` ulps) where the GPU stages interpolate
-/// the normalised scalars in `f32` (6e-8 of the range). The exact mode,
-/// which slices at the reference's own levels, is within 1 pixel.
+/// the normalised scalars in `f32` (6e-8 of the range). (The exact mode,
+/// which sliced its cells at the reference's own levels, was within 1
+/// pixel; it now draws exact-frag's frame with surfaces.)
 const ISO_GAPS: &[(&str, usize, usize, &str)] = &[
     (
         "range_1e-12",
