@@ -137,7 +137,8 @@ pub struct ViewArgs {
     /// Exact mode: colour refinement tolerance (default 0.004). A region
     /// triangle whose optical depth times glow spread exceeds T is split
     /// at its edge midpoints (up to 6 levels): lower is slower and closer
-    /// to the ray caster, higher draws fewer triangles.
+    /// to the ray caster, higher draws fewer triangles. Not used with
+    /// --iso (the exact mode then integrates per fragment, see --iso).
     #[arg(long, value_name = "T", value_parser = parse_positive)]
     pub refine_tol: Option<f64>,
     /// exact-frag and the table modes (preint3d, preint2d, preint2d-cyl):
