@@ -92,15 +92,17 @@
 //! decided.
 
 mod band;
+mod scan;
 
 use glam::{DVec2, DVec3};
 
-use band::{centres_within, in_grown_triangle, inside_by_float, near_centres, near_edge};
+use band::{inside_by_float, near_centres, near_edge};
+pub use scan::scan_triangles;
 
 use crate::camera::Camera;
 use crate::gpu::{GpuVertex, SUBPIXEL};
 use crate::numeric::tolerance::{
-    ISO_SLIVER_REL, PLUCKER_FILTER_K, RASTER_FILTER_MAX_COORD_PX, RASTER_FILTER_PX, THIN_OUTLINE_PX,
+    PLUCKER_FILTER_K, RASTER_FILTER_MAX_COORD_PX, RASTER_FILTER_PX, THIN_OUTLINE_PX,
 };
 use crate::projection::coverage::PixelGrid;
 use crate::projection::{Polyhedron, Projected, RegionVertex};
@@ -543,14 +545,6 @@ impl PartTriangles<'_> {
     }
 }
 
-/// The distance from `s` to the nearest of the sorted `values`.
-fn to_nearest(values: &[f64], s: f64) -> f64 {
-    let k = values.partition_point(|&v| v < s);
-    let above = values.get(k).map_or(f64::INFINITY, |&v| v - s);
-    let below = k.checked_sub(1).map_or(f64::INFINITY, |k| s - values[k]);
-    above.min(below)
-}
-
 /// Decides the centres near the part's outline (see the module docs) into
 /// `scratch.decisions`: the pixels where a quad must be drawn first. The
 /// sliver centres are those [`scan_triangles`] (with `slivers`) left in
@@ -731,172 +725,6 @@ fn outline_centres(
             }
         }
     }
-}
-
-/// One pass over the part's exact triangles for what the snap of their
-/// corners can do: marks the [`snap_is_steep`] ones (`scratch.steep[k]`
-/// for `part.exact[k]`), and with `slivers` (the tie decisions, which
-/// read them) collects the centres inside (or within the band of) the
-/// sliver triangles where the snap could move the thickness by more than
-/// [`SLIVER_DEPTH_TOL`] over the rate. One pass serves both: the same
-/// widths and thickness changes decide them.
-pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScratch) {
-    let pos = |i: u32| part.proj.vertices[i as usize].pos();
-    let (out, near, steep) = (&mut scratch.forced, &mut scratch.near, &mut scratch.steep);
-    out.clear();
-    steep.clear();
-    steep.resize(part.exact.len(), false);
-    // A triangle's thickness changes by at most the part's, so the bound
-    // on the rate and the part's thickness range bound the width below
-    // which the snap can matter in a sliver, and whether a wider
-    // triangle can be steep; most parts of a fine mesh (thin, or
-    // optically thin) have neither.
-    let (l_lo, l_hi) = part.l_range;
-    let reach = part.rate_bound * (l_hi - l_lo) * SNAP_PX / SLIVER_DEPTH_TOL;
-    // NaN stays NaN: no triangle is narrower.
-    let widest = if !slivers {
-        0.0
-    } else if part.isovalues.is_empty() {
-        reach.clamp(0.0, SLIVER_TIE_PX)
-    } else {
-        SLIVER_TIE_PX
-    };
-    // False for NaN too. With isovalues any wide triangle whose scalars
-    // reach one may be steep (below).
-    let may_be_steep = reach > SLIVER_TIE_PX || !part.isovalues.is_empty();
-    if !(widest > 0.0 || may_be_steep) {
-        return;
-    }
-    // Every exact triangle, also those whose snapped corners collapse (a
-    // sliver a few thousandths of a pixel wide on the steep side of a face
-    // seen nearly edge-on, dropped as flat on the grid, whose centres the
-    // neighbouring triangle then takes with its own, far different,
-    // values).
-    for (n, t) in part.exact.iter().enumerate() {
-        let p = t.map(pos);
-        // Cheap tests first: narrow or wide (twice the area against the
-        // longest edge, squared), then what the snap can do to the optical
-        // depth or colour there (the rate times the thickness's change
-        // across the triangle times the snap over the width), with the
-        // bound on the rate, then the part's own rate.
-        let area2 = (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
-        let d2 = [0, 1, 2].map(|k| (p[(k + 1) % 3] - p[k]).length_squared());
-        let longest = d2[0].max(d2[1]).max(d2[2]);
-        let narrow = area2 * area2 < widest * widest * longest;
-        let wide = may_be_steep && area2 * area2 >= SLIVER_TIE_PX * SLIVER_TIE_PX * longest;
-        if !(longest > 0.0 && (narrow || wide)) {
-            continue;
-        }
-        let l = t.map(|i| part.proj.vertices[i as usize].l);
-        let long = longest.sqrt();
-        if wide {
-            // Steep for the optical depth, or (isosurface modes) holding
-            // an isovalue within the snap's shift of its entry or exit
-            // scalars: the snapped corners' interpolation could put a
-            // centre on the other side of the value than the exact
-            // triangle and the piece beside it do (a surface missed or
-            // drawn twice where the volume's rate is small or zero);
-            // exact values at the snapped corners keep every centre's.
-            steep[n] = (snap_is_steep_at(area2, long, l, part.rate_bound)
-                && snap_is_steep_at(area2, long, l, (part.rate)()))
-                || wide_holds_isovalue(part, t, area2 / long);
-            continue;
-        }
-        let dl = l[0].max(l[1]).max(l[2]) - l[0].min(l[1]).min(l[2]);
-        let w = area2 / long;
-        // How far the snap moved this triangle's corners (at most
-        // SNAP_PX): what shifts its interpolated values.
-        let snap = part.snap_of(t);
-        // False for NaN too.
-        let matters = |r: f64| r * dl * snap > SLIVER_DEPTH_TOL * w;
-        // With isovalues: the snap's shift of the entry and exit scalars
-        // across this sliver, where its corners bracket one (with that
-        // shift); NaN or 0 otherwise.
-        let iso_shift = if part.isovalues.is_empty() {
-            0.0
-        } else {
-            let v = t.map(|i| &part.proj.vertices[i as usize]);
-            let spread = |s: [f64; 3]| {
-                let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
-                let shift = (hi - lo) * snap / w;
-                let k = part.isovalues.partition_point(|&x| x < lo - shift);
-                let holds = part.isovalues.get(k).is_some_and(|&x| x <= hi + shift);
-                if holds {
-                    shift
-                } else {
-                    0.0
-                }
-            };
-            spread(v.map(|v| v.s_front)).max(spread(v.map(|v| v.s_back)))
-        };
-        let narrow_for_depth = w < reach.min(SLIVER_TIE_PX);
-        // False for NaN too.
-        let iso = iso_shift > 0.0;
-        if !iso && (!narrow_for_depth || !matters(part.rate_bound) || !matters((part.rate)())) {
-            continue;
-        }
-        let k = if d2[0] == longest {
-            0
-        } else if d2[1] == longest {
-            1
-        } else {
-            2
-        };
-        let (a, b) = (p[k], p[(k + 1) % 3]);
-        near.clear();
-        centres_within(a, b, w + TIE_BAND_PX, part.width, part.height, near);
-        // Only the centres in the exact sliver grown by the band (which
-        // holds every centre its snapped triangle can cover): coverage
-        // culling keeps every triangle within COVERAGE_MARGIN_PX (1/64 px)
-        // of a centre, so it drops no sliver that has such a centre, and
-        // changes no decision.
-        let depth = narrow_for_depth && matters(part.rate_bound) && matters((part.rate)());
-        // Where only an isovalue matters: the centres whose exact scalars
-        // are within the shift (and the f32 stages' rounding) of one.
-        let vals = t.map(|i| {
-            let v = &part.proj.vertices[i as usize];
-            [v.s_front, v.s_back]
-        });
-        out.extend(near.iter().copied().filter(|&(i, j)| {
-            let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
-            if !in_grown_triangle(p, c) {
-                return false;
-            }
-            if depth {
-                return true;
-            }
-            let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
-            let b1 = (c - p[0]).perp_dot(p[2] - p[0]) / area;
-            let b2 = (p[1] - p[0]).perp_dot(c - p[0]) / area;
-            let b = [1.0 - b1 - b2, b1, b2];
-            (0..2).any(|side| {
-                let s: f64 = (0..3).map(|k| b[k] * vals[k][side]).sum();
-                let margin = iso_shift + ISO_SLIVER_REL * s.abs();
-                // Not for NaN.
-                to_nearest(part.isovalues, s) <= margin
-            })
-        }));
-    }
-}
-
-/// Whether the entry or the exit scalars of the wide exact triangle `t`
-/// (width `w` pixels) bracket one of `part.isovalues`, grown by the most
-/// the snap of its corners can shift them at a centre ([`SNAP_PX`] over the
-/// width, of their spread) and by [`ISO_SLIVER_REL`] of their size (the
-/// `f32` stages' rounding): see [`scan_triangles`].
-fn wide_holds_isovalue(part: &PartTriangles, t: &[u32; 3], w: f64) -> bool {
-    if part.isovalues.is_empty() {
-        return false;
-    }
-    let v = t.map(|i| &part.proj.vertices[i as usize]);
-    let holds = |s: [f64; 3]| {
-        let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
-        let grow = (hi - lo) * SNAP_PX / w + ISO_SLIVER_REL * lo.abs().max(hi.abs());
-        let k = part.isovalues.partition_point(|&x| x < lo - grow);
-        // False for NaN too.
-        part.isovalues.get(k).is_some_and(|&x| x <= hi + grow)
-    };
-    holds(v.map(|v| v.s_front)) || holds(v.map(|v| v.s_back))
 }
 
 #[cfg(test)]
