@@ -1,6 +1,10 @@
 //! Isosurfaces on the projected-cell driver: `--mode iso` (surfaces alone)
 //! and `--iso` with `exact-frag` or a table mode (surfaces mixed with the
-//! volume, in each piece's place in the exact order). The rules (what a
+//! volume, in each piece's place in the exact order). `--iso` with the
+//! exact mode draws exact-frag's frame: the exact mode's integrals at
+//! region vertices cannot hold a crossing inside a segment, and slicing
+//! cells at the isovalues (as at breakpoints) would put the `tets`
+//! field's surfaces into whole cells. The rules (what a
 //! crossing is, the sides, the light, the mixing) are in
 //! [`crate::render::iso`]; this is the GPU stage and its twin.
 //!
