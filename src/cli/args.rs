@@ -2,6 +2,8 @@
 //! `--frames A..B`)
 //! that reject NaN and nonsense with a usage error.
 
+use zoovr::render::modes::preint_tables::{TableKind, TableSpec};
+
 /// Parses `WxH` (e.g. `512x512`); both positive and at most 16384.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
@@ -68,18 +70,15 @@ pub fn parse_positive(s: &str) -> Result<f64, String> {
     Ok(v)
 }
 
-/// Parses `--table N`: an integer of at least 2 (a table interpolates
-/// between samples); what an adapter can hold is checked when it draws.
+/// Parses `--table N`: a whole number, at least the library's smallest
+/// table ([`TableSpec::check_small`]); what an adapter can hold is checked
+/// when it draws.
 pub fn parse_table_size(s: &str) -> Result<u32, String> {
     let n: u32 = s
         .trim()
         .parse()
         .map_err(|_| format!("not a whole number of samples: '{s}'"))?;
-    if n < 2 {
-        return Err(format!(
-            "--table {n}: a table needs at least 2 samples per axis"
-        ));
-    }
+    TableSpec::check_small(TableKind::Cube, Some(n)).map_err(|e| e.to_string())?;
     Ok(n)
 }
 

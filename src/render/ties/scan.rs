@@ -74,14 +74,17 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
         if wide {
             // Steep for the optical depth, or (isosurface modes) holding
             // an isovalue within the snap's shift of its entry or exit
-            // scalars: the snapped corners' interpolation could put a
-            // centre on the other side of the value than the exact
-            // triangle and the piece beside it do (a surface missed or
-            // drawn twice where the volume's rate is small or zero);
-            // exact values at the snapped corners keep every centre's.
+            // scalars (and the f32 stages' rounding): the snapped corners'
+            // interpolation could put a centre on the other side of the
+            // value than the exact triangle and the piece beside it do (a
+            // surface missed or drawn twice where the volume's rate is
+            // small or zero); exact values at the snapped corners keep
+            // every centre's.
             steep[n] = (snap_is_steep_at(area2, long, l, part.rate_bound)
                 && snap_is_steep_at(area2, long, l, (part.rate)()))
-                || wide_holds_isovalue(part, t, area2 / long);
+                || (!part.isovalues.is_empty()
+                    && isovalue_shift(part, t, part.snap_of(t), area2 / long, ISO_SLIVER_REL)
+                        .is_some());
             continue;
         }
         let dl = l[0].max(l[1]).max(l[2]) - l[0].min(l[1]).min(l[2]);
@@ -93,23 +96,11 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
         let matters = |r: f64| r * dl * snap > SLIVER_DEPTH_TOL * w;
         // With isovalues: the snap's shift of the entry and exit scalars
         // across this sliver, where its corners bracket one (with that
-        // shift); NaN or 0 otherwise.
+        // shift); 0 otherwise (NaN too).
         let iso_shift = if part.isovalues.is_empty() {
             0.0
         } else {
-            let v = t.map(|i| &part.proj.vertices[i as usize]);
-            let spread = |s: [f64; 3]| {
-                let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
-                let shift = (hi - lo) * snap / w;
-                let k = part.isovalues.partition_point(|&x| x < lo - shift);
-                let holds = part.isovalues.get(k).is_some_and(|&x| x <= hi + shift);
-                if holds {
-                    shift
-                } else {
-                    0.0
-                }
-            };
-            spread(v.map(|v| v.s_front)).max(spread(v.map(|v| v.s_back)))
+            isovalue_shift(part, t, snap, w, 0.0).unwrap_or(0.0)
         };
         let narrow_for_depth = w < reach.min(SLIVER_TIE_PX);
         // False for NaN too.
@@ -161,24 +152,29 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
     }
 }
 
-/// Whether the entry or the exit scalars of the wide exact triangle `t`
-/// (width `w` pixels) bracket one of `part.isovalues`, grown by the most
-/// the snap of its corners can shift them at a centre ([`SNAP_PX`] over the
-/// width, of their spread) and by [`ISO_SLIVER_REL`] of their size (the
-/// `f32` stages' rounding): see [`scan_triangles`].
-fn wide_holds_isovalue(part: &PartTriangles, t: &[u32; 3], w: f64) -> bool {
-    if part.isovalues.is_empty() {
-        return false;
-    }
+/// The snap's largest shift of the entry or exit scalars of the exact
+/// triangle `t` (width `w` pixels, corners moved by at most `snap`: of
+/// their spread, `snap` over the width) where their range, grown by that
+/// shift and by `rel` of their size, holds one of `part.isovalues`;
+/// `None` where neither does (or a value is NaN). The slivers' rule and
+/// the wide triangles' steep rule in [`scan_triangles`].
+fn isovalue_shift(part: &PartTriangles, t: &[u32; 3], snap: f64, w: f64, rel: f64) -> Option<f64> {
     let v = t.map(|i| &part.proj.vertices[i as usize]);
-    let holds = |s: [f64; 3]| {
+    let side = |s: [f64; 3]| {
         let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
-        let grow = (hi - lo) * SNAP_PX / w + ISO_SLIVER_REL * lo.abs().max(hi.abs());
+        let shift = (hi - lo) * snap / w;
+        let grow = shift + rel * lo.abs().max(hi.abs());
         let k = part.isovalues.partition_point(|&x| x < lo - grow);
         // False for NaN too.
-        part.isovalues.get(k).is_some_and(|&x| x <= hi + grow)
+        part.isovalues
+            .get(k)
+            .is_some_and(|&x| x <= hi + grow)
+            .then_some(shift)
     };
-    holds(v.map(|v| v.s_front)) || holds(v.map(|v| v.s_back))
+    match (side(v.map(|v| v.s_front)), side(v.map(|v| v.s_back))) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        (a, b) => a.or(b),
+    }
 }
 
 /// The distance from `s` to the nearest of the sorted `values`.
