@@ -134,6 +134,21 @@ fn exact_mode_frames_equal_renders_and_reuse_is_reported() {
         return;
     }
     assert!(o.status.success(), "{}", stderr(&o));
+    // Values only, one camera: the later frames take the sort and every
+    // part's regions from the frame before.
+    let lines = json_lines(&o);
+    for (k, l) in lines.iter().enumerate() {
+        let d = &l["render"]["detail"];
+        let reused = d["regions_reused"].as_u64().unwrap();
+        assert!(d["regions_kept_bytes"].as_u64().unwrap() > 0, "{l}");
+        if k == 0 {
+            assert_eq!(reused, 0);
+        } else {
+            assert_eq!(l["change"], "values");
+            assert_eq!(d["sort_reused"], true, "{l}");
+            assert!(reused > 0, "frame {k}: {l}");
+        }
+    }
     for k in 0..3 {
         let want = dir.path().join(format!("render_{k}.png"));
         let step = dir.path().join(format!("step_{k}.vtu"));

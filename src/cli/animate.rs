@@ -368,7 +368,11 @@ fn render_series(args: &AnimateArgs, series: &Path, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("{}: cannot make the output folder", out.display()))?;
     let ropts = args.view.scene.read_options();
-    let opts = args.view.render_options();
+    let mut opts = args.view.render_options();
+    // A fixed camera over several steps: each part's regions are kept and
+    // take the next step's values where only values change.
+    opts.projected.keep_regions =
+        !args.no_reuse && frames.len() > 1 && frames.iter().all(|f| f.azimuth == frames[0].azimuth);
     let pending = opts
         .mode
         .info()

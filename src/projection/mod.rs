@@ -17,6 +17,8 @@
 //!   classes, regions built directly);
 //! - `project`: the [`Projector`] pipeline (near clip, projection, regions,
 //!   per-vertex values, fan triangles);
+//! - `kept`: regions kept across frames whose scalars change and nothing
+//!   else ([`KeptRegions`]), which take the new scalars;
 //! - `refine`: conforming midpoint refinement of region triangles, for the
 //!   perspective error bound and for colour accuracy ([`refine`]);
 //! - `coverage`: which triangles can colour a pixel centre (culling);
@@ -42,6 +44,7 @@
 mod arrangement;
 mod clip;
 pub mod coverage;
+mod kept;
 mod overlay;
 mod polyhedron;
 mod project;
@@ -56,6 +59,7 @@ use thiserror::Error;
 
 pub use arrangement::{Arrangement, Segment};
 pub use clip::{ClipValue, Clipper};
+pub use kept::KeptRegions;
 pub use polyhedron::Polyhedron;
 pub use project::Projector;
 pub use refine::{perspective_split, refine};
@@ -455,6 +459,13 @@ pub struct Projected {
     spans: Vec<coverage::Span>,
     /// The triangles [`Projected::cull_to_pixels`] dropped.
     culled: Vec<[u32; 3]>,
+    /// Where step 6 took each vertex's values (`kept`: kept regions take
+    /// new scalars through them); the vertices added after it have none.
+    sources: Vec<kept::VertexSource>,
+    /// What [`Projected::outline_profile`] took from step 6 besides the
+    /// vertices' profiles: whether the fast path made the regions, and
+    /// whether none of their fan triangles was skipped.
+    outline_inputs: [bool; 2],
 }
 
 impl Projected {
@@ -472,6 +483,8 @@ impl Projected {
         self.outline_profile = false;
         self.spans.clear();
         self.culled.clear();
+        self.sources.clear();
+        self.outline_inputs = [false; 2];
     }
 
     /// Each vertex's [`coverage::Span`]: the pixel centres within

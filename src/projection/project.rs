@@ -57,6 +57,7 @@ use glam::DVec2;
 use super::arrangement::{is_outer, Arrangement, Segment};
 use super::clip::{ClipValue, Clipper};
 use super::coverage::PixelGrid;
+use super::kept::{KeptRegions, ValueSource, VertexSource};
 use super::overlay::Overlay;
 use super::polyhedron::Polyhedron;
 use super::subdivision::NIL;
@@ -214,6 +215,26 @@ impl Projector {
         camera: &Camera,
         out: &mut Projected,
     ) -> Result<(), ProjectionError> {
+        self.project_with(poly, camera, None, false, out)
+            .map(|_| ())
+    }
+
+    /// [`Self::project`] with regions kept across frames whose scalars
+    /// change and nothing else ([`KeptRegions`]): with `kept` (which must
+    /// hold `poly`'s geometry, [`KeptRegions::holds`], projected for this
+    /// camera by a projector with these settings) steps 2-6 are not run
+    /// again: their regions take `poly`'s scalars, and the steps that
+    /// follow run as always. Otherwise, with `keep`, what steps 2-6 found
+    /// is returned, to be kept. The result is the same, bit for bit, either
+    /// way.
+    pub fn project_with(
+        &mut self,
+        poly: &Polyhedron,
+        camera: &Camera,
+        kept: Option<&KeptRegions>,
+        keep: bool,
+        out: &mut Projected,
+    ) -> Result<Option<KeptRegions>, ProjectionError> {
         poly.validate()?;
         self.took_fast_path = false;
         out.clear();
@@ -230,19 +251,48 @@ impl Projector {
         self.used_clipped = needs_clip;
         if needs_clip {
             let mut clipped = std::mem::take(&mut self.clipped);
-            let kept = self
+            let beyond = self
                 .clipper
                 .clip(poly, ClipValue::Depth, zc, f64::INFINITY, &mut clipped);
-            let r = match kept {
-                Ok(true) => self.project_inner(&clipped, camera, out),
-                Ok(false) => Ok(()),
+            let r = match beyond {
+                Ok(true) => self.project_part(poly, &clipped, camera, kept, keep, out),
+                Ok(false) => Ok(None),
                 Err(e) => Err(e),
             };
             self.clipped = clipped;
             r
         } else {
-            self.project_inner(poly, camera, out)
+            self.project_part(poly, poly, camera, kept, keep, out)
         }
+    }
+
+    /// Steps 2-8 for `piece` (`poly`, or its part beyond the near plane),
+    /// steps 2-6 taken from `kept` when given.
+    fn project_part(
+        &mut self,
+        poly: &Polyhedron,
+        piece: &Polyhedron,
+        camera: &Camera,
+        kept: Option<&KeptRegions>,
+        keep: bool,
+        out: &mut Projected,
+    ) -> Result<Option<KeptRegions>, ProjectionError> {
+        let (emitted, fresh) = match kept {
+            Some(k) => {
+                self.took_fast_path = k.fast_path();
+                (k.restore(piece, out), None)
+            }
+            None => {
+                let emitted = self.regions(piece, camera, out)?;
+                let fresh = keep
+                    .then(|| KeptRegions::new(poly, &self.pix, out, emitted, self.took_fast_path));
+                (emitted, fresh)
+            }
+        };
+        if emitted {
+            self.finish(piece, camera, out);
+        }
+        Ok(fresh)
     }
 
     /// The polyhedron the last [`Self::project`] of `poly` projected:
@@ -257,12 +307,14 @@ impl Projector {
         }
     }
 
-    fn project_inner(
+    /// Steps 2-6: whether `poly` has regions that can reach a pixel
+    /// centre (written to `out`).
+    fn regions(
         &mut self,
         poly: &Polyhedron,
         camera: &Camera,
         out: &mut Projected,
-    ) -> Result<(), ProjectionError> {
+    ) -> Result<bool, ProjectionError> {
         let n = poly.points.len();
         // 2. Pixel positions and merged ids.
         self.pix.clear();
@@ -283,7 +335,7 @@ impl Projector {
                 |(lo, hi), &p| (lo.min(p), hi.max(p)),
             );
             if !grid.box_reaches(lo, hi) {
-                return Ok(()); // draws no pixel
+                return Ok(false); // draws no pixel
             }
         }
         self.canon.clear();
@@ -320,9 +372,13 @@ impl Projector {
         } else {
             self.general_regions(poly, out)?;
         }
-        if out.regions.is_empty() {
-            return Ok(()); // everything edge-on: zero area
-        }
+        // Empty: everything edge-on, zero area.
+        Ok(!out.regions.is_empty())
+    }
+
+    /// Steps 7-8 and the window clip after the regions of `poly`.
+    fn finish(&mut self, poly: &Polyhedron, camera: &Camera, out: &mut Projected) {
+        let grid = PixelGrid::new(camera.width, camera.height);
         if self.clip_to_image {
             self.window.clip(out);
         }
@@ -365,7 +421,6 @@ impl Projector {
                 out.cull_to_pixels(&grid);
             }
         }
-        Ok(())
     }
 
     /// Steps 5-6 through the arrangement (any piece, degenerate views
@@ -680,18 +735,21 @@ fn emit(
                     .kinds
                     .get(v as usize)
                     .is_some_and(|k| !regions.search || matches!(k, VertexKind::Crossing { .. }));
-                out.vertices.push(if by_kind {
-                    fast_vertex(poly, pix, &view, faces, ft, v, q, on_hull, regions.kinds)
+                let sources = if by_kind {
+                    fast_sources(ft, v, regions.kinds)
                 } else {
                     let [(tf, _), (tb, _)] = best[v as usize];
-                    RegionVertex::evaluate(
-                        &view,
-                        &faces[tf as usize],
-                        &faces[tb as usize],
-                        q,
-                        on_hull,
-                    )
-                });
+                    [ValueSource::Face(tf), ValueSource::Face(tb)]
+                };
+                let value = |src| source_value(poly, pix, &view, faces, src, q);
+                out.vertices.push(RegionVertex::from_values(
+                    &view,
+                    value(sources[0]),
+                    value(sources[1]),
+                    q,
+                    on_hull,
+                ));
+                out.sources.push(VertexSource { sources, on_hull });
                 profile_hull &= !on_hull || out.vertices[id as usize].profile;
             }
             out.regions.push_vertex(id);
@@ -702,44 +760,50 @@ fn emit(
     std::mem::swap(faces, &mut out.faces);
     let complete = out.triangulate_regions();
     out.outline_profile = fast && profile_hull && complete;
+    out.outline_inputs = [fast, complete];
 }
 
-/// The values of fast-path vertex `v` at `q`, first met in a region with
-/// front and back triangles `ft`, from `v`'s [`VertexKind`] (no search among
-/// the regions around it). An original point is a corner of every triangle
-/// around it of its own facing (no point lies inside an edge it does not
-/// end), where any of them gives the point's own data; a point of one
-/// facing only lies strictly inside one triangle of the other facing, the
-/// one of every region around it, and so the general path's search picks
-/// the same triangles and gets the same bits. A crossing lies on a front
-/// and a back edge, along which the front (back) surface is the segment
-/// between the edge's ends ([`along_edge`]): exact whatever the widths of
-/// the triangles on either side, one of which may be a sliver.
-#[allow(clippy::too_many_arguments)]
+/// Where fast-path vertex `v`, first met in a region with front and back
+/// triangles `ft`, takes its values, from its [`VertexKind`] (no search
+/// among the regions around it). An original point is a corner of every
+/// triangle around it of its own facing (no point lies inside an edge it
+/// does not end), where any of them gives the point's own data; a point of
+/// one facing only lies strictly inside one triangle of the other facing,
+/// the one of every region around it, and so the general path's search
+/// picks the same triangles and gets the same bits. A crossing lies on a
+/// front and a back edge, along which the front (back) surface is the
+/// segment between the edge's ends ([`along_edge`]): exact whatever the
+/// widths of the triangles on either side, one of which may be a sliver.
 #[inline]
-fn fast_vertex(
+fn fast_sources(ft: [u32; 2], v: u32, kinds: &[VertexKind]) -> [ValueSource; 2] {
+    use ValueSource::{Edge, Face, Own};
+    match kinds[v as usize] {
+        VertexKind::Front => [Own(v), Face(ft[1])],
+        VertexKind::Back => [Face(ft[0]), Own(v)],
+        VertexKind::Silhouette => [Own(v), Own(v)],
+        VertexKind::Crossing { front, back } => [Edge(front), Edge(back)],
+    }
+}
+
+/// Depth and scalar at pixel position `q` from `src` (step 6): a point's
+/// own data, a boundary triangle's plane ([`FaceTri::eval`]) or the
+/// boundary along an edge ([`along_edge`]). The one evaluation of region
+/// vertex values, at projection and when kept regions take new scalars
+/// ([`super::KeptRegions`]).
+#[inline]
+pub(super) fn source_value(
     poly: &Polyhedron,
     pix: &[DVec2],
     view: &ViewMap,
     faces: &[FaceTri],
-    ft: [u32; 2],
-    v: u32,
+    src: ValueSource,
     q: DVec2,
-    on_hull: bool,
-    kinds: &[VertexKind],
-) -> RegionVertex {
-    let own = || (poly.points[v as usize].z, poly.scalars[v as usize]);
-    let at = |t: u32| faces[t as usize].eval(view, q);
-    let (front, back) = match kinds[v as usize] {
-        VertexKind::Front => (own(), at(ft[1])),
-        VertexKind::Back => (at(ft[0]), own()),
-        VertexKind::Silhouette => (own(), own()),
-        VertexKind::Crossing { front, back } => (
-            along_edge(poly, pix, view.ortho, front, q),
-            along_edge(poly, pix, view.ortho, back, q),
-        ),
-    };
-    RegionVertex::from_values(view, front, back, q, on_hull)
+) -> (f64, f64) {
+    match src {
+        ValueSource::Own(v) => (poly.points[v as usize].z, poly.scalars[v as usize]),
+        ValueSource::Face(t) => faces[t as usize].eval(view, q),
+        ValueSource::Edge(e) => along_edge(poly, pix, view.ortho, e, q),
+    }
 }
 
 /// Depth and scalar of the piece's boundary along its edge between points

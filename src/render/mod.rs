@@ -144,6 +144,8 @@ pub struct Renderer {
     /// The last frame's triangles, with `keep_projection`
     /// ([`driver::kept`]).
     kept: Option<driver::kept::KeptProjection>,
+    /// Each part's regions, with `keep_regions` ([`driver::regions`]).
+    regions: driver::regions::RegionStore,
 }
 
 impl Renderer {
@@ -158,6 +160,7 @@ impl Renderer {
             gpu: None,
             pending_gpu: None,
             kept: None,
+            regions: Default::default(),
         }
     }
 
@@ -177,6 +180,7 @@ impl Renderer {
         if !matches!(change, StepChange::None | StepChange::Values) {
             self.sorter = None;
             self.orders.clear();
+            self.regions.clear();
         }
         self.visible.clear();
         self.geometry = geometry;
@@ -383,6 +387,7 @@ impl Renderer {
             gpu,
             pending_gpu,
             kept,
+            regions,
         } = self;
         // The min/max tree, for the occlusion pass where it may hide
         // something (the visible subset builds it anyway).
@@ -443,6 +448,7 @@ impl Renderer {
                 geometry_ids: ids,
             }),
             kept,
+            (regions, ids),
             progress,
         )?;
         stats.dark_cells_left_out = dark_cells;

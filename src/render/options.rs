@@ -150,6 +150,14 @@ pub struct ProjectedOptions {
     /// and the table modes') are not kept: which pieces go whole depends on
     /// the rates.
     pub keep_projection: bool,
+    /// Keep each part's regions (the winged-edge subdivision of its
+    /// projection) for the next frame with the same camera whose values
+    /// change and nothing else, which gives them its values instead of
+    /// projecting again ([`super::driver::regions`]; `zoovr animate` turns
+    /// it on for a fixed camera). Off by default: kept regions take about
+    /// 2 KB per hex, at most
+    /// [`super::driver::regions::KEEP_REGIONS_MAX_BYTES`].
+    pub keep_regions: bool,
     /// How exact-frag and the table modes draw a piece (`--piece-draw`):
     /// projected into regions on the CPU, or whole, as one polygon whose
     /// fragments find their own segment ([`super::modes::piece_quad`],
@@ -205,6 +213,7 @@ impl Default for ProjectedOptions {
             occlusion_tree: true,
             dark_subset: true,
             keep_projection: false,
+            keep_regions: false,
             piece_draw: PieceDraw::Auto,
         }
     }

@@ -39,6 +39,12 @@ pub struct ProjectedStats {
     /// Of those, the parts drawn as their outline's widened hull rather
     /// than their pixel bounding box ([`super::driver`]'s `whole`).
     pub whole_hulls: usize,
+    /// Parts whose regions were kept from an earlier frame with other
+    /// values ([`super::ProjectedOptions::keep_regions`]): not projected
+    /// again, only given the new values; and what the kept regions hold,
+    /// bytes.
+    pub regions_reused: usize,
+    pub regions_kept_bytes: usize,
     /// Pieces left out as hidden behind opaque ones
     /// ([`super::occlusion`]), and the time the pass took.
     pub hidden_pieces: usize,
@@ -187,6 +193,14 @@ impl fmt::Display for ProjectedStats {
                 String::new()
             }
         )?;
+        if e.regions_kept_bytes > 0 {
+            writeln!(
+                f,
+                "kept regions {} parts' regions from an earlier frame given the new values ({:.1} MiB kept)",
+                e.regions_reused,
+                e.regions_kept_bytes as f64 / (1u64 << 20) as f64
+            )?;
+        }
         if let Some(t) = &e.table {
             writeln!(
                 f,

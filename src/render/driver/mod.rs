@@ -70,11 +70,10 @@ use glam::DVec2;
 
 use crate::camera::Camera;
 use crate::gpu::common::BLOCKER_Z;
-use crate::gpu::cpu::{CpuFrame, CpuStage};
-use crate::gpu::layer::{LayerTwin, LayerVertex, LAYER_STAGE};
+use crate::gpu::cpu::CpuFrame;
+use crate::gpu::layer::{LayerVertex, LAYER_STAGE};
 use crate::gpu::{
-    ClipMapper, Context, DrawKind, Frame, FrameOptions, FrameStats, GpuError, GpuVertex,
-    PendingContext, Stage, MAX_PIECES, SUBPIXEL,
+    ClipMapper, Context, DrawKind, FrameOptions, GpuVertex, PendingContext, SUBPIXEL,
 };
 use crate::image::Image;
 use crate::projection::coverage::PixelGrid;
@@ -94,6 +93,8 @@ use super::ties::{
 use super::workers::run_ordered;
 use super::{Compositor, RenderError, RenderOptions};
 use kept::{KeepKey, KeptCounts, KeptProjection};
+use regions::{PartKey, RegionStore, StoreFrame};
+use sink::{finish, push_out, take_pieces, Sink};
 use whole::draw_whole;
 
 /// Pieces processed per chunk (one worker's unit of work).
@@ -129,6 +130,8 @@ pub(super) struct ChunkOut<V> {
     whole: usize,
     /// Of those, the parts drawn as their outline's hull ([`whole`]).
     hulls: usize,
+    /// Parts whose regions were kept from an earlier frame ([`regions`]).
+    regions_reused: usize,
     pub(super) error: Option<PieceError>,
 }
 
@@ -147,6 +150,7 @@ impl<V> Default for ChunkOut<V> {
             thin: 0,
             whole: 0,
             hulls: 0,
+            regions_reused: 0,
             error: None,
         }
     }
@@ -167,6 +171,7 @@ impl<V> ChunkOut<V> {
         self.thin = 0;
         self.whole = 0;
         self.hulls = 0;
+        self.regions_reused = 0;
         self.error = None;
     }
 }
@@ -225,11 +230,15 @@ impl<P: Default, V> Worker<P, V> {
 }
 
 /// Projects one part, and appends its triangles with the mode's payload
-/// to `out` as one piece.
+/// to `out` as one piece; with `store`, its regions are kept across
+/// frames under `key` (its cell and which part of it, [`regions`]).
+#[allow(clippy::too_many_arguments)]
 fn draw_part<M: ProjectedMode>(
     mode: &M,
     src: &PieceSource,
     part: &Polyhedron,
+    key: Option<(u32, PartKey)>,
+    store: Option<&StoreFrame>,
     w: &mut Worker<M::Payload, M::Vertex>,
     out: &mut ChunkOut<M::Vertex>,
 ) -> Result<(), crate::projection::ProjectionError> {
@@ -241,7 +250,21 @@ fn draw_part<M: ProjectedMode>(
         draw_whole(src.camera, part, v, out);
         return Ok(());
     }
-    w.projector.project(part, src.camera, &mut w.proj)?;
+    match (store, key) {
+        (Some(store), Some((cell, pk))) => {
+            let kept = store.get(cell, pk, part);
+            out.regions_reused += kept.is_some() as usize;
+            let keep = kept.is_none() && store.has_room();
+            let camera = src.camera;
+            let fresh =
+                w.projector
+                    .project_with(part, camera, kept.as_deref(), keep, &mut w.proj)?;
+            if let Some(k) = fresh {
+                store.put(cell, pk, k);
+            }
+        }
+        _ => w.projector.project(part, src.camera, &mut w.proj)?,
+    }
     let proj = &mut w.proj;
     if proj.triangles.is_empty() {
         return Ok(());
@@ -475,16 +498,20 @@ pub(super) fn grid_area_positive(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> bool 
 fn process_chunk<M: ProjectedMode>(
     mode: &M,
     src: &PieceSource,
+    store: Option<&StoreFrame>,
     pieces: &[Piece],
     mut out: ChunkOut<M::Vertex>,
 ) -> ChunkOut<M::Vertex> {
     let mut w = Worker::<M::Payload, M::Vertex>::new(src, mode.perspective_refine());
     for piece in pieces {
         let mut parts = std::mem::take(&mut w.parts);
+        let key = store.and(PartKey::of(piece));
         let done = src.parts(piece, &mut parts, |part| {
-            draw_part(mode, src, part, &mut w, &mut out).map_err(|source| PieceError::Projection {
-                cell: piece.cell(),
-                source,
+            draw_part(mode, src, part, key, store, &mut w, &mut out).map_err(|source| {
+                PieceError::Projection {
+                    cell: piece.cell(),
+                    source,
+                }
             })
         });
         w.parts = parts;
@@ -533,9 +560,11 @@ impl<V> BufferPool<V> {
 /// Projects `pieces` in chunks of `chunk` pieces on `workers` threads and
 /// hands each chunk's output to `sink` on this thread, in order
 /// ([`run_ordered`]).
+#[allow(clippy::too_many_arguments)]
 fn pipeline<M: ProjectedMode>(
     mode: &M,
     src: &PieceSource,
+    store: Option<&StoreFrame>,
     pieces: &[Piece],
     chunk: usize,
     workers: usize,
@@ -547,83 +576,9 @@ fn pipeline<M: ProjectedMode>(
         chunks.len(),
         workers,
         workers * AHEAD_PER_WORKER,
-        |i| process_chunk(mode, src, chunks[i], pool.take()),
+        |i| process_chunk(mode, src, store, chunks[i], pool.take()),
         sink,
     )
-}
-
-/// Where a frame's triangles go: the GPU, or its CPU twin; with the mode's
-/// stage and the layer stage.
-enum Sink<'c, V> {
-    Gpu {
-        frame: Box<Frame<'c>>,
-        stage: Stage,
-        layer: Stage,
-    },
-    Cpu {
-        frame: Box<CpuFrame>,
-        twin: Box<dyn CpuStage<V>>,
-    },
-}
-
-impl<V: GpuVertex> Sink<'_, V> {
-    fn push(&mut self, vertices: &[V], indices: &[u32]) -> Result<(), GpuError> {
-        match self {
-            Sink::Gpu { frame, stage, .. } => frame.push_triangles(stage, vertices, indices),
-            Sink::Cpu { frame, twin } => frame.push_triangles(twin.as_ref(), vertices, indices),
-        }
-    }
-
-    fn push_layer(&mut self, vertices: &[LayerVertex], indices: &[u32]) -> Result<(), GpuError> {
-        match self {
-            Sink::Gpu { frame, layer, .. } => frame.push_triangles(layer, vertices, indices),
-            Sink::Cpu { frame, .. } => frame.push_triangles(&LayerTwin, vertices, indices),
-        }
-    }
-}
-
-/// Frame-wide piece numbers: the next one, and the rebasing of a chunk's.
-fn take_pieces(next_piece: &mut u32, count: u32) -> Result<u32, RenderError> {
-    let base = *next_piece;
-    *next_piece = base
-        .checked_add(count)
-        .filter(|&n| n <= MAX_PIECES)
-        .ok_or(RenderError::TooManyPieces(MAX_PIECES))?;
-    Ok(base)
-}
-
-/// Sends one chunk's triangles to the frame and adds up its counts; its
-/// pieces are numbered on from `next_piece` (drawing order).
-fn push_out<V: GpuVertex>(
-    sink: &mut Sink<V>,
-    out: &mut ChunkOut<V>,
-    stats: &mut ProjectedStats,
-    next_piece: &mut u32,
-    record: Option<&mut KeptProjection>,
-) -> Result<(), RenderError> {
-    if let Some(e) = out.error.take() {
-        return Err(e.into());
-    }
-    let base = take_pieces(next_piece, out.pieces)?;
-    if base > 0 {
-        for v in &mut out.vertices {
-            *v = v.with_piece(v.piece() + base);
-        }
-    }
-    stats.culled_pieces += out.culled;
-    stats.slabs += out.slabs;
-    stats.refined_triangles += out.refined;
-    stats.tie_pixels += out.tie_pixels;
-    stats.steep_triangles += out.steep;
-    stats.thin_outlines += out.thin;
-    stats.whole_pieces += out.whole;
-    stats.whole_hulls += out.hulls;
-    stats.triangles += out.indices.len() / 3;
-    sink.push(&out.vertices, &out.indices)?;
-    if let Some(r) = record {
-        r.record(&out.vertices, &out.indices);
-    }
-    Ok(())
 }
 
 /// Renders the scene with a projected-cell mode. The GPU context is `gpu`,
@@ -646,6 +601,7 @@ pub fn render_projected<M: ProjectedMode>(
     whole: &crate::mesh::Mesh,
     tree: Option<super::occlusion::TreeView>,
     kept_frame: &mut Option<KeptProjection>,
+    (regions, ids): (&mut RegionStore, Option<&[u32]>),
     mut progress: impl FnMut(usize, usize),
 ) -> Result<(Image, ProjectedStats), RenderError> {
     let mut stats = ProjectedStats::default();
@@ -771,6 +727,15 @@ pub fn render_projected<M: ProjectedMode>(
         // Nothing to keep: free what an earlier frame kept.
         *kept_frame = None;
     }
+    // Region geometry kept across frames whose values change ([`regions`]).
+    if !opts.projected.keep_regions {
+        regions.clear();
+    }
+    let cull = opts.projected.cull_to_pixels;
+    let store = opts
+        .projected
+        .keep_regions
+        .then(|| regions.frame(camera, cull, whole.cells.len(), ids));
     let total = order.pieces.len();
     let mut done = 0;
     // Stretches of ordinary pieces, each followed by at most one group.
@@ -816,19 +781,28 @@ pub fn render_projected<M: ProjectedMode>(
             None => &order.pieces[plain],
         };
         let mut handed = 0;
-        pipeline(mode, &src, pieces, CHUNK, workers, &pool, |mut out| {
-            push_out(
-                &mut sink,
-                &mut out,
-                &mut stats,
-                &mut next_piece,
-                record.as_mut(),
-            )?;
-            pool.put(out);
-            handed += CHUNK;
-            progress(done + handed.min(pieces.len()), total);
-            Ok(())
-        })?;
+        pipeline(
+            mode,
+            &src,
+            store.as_ref(),
+            pieces,
+            CHUNK,
+            workers,
+            &pool,
+            |mut out| {
+                push_out(
+                    &mut sink,
+                    &mut out,
+                    &mut stats,
+                    &mut next_piece,
+                    record.as_mut(),
+                )?;
+                pool.put(out);
+                handed += CHUNK;
+                progress(done + handed.min(pieces.len()), total);
+                Ok(())
+            },
+        )?;
         done += pieces.len();
         if let Some(g) = group {
             let layer = composite_group(&src, &order.pieces[g.clone()])?;
@@ -851,35 +825,13 @@ pub fn render_projected<M: ProjectedMode>(
         r.counts = KeptCounts::of(&stats);
         *kept_frame = r.complete();
     }
+    stats.regions_kept_bytes = store.map_or(0, |s| s.bytes());
     finish(sink, stats, tp.elapsed().as_secs_f64(), t_gpu)
 }
 
-/// Finishes the frame of `sink`: the image, and the GPU's figures in
-/// `stats` (`project_s` spent projecting and drawing since `t_gpu`).
-fn finish<V: GpuVertex>(
-    sink: Sink<V>,
-    mut stats: ProjectedStats,
-    project_s: f64,
-    t_gpu: Instant,
-) -> Result<(Image, ProjectedStats), RenderError> {
-    let (image, fstats) = match sink {
-        Sink::Gpu { frame, .. } => frame.finish_with_stats()?,
-        Sink::Cpu { frame, .. } => {
-            stats.watched = frame.covering().to_vec();
-            let fs = FrameStats {
-                triangles: frame.triangles(),
-                ..Default::default()
-            };
-            (frame.finish(), fs)
-        }
-    };
-    stats.gpu = fstats;
-    stats.project_s = project_s;
-    stats.gpu_total_s = t_gpu.elapsed().as_secs_f64() - project_s;
-    Ok((image, stats))
-}
-
 pub mod kept;
+pub mod regions;
+mod sink;
 mod whole;
 
 #[cfg(test)]

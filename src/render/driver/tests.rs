@@ -93,6 +93,7 @@ fn no_triangle_degenerate_in_f32_reaches_the_gpu() {
         let out = process_chunk(
             &ExactMode::default(),
             &ctx,
+            None,
             std::slice::from_ref(piece),
             ChunkOut::default(),
         );
@@ -157,7 +158,7 @@ fn pipeline_hands_chunks_over_in_order_and_stops_on_error() {
         .pieces
         .chunks(chunk)
         .map(|c| {
-            let out = process_chunk(&ExactMode::default(), &ctx, c, ChunkOut::default());
+            let out = process_chunk(&ExactMode::default(), &ctx, None, c, ChunkOut::default());
             (out.vertices, out.indices)
         })
         .collect();
@@ -168,6 +169,7 @@ fn pipeline_hands_chunks_over_in_order_and_stops_on_error() {
         pipeline(
             &ExactMode::default(),
             &ctx,
+            None,
             &order.pieces,
             chunk,
             workers,
@@ -184,6 +186,7 @@ fn pipeline_hands_chunks_over_in_order_and_stops_on_error() {
         let r = pipeline(
             &ExactMode::default(),
             &ctx,
+            None,
             &order.pieces,
             chunk,
             workers,

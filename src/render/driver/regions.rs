@@ -1,0 +1,173 @@
+//! Region geometry kept across frames whose values change and nothing else
+//! ([`super::super::ProjectedOptions::keep_regions`]): the steps of a time
+//! series with the same points and cells, under a fixed camera.
+//!
+//! A part's regions (steps 2-6 of the [`crate::projection::Projector`]:
+//! pixel positions, facing, the winged-edge regions and their front and
+//! back triangles, the fan triangles) depend on its points only; the
+//! scalars enter through each region vertex's values, which
+//! [`KeptRegions`] evaluates again from the new scalars, bit for bit as a
+//! fresh projection would. The store keeps them per part that is a whole
+//! cell or one of its consistent tets (slabs and cycle fragments follow the
+//! values or are rare: they are projected afresh), keyed by the
+//! geometry's cell id (so a visible subset that changes from step to step
+//! keeps its cells' regions), and each lookup checks the part's points and
+//! triangles against the kept ones ([`KeptRegions::holds`]): a key that
+//! names another piece only costs a fresh projection.
+//!
+//! Everything after step 6 runs as always: the window clip, the
+//! perspective refinement and the culling, the mode's payload (the exact
+//! mode's vertex integrals and refinement), the tie, steep and thin
+//! decisions, which all follow the values; dark and hidden pieces are
+//! decided per frame too. The image is the one a fresh render gives
+//! (`tests/keep_regions.rs`).
+//!
+//! The store is emptied when the camera, the culling or the geometry's
+//! points change ([`super::super::Renderer::set_geometry`]), and holds at
+//! most [`KEEP_REGIONS_MAX_BYTES`]: parts met once it is full are projected
+//! every frame.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+use crate::camera::Camera;
+use crate::projection::{KeptRegions, Polyhedron};
+use crate::visibility::Piece;
+
+/// The most the kept regions may hold, bytes (about 2.2 KB per hex: the
+/// regions of 2^30 bytes keep about 480,000 hexes).
+pub const KEEP_REGIONS_MAX_BYTES: usize = 1 << 30;
+
+/// Which part of a cell a kept projection is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum PartKey {
+    Cell,
+    /// One consistent tet (its global point ids).
+    Tet([u32; 4]),
+}
+
+impl PartKey {
+    /// The cell (in the drawn mesh) and part key of `piece`, for the
+    /// pieces whose projection can be kept.
+    pub(super) fn of(piece: &Piece) -> Option<(u32, PartKey)> {
+        match *piece {
+            Piece::Cell(c) => Some((c, PartKey::Cell)),
+            Piece::Tet { cell, tet } => Some((cell, PartKey::Tet(tet))),
+            Piece::Slab { .. } | Piece::Frag { .. } => None,
+        }
+    }
+}
+
+/// What the kept regions were made for besides the parts' own geometry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct StoreKey {
+    camera: Camera,
+    cull: bool,
+}
+
+type CellParts = Vec<(PartKey, Arc<KeptRegions>)>;
+
+/// The kept regions of the renderer's geometry (module docs).
+#[derive(Default)]
+pub struct RegionStore {
+    key: Option<StoreKey>,
+    /// Per geometry cell, its parts' kept regions.
+    cells: Vec<Mutex<CellParts>>,
+    bytes: AtomicUsize,
+}
+
+impl RegionStore {
+    /// Forgets everything kept.
+    pub fn clear(&mut self) {
+        self.key = None;
+        self.cells = Vec::new();
+        self.bytes = AtomicUsize::new(0);
+    }
+
+    /// About how many bytes the kept regions hold.
+    pub fn bytes(&self) -> usize {
+        self.bytes.load(Ordering::Relaxed)
+    }
+
+    /// Readies the store for a frame with `camera` and culling `cull` over a
+    /// geometry of `cells` cells (emptied when these changed), seen through
+    /// `ids` (the geometry id of each drawn cell, for a visible subset).
+    pub(super) fn frame<'a>(
+        &'a mut self,
+        camera: &Camera,
+        cull: bool,
+        cells: usize,
+        ids: Option<&'a [u32]>,
+    ) -> StoreFrame<'a> {
+        let key = StoreKey {
+            camera: *camera,
+            cull,
+        };
+        if self.key != Some(key) || self.cells.len() != cells {
+            self.clear();
+            self.key = Some(key);
+            self.cells = (0..cells).map(|_| Mutex::new(Vec::new())).collect();
+        }
+        StoreFrame { store: self, ids }
+    }
+}
+
+/// The store during one frame: looked up and filled by the workers.
+pub(super) struct StoreFrame<'a> {
+    store: &'a RegionStore,
+    ids: Option<&'a [u32]>,
+}
+
+impl StoreFrame<'_> {
+    fn cell(&self, cell: u32) -> Option<&Mutex<CellParts>> {
+        let id = match self.ids {
+            Some(ids) => *ids.get(cell as usize)?,
+            None => cell,
+        };
+        self.store.cells.get(id as usize)
+    }
+
+    /// The kept regions of part `key` of drawn cell `cell`, if they hold
+    /// `part`.
+    pub(super) fn get(
+        &self,
+        cell: u32,
+        key: PartKey,
+        part: &Polyhedron,
+    ) -> Option<Arc<KeptRegions>> {
+        let parts = self.cell(cell)?.lock().ok()?;
+        parts
+            .iter()
+            .find(|(k, kept)| *k == key && kept.holds(part))
+            .map(|(_, kept)| kept.clone())
+    }
+
+    /// Whether there is room for more.
+    pub(super) fn has_room(&self) -> bool {
+        self.store.bytes() < KEEP_REGIONS_MAX_BYTES
+    }
+
+    /// About how many bytes the kept regions hold.
+    pub(super) fn bytes(&self) -> usize {
+        self.store.bytes()
+    }
+
+    /// Keeps `kept` as part `key` of drawn cell `cell`, in place of what
+    /// was kept for it.
+    pub(super) fn put(&self, cell: u32, key: PartKey, kept: KeptRegions) {
+        let Some(Ok(mut parts)) = self.cell(cell).map(|m| m.lock()) else {
+            return;
+        };
+        let bytes = kept.bytes();
+        let kept = Arc::new(kept);
+        let bytes_of = &self.store.bytes;
+        match parts.iter_mut().find(|(k, _)| *k == key) {
+            Some(slot) => {
+                bytes_of.fetch_sub(slot.1.bytes(), Ordering::Relaxed);
+                slot.1 = kept;
+            }
+            None => parts.push((key, kept)),
+        }
+        bytes_of.fetch_add(bytes, Ordering::Relaxed);
+    }
+}
