@@ -16,7 +16,10 @@
 //! 4. The frames are rendered by one [`Renderer`]: a loader thread reads
 //!    the next step while the current one is drawn; each step is compared
 //!    with the geometry drawn before ([`Geometry::next_step`]) and the
-//!    renderer keeps what did not change ([`StepChange`]). Every frame is
+//!    renderer keeps what did not change ([`StepChange`]); under a fixed
+//!    camera it keeps each part's projected regions too
+//!    (`ProjectedOptions::keep_regions`), which values-only steps reuse.
+//!    Every frame is
 //!    written atomically (temporary file, then rename), so an interrupted
 //!    run leaves only whole frames.
 //! 5. `--gif` / `--mp4` assemble the frames of DIR ([`super::assemble`]).
@@ -97,9 +100,9 @@ pub struct AnimateArgs {
     /// Read the colour range from a file written by --range-only.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["range", "range_from", "range_only"])]
     pub range_file: Option<PathBuf>,
-    /// Reuse nothing across frames: a new geometry, topology, sorter and
-    /// GPU context per step, as separate `render` runs would (to measure
-    /// what reuse saves).
+    /// Reuse nothing across frames: a new geometry, topology, sorter, GPU
+    /// context and projection per step, as separate `render` runs would
+    /// (to measure what reuse saves).
     #[arg(long)]
     pub no_reuse: bool,
     #[command(flatten)]
@@ -368,10 +371,10 @@ fn render_series(args: &AnimateArgs, series: &Path, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("{}: cannot make the output folder", out.display()))?;
     let ropts = args.view.scene.read_options();
-    let mut opts = args.view.render_options();
+    let opts = args.view.render_options();
     // A fixed camera over several steps: each part's regions are kept and
     // take the next step's values where only values change.
-    opts.projected.keep_regions =
+    let keep_regions =
         !args.no_reuse && frames.len() > 1 && frames.iter().all(|f| f.azimuth == frames[0].azimuth);
     let pending = opts
         .mode
@@ -404,6 +407,7 @@ fn render_series(args: &AnimateArgs, series: &Path, out: &Path) -> Result<()> {
         collection,
         first_step: frames.first().map_or(0, |f| f.step),
         opts,
+        keep_regions,
         renderer: None,
         pending,
         current: None,
@@ -471,6 +475,9 @@ struct Drawer<'a> {
     /// The step of the first frame, whose field every step must render.
     first_step: usize,
     opts: RenderOptions,
+    /// Keep the parts' regions for the next frame (a fixed camera), from
+    /// frames whose step changed no points ([`Drawer::draw`]).
+    keep_regions: bool,
     renderer: Option<Renderer>,
     pending: Option<PendingContext>,
     current: Option<(usize, Shading, f64)>,
@@ -562,6 +569,10 @@ impl Drawer<'_> {
         };
         let load_s = t0.elapsed().as_secs_f64();
         self.opts.camera.azimuth = f.azimuth;
+        // Regions are kept from the first frame and from values-only steps:
+        // a deforming mesh (new points every step) would only pay for
+        // keeping them.
+        self.opts.projected.keep_regions = self.keep_regions && matches!(change, "none" | "values");
         let camera = Camera::fit(bounds, &self.opts.camera);
         let (image, stats) = renderer
             .render_with_camera(shading, &self.opts, &camera, |_, _| {})

@@ -54,7 +54,8 @@ pub(crate) struct VertexSource {
 
 /// The regions of one piece (steps 2-6 of the [`super::Projector`]), kept
 /// for frames in which only its scalars change (module docs): what step 6
-/// wrote less the values, which [`KeptRegions::restore`] evaluates again.
+/// wrote less the values, which [`KeptRegions::restore`] evaluates again,
+/// and the fan triangles, which it makes again from the regions.
 #[derive(Clone, Debug)]
 pub struct KeptRegions {
     /// The piece's view-space points and boundary triangles (before any
@@ -68,8 +69,6 @@ pub struct KeptRegions {
     pos: Vec<DVec2>,
     sources: Vec<VertexSource>,
     regions: RegionList,
-    fan: Vec<[u32; 3]>,
-    fan_region: Vec<u32>,
     region_faces: Vec<[u32; 2]>,
     outline_inputs: [bool; 2],
     /// Whether the piece had regions that can reach a pixel centre.
@@ -95,8 +94,6 @@ impl KeptRegions {
             pos: Vec::new(),
             sources: Vec::new(),
             regions: RegionList::default(),
-            fan: Vec::new(),
-            fan_region: Vec::new(),
             region_faces: Vec::new(),
             outline_inputs: out.outline_inputs,
             emitted,
@@ -107,8 +104,6 @@ impl KeptRegions {
             kept.pos = out.vertices.iter().map(RegionVertex::pos).collect();
             kept.sources = out.sources.clone();
             kept.regions = out.regions.clone();
-            kept.fan = out.triangles.clone();
-            kept.fan_region = out.triangle_region.clone();
             kept.region_faces = out.region_faces.clone();
         }
         kept
@@ -129,8 +124,6 @@ impl KeptRegions {
             + (self.pix.len() + self.pos.len()) * size_of::<DVec2>()
             + self.sources.len() * size_of::<VertexSource>()
             + (self.regions.verts.len() + self.regions.start.len()) * size_of::<u32>()
-            + self.fan.len() * size_of::<[u32; 3]>()
-            + self.fan_region.len() * size_of::<u32>()
             + self.region_faces.len() * size_of::<[u32; 2]>()
     }
 
@@ -166,8 +159,9 @@ impl KeptRegions {
         out.sources.extend_from_slice(&self.sources);
         out.regions.verts.clone_from(&self.regions.verts);
         out.regions.start.clone_from(&self.regions.start);
-        out.triangles.extend_from_slice(&self.fan);
-        out.triangle_region.extend_from_slice(&self.fan_region);
+        // The fan triangles again (exact orientations of the same
+        // positions: the same triangles).
+        out.triangulate_regions();
         out.region_faces.extend_from_slice(&self.region_faces);
         out.outline_inputs = self.outline_inputs;
         let [fast, complete] = self.outline_inputs;

@@ -225,7 +225,7 @@ impl Projector {
     /// camera by a projector with these settings) steps 2-6 are not run
     /// again: their regions take `poly`'s scalars, and the steps that
     /// follow run as always. Otherwise, with `keep`, what steps 2-6 found
-    /// is returned, to be kept. The result is the same, bit for bit, either
+    /// is returned, to be kept, where they found regions. The result is the same, bit for bit, either
     /// way.
     pub fn project_with(
         &mut self,
@@ -284,7 +284,9 @@ impl Projector {
             }
             None => {
                 let emitted = self.regions(piece, camera, out)?;
-                let fresh = keep
+                // A piece without regions (its pixel box holds no centre,
+                // or it is edge-on) is as quick to project again.
+                let fresh = (keep && emitted)
                     .then(|| KeptRegions::new(poly, &self.pix, out, emitted, self.took_fast_path));
                 (emitted, fresh)
             }

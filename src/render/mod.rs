@@ -175,7 +175,8 @@ impl Renderer {
     /// splits and scratch) stays, otherwise it is rebuilt on first use (on
     /// the shared topology for [`StepChange::Points`]), and so do the
     /// views' sorts ([`order_cache`]: a values-only step splices its values
-    /// into the last sort of the view); the GPU context always stays.
+    /// into the last sort of the view) and the parts' kept regions
+    /// ([`driver::regions`]); the GPU context always stays.
     pub fn set_geometry(&mut self, geometry: Geometry, change: StepChange) {
         if !matches!(change, StepChange::None | StepChange::Values) {
             self.sorter = None;
