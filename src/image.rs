@@ -68,20 +68,22 @@ impl Image {
     }
 
     /// Display values in [0, 1] per docs/conventions.md: RGB over `background`, or
-    /// straight-alpha RGBA when `alpha` is set. Values are clamped, not gamma
-    /// encoded. Returns 3 or 4 channels per pixel.
+    /// straight-alpha RGBA when `alpha` is set (colour 0 where the opacity
+    /// is below half an 8-bit step, so that its alpha byte is 0). Values
+    /// are clamped, not gamma encoded. Returns 3 or 4 channels per pixel.
     pub fn display_values(&self, background: [f32; 3], alpha: bool) -> Vec<f32> {
         let ch = if alpha { 4 } else { 3 };
         let mut out = Vec::with_capacity(self.pixels.len() * ch);
         for p in &self.pixels {
             let a = p[3].clamp(0.0, 1.0);
             if alpha {
+                // The straight colour c / a of a pixel whose opacity is
+                // below half an 8-bit step is written as 0 with its alpha
+                // byte 0: invisible, and ill-conditioned (a grazing ray's
+                // opacity of 1e-5 or none at all would give any colour).
+                let shown = a * 255.0 >= 0.5;
                 for c in &p[..3] {
-                    out.push(if a > 0.0 {
-                        (c / a).clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    });
+                    out.push(if shown { (c / a).clamp(0.0, 1.0) } else { 0.0 });
                 }
                 out.push(a);
             } else {
@@ -437,6 +439,21 @@ mod tests {
         assert_eq!(v, vec![0.25, 0.5, 0.0]);
         let v = img.display_values([0.0; 3], true);
         assert_eq!(v, vec![0.5, 0.0, 0.0, 0.5]);
+    }
+
+    #[test]
+    fn straight_alpha_below_half_a_step_is_written_transparent_black() {
+        // Opacity 1e-4 (a grazing ray) and 0 give the same bytes, where
+        // colour over opacity would write the full colour for one of them.
+        let mut img = Image::new(3, 1);
+        img.set(0, 0, [0.7e-4, 0.2e-4, 1e-4, 1e-4]);
+        img.set(2, 0, [0.7e-2, 0.2e-2, 1e-2, 1e-2]);
+        let bytes = img.to_png_bytes([0.0; 3], true);
+        assert_eq!(&bytes[..8], &[0; 8]);
+        assert_eq!(&bytes[8..], &[179, 51, 255, 3]);
+        // Half a step is shown.
+        img.set(0, 0, [0.5 / 255.0, 0.0, 0.0, 0.5 / 255.0]);
+        assert_eq!(&img.to_png_bytes([0.0; 3], true)[..4], &[255, 0, 0, 1]);
     }
 
     #[test]

@@ -164,7 +164,8 @@ pub struct ViewArgs {
     /// Background colour R,G,B in [0,1] for PNG output.
     #[arg(long, value_parser = parse_rgb, default_value = "0,0,0")]
     pub background: [f32; 3],
-    /// Write RGBA PNGs with straight alpha instead of compositing over the background.
+    /// Write RGBA PNGs with straight alpha instead of compositing over the
+    /// background (colour 0 where the alpha byte is 0).
     #[arg(long)]
     pub alpha: bool,
     /// GPU backend (default: WGPU_BACKEND, else the best available).
