@@ -24,8 +24,8 @@
 //!
 //! The store is emptied when the camera, the culling or the geometry's
 //! points change ([`super::super::Renderer::set_geometry`]), and holds at
-//! most [`KEEP_REGIONS_MAX_BYTES`]: parts met once it is full are projected
-//! every frame.
+//! most [`KEEP_REGIONS_MAX_BYTES`] (less where a quarter of the available
+//! memory is less): parts met once it is full are projected every frame.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -34,9 +34,25 @@ use crate::camera::Camera;
 use crate::projection::{KeptRegions, Polyhedron};
 use crate::visibility::Piece;
 
-/// The most the kept regions may hold, bytes (about 2.2 KB per hex: the
-/// regions of 2^30 bytes keep about 480,000 hexes).
+/// The most the kept regions may hold, bytes (1.5 to 2 KB per hex: 2^30
+/// bytes keep about 600,000 hexes), and at most a quarter of the memory
+/// available when the store is set up ([`budget`]).
 pub const KEEP_REGIONS_MAX_BYTES: usize = 1 << 30;
+
+/// The kept regions' budget: [`KEEP_REGIONS_MAX_BYTES`], or a quarter of
+/// the memory the system says is available (Linux `MemAvailable`) where
+/// that is less, so that keeping regions never pushes a machine into
+/// swapping or out of memory.
+fn budget() -> usize {
+    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+        let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?;
+        let kib: usize = line.split_whitespace().nth(1)?.parse().ok()?;
+        Some(kib.saturating_mul(1024))
+    });
+    available.map_or(KEEP_REGIONS_MAX_BYTES, |a| {
+        (a / 4).min(KEEP_REGIONS_MAX_BYTES)
+    })
+}
 
 /// Which part of a cell a kept projection is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -74,6 +90,8 @@ pub struct RegionStore {
     /// Per geometry cell, its parts' kept regions.
     cells: Vec<Mutex<CellParts>>,
     bytes: AtomicUsize,
+    /// The most it may hold, bytes ([`budget`], set with the cells).
+    budget: usize,
 }
 
 impl RegionStore {
@@ -107,6 +125,7 @@ impl RegionStore {
             self.clear();
             self.key = Some(key);
             self.cells = (0..cells).map(|_| Mutex::new(Vec::new())).collect();
+            self.budget = budget();
         }
         StoreFrame { store: self, ids }
     }
@@ -144,7 +163,7 @@ impl StoreFrame<'_> {
 
     /// Whether there is room for more.
     pub(super) fn has_room(&self) -> bool {
-        self.store.bytes() < KEEP_REGIONS_MAX_BYTES
+        self.store.bytes() < self.store.budget
     }
 
     /// About how many bytes the kept regions hold.
