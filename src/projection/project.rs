@@ -38,7 +38,9 @@
 //!    ones; a crossing of a front and a back edge takes its front (back)
 //!    values along the front (back) edge, between the edge's ends, which is
 //!    exact and well conditioned even when a triangle beside the edge is a
-//!    sliver; regions are fan-triangulated, skipping triangles
+//!    sliver; each vertex records where its values came from (a point, a
+//!    triangle's plane, an edge: [`super::KeptRegions`] evaluates them
+//!    again for new scalars); regions are fan-triangulated, skipping triangles
 //!    whose exact orientation is not positive (zero area); with
 //!    [`Projector::clip_to_image`] the regions are then clipped to the image
 //!    rectangle plus a margin (near-plane caps project ~1e9 pixels away;
@@ -225,8 +227,8 @@ impl Projector {
     /// camera by a projector with these settings) steps 2-6 are not run
     /// again: their regions take `poly`'s scalars, and the steps that
     /// follow run as always. Otherwise, with `keep`, what steps 2-6 found
-    /// is returned, to be kept, where they found regions. The result is the same, bit for bit, either
-    /// way.
+    /// is returned, to be kept, where they found regions. The result is
+    /// the same, bit for bit, either way.
     pub fn project_with(
         &mut self,
         poly: &Polyhedron,
