@@ -1,5 +1,7 @@
 //! Projection cost per cell kind (one core): microseconds per projected
-//! piece, and regions / vertices per kind. Fixed seeds; cells are random
+//! piece, and regions / vertices per kind; and for regions kept across a
+//! values-only frame (`KeptRegions`), the cost of keeping them and of
+//! giving them new scalars (`restore_*`, against `project_*`). Fixed seeds; cells are random
 //! affine images of the reference shapes, cameras random (orthographic and
 //! perspective at the default 30-degree view angle) and fitted to a box 50
 //! times the cell's size, as for one cell of a ~50^3 mesh.
@@ -93,6 +95,44 @@ fn bench(c: &mut Criterion) {
                     let (p, cam) = &set[k % set.len()];
                     k += 1;
                     pr.project(black_box(p), cam, &mut out).unwrap();
+                    black_box(out.triangles.len())
+                })
+            });
+            // Regions kept for a values-only frame: making them (projecting
+            // and keeping), and giving them the next frame's scalars.
+            let kept: Vec<_> = set
+                .iter()
+                .map(|(p, cam)| pr.project_with(p, cam, None, true, &mut out).unwrap())
+                .collect();
+            let next: Vec<Polyhedron> = set
+                .iter()
+                .map(|(p, _)| {
+                    let mut q = p.clone();
+                    for s in &mut q.scalars {
+                        *s = 1.0 - 0.5 * *s;
+                    }
+                    q
+                })
+                .collect();
+            c.bench_function(&format!("project_keep_{name}_{mode}"), |b| {
+                let mut k = 0;
+                b.iter(|| {
+                    let (p, cam) = &set[k % set.len()];
+                    k += 1;
+                    black_box(
+                        pr.project_with(black_box(p), cam, None, true, &mut out)
+                            .unwrap(),
+                    )
+                })
+            });
+            c.bench_function(&format!("restore_{name}_{mode}"), |b| {
+                let mut k = 0;
+                b.iter(|| {
+                    let i = k % set.len();
+                    k += 1;
+                    let kept = kept[i].as_ref();
+                    pr.project_with(black_box(&next[i]), &set[i].1, kept, false, &mut out)
+                        .unwrap();
                     black_box(out.triangles.len())
                 })
             });
