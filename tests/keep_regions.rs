@@ -7,10 +7,10 @@
 //!
 //! The projected modes run on their CPU twin, so no adapter is needed.
 
-use std::sync::Arc;
+mod render_util;
 
+use render_util::time_step;
 use zoovr::camera::CameraParams;
-use zoovr::field::{Association, ScalarField};
 use zoovr::image::Image;
 use zoovr::io::{self, ReadOptions};
 use zoovr::render::iso::{IsoOptions, Lighting};
@@ -50,21 +50,9 @@ fn options(mode: Mode, close: bool, keep: bool) -> RenderOptions {
 /// Step `k`: a point field that changes per step (some cells dark in one
 /// step and not the next), mapped by the shading of step 0.
 fn step(geometry: &Geometry, first: &Shading, k: usize) -> Shading {
-    let phase = k as f64 * 0.9;
-    let values: Vec<f64> = geometry
-        .mesh
-        .points
-        .iter()
-        .map(|p| (p.x * 1.7 + p.y * 0.6 + phase).sin() * 2.0 + p.z * 0.3)
-        .collect();
-    Shading {
-        field: Some(Arc::new(ScalarField::new(
-            format!("step{k}"),
-            Association::Point,
-            values,
-        ))),
-        ..first.clone()
-    }
+    time_step(geometry, first, k, |p, k| {
+        (p.x * 1.7 + p.y * 0.6 + k * 0.9).sin() * 2.0 + p.z * 0.3
+    })
 }
 
 fn fresh(geometry: &Geometry, shading: &Shading, opts: &RenderOptions) -> Image {

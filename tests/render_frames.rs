@@ -5,8 +5,11 @@
 //!
 //! The projected mode runs on its CPU twin, so no adapter is needed.
 
+mod render_util;
+
 use std::sync::Arc;
 
+use render_util::time_step;
 use zoovr::camera::CameraParams;
 use zoovr::field::{Association, ScalarField};
 use zoovr::image::Image;
@@ -43,21 +46,9 @@ fn options(mode: Mode) -> RenderOptions {
 /// Step `k` of a synthetic series: a point field that changes per step,
 /// mapped by the shading of step 0 (the same transfer function and range).
 fn step(geometry: &Geometry, first: &Shading, k: usize) -> Shading {
-    let phase = k as f64 * 0.7;
-    let values: Vec<f64> = geometry
-        .mesh
-        .points
-        .iter()
-        .map(|p| (p.x * 1.3 + p.y * 0.4 + phase).sin() + p.z * 0.2)
-        .collect();
-    Shading {
-        field: Some(Arc::new(ScalarField::new(
-            format!("step{k}"),
-            Association::Point,
-            values,
-        ))),
-        ..first.clone()
-    }
+    time_step(geometry, first, k, |p, k| {
+        (p.x * 1.3 + p.y * 0.4 + k * 0.7).sin() + p.z * 0.2
+    })
 }
 
 fn fresh(geometry: &Geometry, shading: &Shading, opts: &RenderOptions) -> Image {

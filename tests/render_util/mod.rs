@@ -1,10 +1,40 @@
-//! Helpers shared by the render tests: whether a GPU adapter is there, and
-//! the options of one render by mode, split and field model.
+//! Helpers shared by the render tests: whether a GPU adapter is there, the
+//! options of one render by mode, split and field model, and the steps of a
+//! synthetic series.
 #![allow(dead_code)]
 
+use std::sync::Arc;
+
+use glam::DVec3;
+use zoovr::field::{Association, ScalarField};
 use zoovr::gpu::{Context, GpuOptions};
 use zoovr::raycast::FieldModel;
-use zoovr::render::{Mode, ProjectedOptions, ReferenceOptions, RenderOptions};
+use zoovr::render::{Geometry, Mode, ProjectedOptions, ReferenceOptions, RenderOptions, Shading};
+
+/// Step `k` of a synthetic series over `geometry`: the point field
+/// `value(p, k)`, mapped by the shading of step 0 (`first`: the same
+/// transfer function and range).
+pub fn time_step(
+    geometry: &Geometry,
+    first: &Shading,
+    k: usize,
+    value: impl Fn(DVec3, f64) -> f64,
+) -> Shading {
+    let values = geometry
+        .mesh
+        .points
+        .iter()
+        .map(|&p| value(p, k as f64))
+        .collect();
+    Shading {
+        field: Some(Arc::new(ScalarField::new(
+            format!("step{k}"),
+            Association::Point,
+            values,
+        ))),
+        ..first.clone()
+    }
+}
 
 /// Whether a GPU adapter opens with the default options; when none does,
 /// says so on stderr (the caller then skips its GPU part).
