@@ -33,7 +33,8 @@ enum Command {
     Render(Box<render::RenderArgs>),
     /// Render the steps of a time series (or a turntable of one dataset) to
     /// numbered PNG frames, and optionally a GIF or an MP4, reusing the
-    /// topology, sort and GPU state across frames where the steps allow.
+    /// topology, sort, projected regions and GPU state across frames where
+    /// the steps allow.
     Animate(Box<animate::AnimateArgs>),
     /// Time every mode against its error: each mode at the settings that
     /// trade time for error, at several sizes and views, against the ray
