@@ -190,3 +190,82 @@ impl StoreFrame<'_> {
         bytes_of.fetch_add(bytes, Ordering::Relaxed);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::CameraParams;
+    use crate::projection::Projector;
+    use glam::DVec3;
+
+    /// A tet's polyhedron and its kept regions for `camera`.
+    fn kept_tet(camera: &Camera, s: f64) -> (Polyhedron, KeptRegions) {
+        let p =
+            [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.2, 0.3, 1.0)].map(|w| camera.to_view(w));
+        let mut poly = Polyhedron::default();
+        poly.set_tet(p, [0.0, s, 1.0, 0.5]);
+        let mut pr = Projector::new();
+        pr.clip_to_image = true;
+        pr.cull_to_pixels = true;
+        let kept = pr
+            .project_with(&poly, camera, None, true, &mut Default::default())
+            .unwrap()
+            .expect("regions");
+        (poly, kept)
+    }
+
+    #[test]
+    fn parts_are_found_by_key_and_geometry_within_the_budget() {
+        let params = CameraParams {
+            width: 64,
+            height: 64,
+            ..Default::default()
+        };
+        let camera = Camera::fit([0.0, 1.0, 0.0, 1.0, 0.0, 1.0], &params);
+        let mut store = RegionStore::default();
+        let (poly, kept) = kept_tet(&camera, 0.25);
+        let bytes = kept.bytes();
+        {
+            let frame = store.frame(&camera, true, 3, None);
+            assert!(frame.has_room());
+            frame.put(1, PartKey::Cell, kept);
+            assert!(frame.get(1, PartKey::Cell, &poly).is_some());
+            assert!(frame.get(0, PartKey::Cell, &poly).is_none(), "another cell");
+            assert!(frame.get(1, PartKey::Tet([0, 1, 2, 3]), &poly).is_none());
+            let mut moved = poly.clone();
+            moved.points[0].x += 1e-9;
+            assert!(
+                frame.get(1, PartKey::Cell, &moved).is_none(),
+                "other points"
+            );
+            // Put again in place: counted once.
+            frame.put(1, PartKey::Cell, kept_tet(&camera, 0.5).1);
+            assert_eq!(frame.bytes(), bytes);
+            // Cells beyond the store, or a subset's ids out of range.
+            frame.put(7, PartKey::Cell, kept_tet(&camera, 0.5).1);
+            assert_eq!(frame.bytes(), bytes);
+        }
+        let ids = [2u32, 1, 9];
+        {
+            let frame = store.frame(&camera, true, 3, Some(&ids));
+            assert!(
+                frame.get(1, PartKey::Cell, &poly).is_some(),
+                "geometry id 1"
+            );
+            assert!(frame.get(0, PartKey::Cell, &poly).is_none());
+            assert!(frame.get(2, PartKey::Cell, &poly).is_none(), "id 9: none");
+        }
+        // Full: nothing more is kept.
+        store.budget = bytes;
+        assert!(!store.frame(&camera, true, 3, None).has_room());
+        // Another camera or culling empties the store.
+        let other = Camera::fit([0.0, 2.0, 0.0, 1.0, 0.0, 1.0], &params);
+        assert_eq!(store.frame(&other, true, 3, None).bytes(), 0);
+        store
+            .frame(&camera, true, 3, None)
+            .put(0, PartKey::Cell, kept_tet(&camera, 0.1).1);
+        assert!(store.bytes() > 0);
+        assert_eq!(store.frame(&camera, false, 3, None).bytes(), 0);
+        assert!(budget() > 0 && budget() <= KEEP_REGIONS_MAX_BYTES);
+    }
+}
