@@ -459,6 +459,38 @@ fn malformed_ghost_arrays_are_named() {
     }
 }
 
+/// A field with NaN values renders in a projected mode and in the
+/// reference, each saying what it makes of them, naming the file.
+#[test]
+fn nan_values_are_rendered_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let mut m = ghost_grid(4, &Warp::default());
+    m.cell_data.clear();
+    let n = m.points.len();
+    let values: Vec<f64> = (0..n)
+        .map(|i| if i % 11 == 0 { f64::NAN } else { i as f64 })
+        .collect();
+    m.point_data = vec![DataArray {
+        name: "f".into(),
+        components: 1,
+        data: ArrayData::F64(values),
+        vtk_type: "Float64".into(),
+    }];
+    let file = dir.path().join("nan.vtu");
+    write_vtu(&file, &m, Compression::None).unwrap();
+    for (mode, says) in [
+        ("exact-frag", "drawn empty"),
+        ("raycast", "NaN end are empty"),
+    ] {
+        let o = render(&file, &out, &["--size", "24x24", "--mode", mode]);
+        let e = stderr(&o);
+        assert!(o.status.success(), "{mode}: {e}");
+        assert!(e.contains("nan.vtu") && e.contains(says), "{mode}: {e}");
+        assert!(out.exists());
+    }
+}
+
 /// The table modes through the binary: `--table` and `--table-build` in
 /// `--help`, the table in `--stats --json`, and sizes no device holds
 /// refused with the limit named (exit 1).

@@ -533,6 +533,7 @@ impl Drawer<'_> {
             .as_ref()
             .ok_or_else(|| anyhow!("no renderer"))?;
         let shading = Shading::build(r.geometry(), self.spec).with_context(at)?;
+        self.args.view.non_finite_warning(&shading, &step.path);
         if self.current.is_none() && k == self.first_step {
             self.first_field = field_key(&shading);
         } else {

@@ -259,6 +259,25 @@ impl ViewArgs {
         }
     }
 
+    /// A warning where the field of `file` has NaN or infinite values:
+    /// what the mode makes of them (README, "Bad values").
+    pub fn non_finite_warning(&self, shading: &Shading, file: &std::path::Path) {
+        let Some(field) = shading.field.as_ref().filter(|f| !f.all_finite) else {
+            return;
+        };
+        let n = field.values.iter().filter(|v| !v.is_finite()).count();
+        let what = if self.mode.info().gpu {
+            "the cells (or tets, slabs) holding one are drawn empty"
+        } else {
+            "ray segments with a NaN end are empty, infinities are clamped to 1e300"
+        };
+        eprintln!(
+            "zoovr: warning: {}: {n} values of field '{}' are NaN or infinite; {what}",
+            file.display(),
+            field.name
+        );
+    }
+
     /// Flag combinations that are usage errors (beyond what clap checks).
     pub fn usage_error(&self) -> Option<String> {
         if self.mode == Mode::Iso && self.iso.is_none() {
@@ -390,6 +409,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let (geometry, shading) = args.view.load_scene(&args.file)?;
     let load_s = t0.elapsed().as_secs_f64();
     args.view.iso_range_warnings(&shading);
+    args.view.non_finite_warning(&shading, &args.file);
     let ghost_cells = geometry.ghost_cells;
     let mut renderer = Renderer::new(geometry);
     if let Some(p) = pending {

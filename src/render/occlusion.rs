@@ -637,6 +637,11 @@ fn cell_credit(
 ) {
     let mesh = src.mesh;
     let nodes = mesh.cells.nodes(c as usize);
+    // A cell with a non-finite scalar is drawn empty (`PieceSource::parts`):
+    // it hides nothing.
+    if nodes.iter().any(|&p| !src.scalar(c, p).is_finite()) {
+        return;
+    }
     let (lo, hi) = value_range(nodes.iter().map(|&p| src.scalar(c, p)));
     let tau = if credit.volume {
         src.min_extinction(lo, hi) * CREDIT_SHRINK

@@ -11,7 +11,8 @@
 //!   breakpoints its slabs (back to front along the tet's gradient,
 //!   [`tet_slabs`], the slab expansion the order uses too). Pieces whose scalar range maps to zero extinction
 //!   everywhere are left out ([`PieceSource::invisible`]): they neither emit
-//!   nor absorb in the glow model. The tet of consecutive slabs is built
+//!   nor absorb in the glow model; so are pieces with a non-finite scalar
+//!   at a node, empty as the reference's segments with a NaN end are. The tet of consecutive slabs is built
 //!   once ([`PartScratch`]).
 
 use super::ties::TieRays;
@@ -122,7 +123,9 @@ pub struct PartScratch {
 /// What [`PieceSource::parts`] did with a piece.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Parts {
-    /// Left out: zero extinction over its scalar range.
+    /// Left out: zero extinction over its scalar range, or a non-finite
+    /// scalar at a node (drawn empty, as the reference's segments with a
+    /// NaN end are).
     pub invisible: bool,
     /// Slab pieces drawn.
     pub slabs: usize,
@@ -180,6 +183,25 @@ impl PieceSource<'_> {
     ) -> Result<Parts, PieceError> {
         let cell = piece.cell();
         let mut done = Parts::default();
+        // A piece with a non-finite scalar at a node is drawn empty. The
+        // reference integrates a segment with a NaN end as nothing
+        // (`integrate::segment`), and every ray through a tet with a NaN
+        // corner enters or leaves it through a face holding that corner,
+        // so such a tet is empty to the `tets` field exactly; the `faces`
+        // field of a whole cell keeps the rays between two faces without
+        // it, and the reference clamps infinities to 1e300 (README, "Bad
+        // values").
+        let finite = |n: &u32| self.scalar(cell, *n).is_finite();
+        let all_finite = match *piece {
+            Piece::Cell(c) => self.mesh.cells.nodes(c as usize).iter().all(finite),
+            Piece::Tet { tet, .. } | Piece::Slab { tet, .. } | Piece::Frag { tet, .. } => {
+                tet.iter().all(finite)
+            }
+        };
+        if !all_finite {
+            done.invisible = true;
+            return Ok(done);
+        }
         let PartScratch {
             poly,
             whole,
