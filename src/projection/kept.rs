@@ -71,42 +71,29 @@ pub struct KeptRegions {
     regions: RegionList,
     region_faces: Vec<[u32; 2]>,
     outline_inputs: [bool; 2],
-    /// Whether the piece had regions that can reach a pixel centre.
-    emitted: bool,
     fast_path: bool,
 }
 
 impl KeptRegions {
-    /// What steps 2-6 made of `poly` (its part beyond the near plane
-    /// projected at pixel positions `pix`): `out`, or nothing when
-    /// `emitted` is false.
+    /// The regions steps 2-6 made of `poly` (its part beyond the near
+    /// plane projected at pixel positions `pix`), written in `out`.
     pub(super) fn new(
         poly: &Polyhedron,
         pix: &[DVec2],
         out: &Projected,
-        emitted: bool,
         fast_path: bool,
     ) -> KeptRegions {
-        let mut kept = KeptRegions {
+        KeptRegions {
             points: poly.points.clone(),
             triangles: poly.triangles.clone(),
-            pix: Vec::new(),
-            pos: Vec::new(),
-            sources: Vec::new(),
-            regions: RegionList::default(),
-            region_faces: Vec::new(),
+            pix: pix.to_vec(),
+            pos: out.vertices.iter().map(RegionVertex::pos).collect(),
+            sources: out.sources.clone(),
+            regions: out.regions.clone(),
+            region_faces: out.region_faces.clone(),
             outline_inputs: out.outline_inputs,
-            emitted,
             fast_path,
-        };
-        if emitted {
-            kept.pix = pix.to_vec();
-            kept.pos = out.vertices.iter().map(RegionVertex::pos).collect();
-            kept.sources = out.sources.clone();
-            kept.regions = out.regions.clone();
-            kept.region_faces = out.region_faces.clone();
         }
-        kept
     }
 
     /// Whether `poly` has the geometry these regions were made for: the
@@ -134,12 +121,8 @@ impl KeptRegions {
     /// Writes the kept regions into `out` (cleared, its view set) with the
     /// scalars of `piece` (the piece these were made for, or its part
     /// beyond the near plane, now with new scalars): the faces and the
-    /// vertices' values are evaluated again as step 6 did. Returns whether
-    /// there are regions.
-    pub(super) fn restore(&self, piece: &Polyhedron, out: &mut Projected) -> bool {
-        if !self.emitted {
-            return false;
-        }
+    /// vertices' values are evaluated again as step 6 did.
+    pub(super) fn restore(&self, piece: &Polyhedron, out: &mut Projected) {
         out.faces
             .extend((0..piece.triangles.len() as u32).map(|t| FaceTri::new(piece, &self.pix, t)));
         let view = out.view;
@@ -166,6 +149,5 @@ impl KeptRegions {
         out.outline_inputs = self.outline_inputs;
         let [fast, complete] = self.outline_inputs;
         out.outline_profile = fast && profile_hull && complete;
-        true
     }
 }

@@ -282,14 +282,15 @@ impl Projector {
         let (emitted, fresh) = match kept {
             Some(k) => {
                 self.took_fast_path = k.fast_path();
-                (k.restore(piece, out), None)
+                k.restore(piece, out);
+                (true, None)
             }
             None => {
                 let emitted = self.regions(piece, camera, out)?;
                 // A piece without regions (its pixel box holds no centre,
                 // or it is edge-on) is as quick to project again.
                 let fresh = (keep && emitted)
-                    .then(|| KeptRegions::new(poly, &self.pix, out, emitted, self.took_fast_path));
+                    .then(|| KeptRegions::new(poly, &self.pix, out, self.took_fast_path));
                 (emitted, fresh)
             }
         };

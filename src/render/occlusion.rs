@@ -639,7 +639,7 @@ fn cell_credit(
     let nodes = mesh.cells.nodes(c as usize);
     // A cell with a non-finite scalar is drawn empty (`PieceSource::parts`):
     // it hides nothing.
-    if nodes.iter().any(|&p| !src.scalar(c, p).is_finite()) {
+    if src.field_span.is_none() && nodes.iter().any(|&p| !src.scalar(c, p).is_finite()) {
         return;
     }
     let (lo, hi) = value_range(nodes.iter().map(|&p| src.scalar(c, p)));

@@ -191,13 +191,15 @@ impl PieceSource<'_> {
         // field of a whole cell keeps the rays between two faces without
         // it, and the reference clamps infinities to 1e300 (README, "Bad
         // values").
+        // (Only looked at where the field has such a value: its span.)
         let finite = |n: &u32| self.scalar(cell, *n).is_finite();
-        let all_finite = match *piece {
-            Piece::Cell(c) => self.mesh.cells.nodes(c as usize).iter().all(finite),
-            Piece::Tet { tet, .. } | Piece::Slab { tet, .. } | Piece::Frag { tet, .. } => {
-                tet.iter().all(finite)
-            }
-        };
+        let all_finite = self.field_span.is_some()
+            || match *piece {
+                Piece::Cell(c) => self.mesh.cells.nodes(c as usize).iter().all(finite),
+                Piece::Tet { tet, .. } | Piece::Slab { tet, .. } | Piece::Frag { tet, .. } => {
+                    tet.iter().all(finite)
+                }
+            };
         if !all_finite {
             done.invisible = true;
             return Ok(done);
