@@ -11,11 +11,17 @@
 //    src/render/modes/segment.rs `ScalarMap` says);
 // 2: the constants of the closed form (`consts`): the Taylor centres of the
 //    special functions (129 entries: P, Q, B, G at x = k/16) followed by the
-//    6-node Gauss-Legendre rule on [0, 1] ((x, w) pairs, two per entry). In
-//    f32 it is as good as the f64 path's 12 nodes (error below 6e-9 up to
-//    depth 2, tested) at half the cost. One rule at every depth up to 2: a
-//    second, shorter rule for small depths cost more than it saved, since
-//    the lanes of a SIMD group that straddle its threshold run both.
+//    6-node Gauss-Legendre rule on [0, 1] ((x, w) pairs, two per entry),
+//    which the table build's recurrences read.
+//
+// Up to optical depth 2 the basis integrals are a Gauss-Legendre rule whose
+// nodes are literals here (`gauss`): loaded from a buffer they cost a
+// gather per node on a software rasteriser. The 6-node rule is as good in
+// f32 as the f64 path's 12 nodes (error below 6e-9 up to depth 2, tested)
+// at half the cost; a stage whose every segment is thinner takes a shorter
+// rule (`GAUSS_NODES`, chosen on the CPU per frame from the scene's
+// thickest possible segment, never per fragment: the lanes of a SIMD group
+// that straddle a threshold would run both rules).
 
 struct TfBuffer {
     // Number of nodes (>= 1).
@@ -48,6 +54,12 @@ const GAUSS_MAX: f32 = 2.0;
 // compiler then drops the closed form, whose mere presence slowed every
 // fragment on llvmpipe by about 12 %.
 override THICK_SEGMENTS: bool = true;
+// The Gauss-Legendre rule of the thin regime: 6 nodes (error below 6e-9
+// relative up to depth 2), 5 (below 4.4e-8 up to depth 1.25) or 4 (below
+// 5.4e-8 up to depth 0.35), all under f32's rounding unit (6.0e-8), chosen
+// on the CPU (render::modes::integral::GaussRule) from the thickest
+// segment the frame can hold.
+override GAUSS_NODES: u32 = 6u;
 // Above this argument the special functions use their asymptotic series.
 const ASYM_X: f32 = 8.0;
 // Optical thicknesses and lengths are clamped here (f32 range, and so that
@@ -96,28 +108,26 @@ fn piece_index(s: f32) -> u32 {
 }
 
 // Extinction and colour of piece `idx` at `s`: exact node values at its
-// nodes, constant beyond the first and last node.
+// nodes, constant beyond the first and last node. Without branches (a
+// software rasteriser runs every side of a branch its lanes take, with
+// every side's loads): the piece's two nodes are loaded once and the
+// result selected.
 fn eval_piece(idx: u32, s: f32) -> Material {
     let n = tf.count;
-    if idx == 0u {
-        return node(0u);
-    }
-    if idx >= n {
-        return node(n - 1u);
-    }
-    let j = idx - 1u;
-    let s0 = node_s(j);
-    let s1 = node_s(j + 1u);
-    if s == s0 {
-        return node(j);
-    }
-    if s == s1 {
-        return node(j + 1u);
-    }
-    let u = (s - s0) / (s1 - s0);
-    let m0 = node(j);
-    let m1 = node(j + 1u);
-    return Material(m0.tau + (m1.tau - m0.tau) * u, m0.col + (m1.col - m0.col) * u);
+    let j = min(max(idx, 1u), n) - 1u;
+    let k = min(j + 1u, n - 1u);
+    let a0 = tf.nodes[2u * j];
+    let a1 = tf.nodes[2u * k];
+    let c0 = tf.nodes[2u * j + 1u].xyz;
+    let c1 = tf.nodes[2u * k + 1u].xyz;
+    let u = (s - a0.x) / (a1.x - a0.x);
+    var tau = a0.y + (a1.y - a0.y) * u;
+    var col = c0 + (c1 - c0) * u;
+    let at_back = s == a1.x;
+    tau = select(tau, a1.y, at_back);
+    col = select(col, c1, at_back);
+    let at_front = idx == 0u || idx >= n || s == a0.x;
+    return Material(select(tau, a0.y, at_front), select(col, c0, at_front));
 }
 
 // 1 - exp(-d) for d >= 0 without cancellation at small d.
@@ -198,22 +208,39 @@ fn sanitize_thickness(x: f32) -> f32 {
     return 0.0;
 }
 
-// [w_f, w_b, phi_f, phi_b] by a Gauss-Legendre rule on [0, 1] (positive
-// integrands: no cancellation).
-fn gauss(a: f32, b: f32, base: u32, pairs: u32) -> vec4<f32> {
+// Adds node x with weight w of a Gauss-Legendre rule on [0, 1] to
+// [w_f, w_b, phi_f, phi_b] (positive integrands: no cancellation).
+fn gauss_node(acc: ptr<function, vec4<f32>>, a: f32, b: f32, x: f32, w: f32) {
+    let y = 1.0 - x;
+    let dx = x * (a * (1.0 - 0.5 * x) + b * (0.5 * x));
+    let dp = a * y + b * x;
+    let e = w * exp(-dx);
+    let ed = e * dp;
+    *acc += vec4<f32>(y * ed, x * ed, y * e, x * e);
+}
+
+// [w_f, w_b, phi_f, phi_b] by the GAUSS_NODES rule (twin:
+// integral::GaussRule's nodes, the same f32 values).
+fn gauss(a: f32, b: f32) -> vec4<f32> {
     var acc = vec4<f32>(0.0);
-    for (var i = 0u; i < pairs; i++) {
-        let e2 = consts[base + i];
-        for (var h = 0u; h < 2u; h++) {
-            let x = select(e2.x, e2.z, h == 1u);
-            let w = select(e2.y, e2.w, h == 1u);
-            let y = 1.0 - x;
-            let dx = x * (a * (1.0 - 0.5 * x) + b * (0.5 * x));
-            let dp = a * y + b * x;
-            let e = w * exp(-dx);
-            let ed = e * dp;
-            acc += vec4<f32>(y * ed, x * ed, y * e, x * e);
-        }
+    if GAUSS_NODES == 4u {
+        gauss_node(&acc, a, b, 0.06943184420297371, 0.17392742256872692);
+        gauss_node(&acc, a, b, 0.3300094782075719, 0.32607257743127305);
+        gauss_node(&acc, a, b, 0.6699905217924281, 0.32607257743127305);
+        gauss_node(&acc, a, b, 0.9305681557970262, 0.17392742256872692);
+    } else if GAUSS_NODES == 5u {
+        gauss_node(&acc, a, b, 0.046910077030668, 0.11846344252809454);
+        gauss_node(&acc, a, b, 0.2307653449471585, 0.23931433524968324);
+        gauss_node(&acc, a, b, 0.5, 0.28444444444444444);
+        gauss_node(&acc, a, b, 0.7692346550528415, 0.23931433524968324);
+        gauss_node(&acc, a, b, 0.953089922969332, 0.11846344252809454);
+    } else {
+        gauss_node(&acc, a, b, 0.03376524289842399, 0.08566224618958518);
+        gauss_node(&acc, a, b, 0.16939530676686773, 0.1803807865240693);
+        gauss_node(&acc, a, b, 0.38069040695840156, 0.23395696728634552);
+        gauss_node(&acc, a, b, 0.6193095930415985, 0.23395696728634552);
+        gauss_node(&acc, a, b, 0.8306046932331322, 0.1803807865240693);
+        gauss_node(&acc, a, b, 0.966234757101576, 0.08566224618958518);
     }
     return acc;
 }
@@ -227,7 +254,7 @@ fn weights(a_in: f32, b_in: f32) -> Weights {
     if m <= GAUSS_MAX || !THICK_SEGMENTS {
         let alpha = neg_expm1(d1);
         let t = 1.0 - alpha;
-        let g = gauss(a, b, GL6_BASE, 3u);
+        let g = gauss(a, b);
         return Weights(g.z + g.w, g.z, g.w, g.x, g.y, alpha, t);
     }
     let t = exp(-d1);
@@ -250,6 +277,10 @@ struct Composite {
     depth: f32,
     alpha: f32,
     pieces: u32,
+    // Transmittance in front of the next piece: the product of the
+    // pieces' own (each exp(-depth) already), so no exponential of the
+    // running depth per piece.
+    tr: f32,
 }
 
 // Adds one linear piece of length `l` (extinction and colour linear from
@@ -264,11 +295,8 @@ fn add_piece(acc: ptr<function, Composite>, l: f32, m0: Material, m1: Material) 
     } else {
         c = l * (m0.col * w.phi_f + m1.col * w.phi_b);
     }
-    var tr = 1.0;
-    if (*acc).depth != 0.0 {
-        tr = exp(-(*acc).depth);
-    }
-    (*acc).color += tr * c;
+    (*acc).color += (*acc).tr * c;
+    (*acc).tr *= w.t;
     (*acc).depth += 0.5 * (sanitize_thickness(a) + sanitize_thickness(b));
     (*acc).alpha = w.alpha;
     (*acc).pieces += 1u;
@@ -338,7 +366,7 @@ fn integrate_segment(l_in: f32, sf_in: f32, sb_in: f32) -> vec4<f32> {
     let l = min(l_in, MAX_THICKNESS);
     let s_f = clamp(sf_in, -MAX_SCALAR, MAX_SCALAR);
     let s_b = clamp(sb_in, -MAX_SCALAR, MAX_SCALAR);
-    var acc = Composite(vec3<f32>(0.0), 0.0, 0.0, 0u);
+    var acc = Composite(vec3<f32>(0.0), 0.0, 0.0, 0u, 1.0);
     // Front to back, count + 1 spans (`segment_spans`, `span_end`). One
     // loop with one call of add_piece keeps the shader small (every lane of
     // a SIMD group runs the loop as often as its longest segment).

@@ -18,8 +18,8 @@ mod golden_util;
 use golden_util::{f, golden, rgb};
 use serde_json::Value;
 use zoovr::gpu::{AccumFormat, ClipMapper, Context, FrameOptions, GpuOptions};
-use zoovr::render::modes::exact_frag::{bind_exact_frag_stage, thin_stage_holds};
-use zoovr::render::modes::integral::{closed_form_constants, TfBuffer};
+use zoovr::render::modes::exact_frag::{bind_exact_frag_stage, thin_rule};
+use zoovr::render::modes::integral::{closed_form_constants, GaussRule, TfBuffer};
 use zoovr::render::modes::segment::{SegmentVertex, SegmentView};
 
 const REL: f64 = 1e-5;
@@ -141,12 +141,18 @@ fn golden_through_the_twin() {
     assert_eq!(cases.len(), 418);
     let mut worst = 0.0f64;
     for case in &cases {
-        let got = composite(
-            case.cells
-                .iter()
-                .map(|&(l, sf, sb)| case.tf.integrate_segment(&consts, l, sf, sb)),
-        );
-        worst = worst.max(check(case, got, "twin"));
+        // Every case with the 6-node rule, and with the shorter rule the
+        // stage would draw it with (its own longest cell, as on the GPU).
+        let longest = case.cells.iter().map(|c| c.0 as f64).fold(0.0, f64::max);
+        let rule = thin_rule(&case.tf, longest).unwrap_or_default();
+        for rule in [GaussRule::Six, rule] {
+            let got = composite(
+                case.cells
+                    .iter()
+                    .map(|&(l, sf, sb)| case.tf.integrate_segment(&consts, rule, l, sf, sb)),
+            );
+            worst = worst.max(check(case, got, &format!("twin {rule:?}")));
+        }
     }
     eprintln!("twin: worst relative error {worst:.2e}");
 }
@@ -174,12 +180,15 @@ fn golden_on_the_gpu() {
         .unwrap();
     let mut piece = 0u32;
     // Each case at its own longest cell: the cases whose every segment is
-    // thinner than the closed form's threshold are drawn by the thin stage
-    // (`THICK_SEGMENTS` off), the others by the full one; both are checked.
-    let mut thin = 0;
+    // thinner than the closed form's threshold are drawn by a thin stage
+    // (`THICK_SEGMENTS` off) with the shortest Gauss rule holding them, the
+    // others by the full one; every variant is checked.
+    let mut by_rule = std::collections::BTreeMap::new();
     for (n, case) in cases.iter().enumerate() {
         let longest = case.cells.iter().map(|c| c.0 as f64).fold(0.0, f64::max);
-        thin += thin_stage_holds(&case.tf, longest) as usize;
+        *by_rule
+            .entry(format!("{:?}", thin_rule(&case.tf, longest)))
+            .or_insert(0) += 1;
         let stage = bind_exact_frag_stage(&gpu, &SegmentView::ortho(), &case.tf, longest).unwrap();
         let (i, j) = (n as u32 % w, n as u32 / w);
         // Back to front: the last cell first.
@@ -208,11 +217,8 @@ fn golden_on_the_gpu() {
         let got = img.pixels[n];
         worst = worst.max(check(case, got, "gpu"));
     }
-    eprintln!(
-        "gpu: worst relative error {worst:.2e} ({thin} of {} cases on the thin stage)",
-        cases.len()
-    );
-    assert!(thin > 0 && thin < cases.len(), "{thin} thin cases");
+    eprintln!("gpu: worst relative error {worst:.2e} (cases by stage: {by_rule:?})");
+    assert_eq!(by_rule.len(), 4, "every stage variant drawn: {by_rule:?}");
 }
 
 /// Independent emission (a source of its own, not extinction times colour,
@@ -320,23 +326,29 @@ fn independent_emission_matches_the_reference() {
     }
 }
 
-/// The thin stage is chosen only where the transfer function's largest
+/// A thin stage is chosen only where the transfer function's largest
 /// extinction times the longest segment stays below the closed form's
-/// threshold, with its margin, and never on NaN or infinite inputs.
+/// threshold, with its margin, and never on NaN or infinite inputs; its
+/// Gauss rule is the shortest holding that depth.
 #[test]
 fn thin_stage_needs_every_segment_below_the_threshold() {
     let tf = TfBuffer {
         model: 0,
         nodes: [node(0.0, 0.5, [1.0; 3]), node(1.0, 1.0, [1.0; 3])].concat(),
     };
-    assert!(thin_stage_holds(&tf, 1.9));
-    assert!(!thin_stage_holds(&tf, 2.0), "no margin");
-    assert!(!thin_stage_holds(&tf, 2.5));
-    assert!(!thin_stage_holds(&tf, f64::INFINITY));
-    assert!(!thin_stage_holds(&tf, f64::NAN));
+    assert_eq!(thin_rule(&tf, 1.9), Some(GaussRule::Six));
+    assert_eq!(thin_rule(&tf, 2.0), None, "no margin");
+    assert_eq!(thin_rule(&tf, 2.5), None);
+    assert_eq!(thin_rule(&tf, f64::INFINITY), None);
+    assert_eq!(thin_rule(&tf, f64::NAN), None);
+    assert_eq!(thin_rule(&tf, 1.2), Some(GaussRule::Five));
+    assert_eq!(thin_rule(&tf, 1.25), Some(GaussRule::Six), "no margin");
+    assert_eq!(thin_rule(&tf, 0.3), Some(GaussRule::Four));
+    assert_eq!(thin_rule(&tf, 0.35), Some(GaussRule::Five), "no margin");
+    assert_eq!(thin_rule(&tf, 0.0), Some(GaussRule::Four));
     let nan = TfBuffer {
         model: 0,
         nodes: [node(0.0, 0.5, [1.0; 3]), node(1.0, f64::NAN, [1.0; 3])].concat(),
     };
-    assert!(!thin_stage_holds(&nan, 0.1));
+    assert_eq!(thin_rule(&nan, 0.1), None);
 }

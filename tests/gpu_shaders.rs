@@ -21,14 +21,22 @@ fn stages() -> Vec<&'static StageDesc> {
         &iso::ISO_PREINT3D_STAGE,
         &iso::ISO_PREINT2D_STAGE,
         &iso::ISO_PREINT2D_CYL_STAGE,
-        // exact-frag's whole-piece quads.
-        &zoovr::render::modes::piece_quad::PIECE_QUAD_STAGE,
-        &zoovr::render::modes::piece_quad::PIECE_QUAD_THIN_STAGE,
         // The table modes' whole-piece quads.
         &zoovr::render::modes::preint_quads::PREINT3D_QUAD_STAGE,
         &zoovr::render::modes::preint_quads::PREINT2D_QUAD_STAGE,
         &zoovr::render::modes::preint_quads::PREINT2D_CYL_QUAD_STAGE,
     ]);
+    // Every variant of the stages that integrate: by segment thickness and
+    // Gauss rule (exact-frag's whole-piece quads only here).
+    for stages in [
+        &zoovr::render::modes::exact_frag::EXACT_FRAG_STAGES,
+        &zoovr::render::modes::piece_quad::PIECE_QUAD_STAGES,
+        &iso::ISO_EXACT_FRAG_STAGES,
+    ] {
+        v.extend(stages.all());
+    }
+    v.sort_by_key(|s| s.name);
+    v.dedup_by_key(|s| s.name);
     v
 }
 

@@ -29,8 +29,8 @@ use crate::raycast::FieldModel;
 use crate::render::pieces::PieceSource;
 use crate::tf::{EmissionModel, TransferFunction};
 
-use super::integral::{closed_form_constants, TfBuffer, GAUSS_MAX};
-use super::preint_tables::TableCache;
+use super::integral::{closed_form_constants, GaussRule, TfBuffer};
+use super::preint_tables::{SceneLengths, TableCache};
 use super::segment::{segment_at, ScalarMap, SegmentMode, SegmentVertex, SegmentView};
 use super::{Bounds, ModeInfo};
 
@@ -63,12 +63,44 @@ pub static INFO: ModeInfo = ModeInfo {
 /// the fragment entry points.
 pub static EXACT_FRAG_STAGE: StageDesc = exact_frag_stage("exact_frag.wgsl", &[]);
 
-/// The exact-frag stage compiled without the closed form for optically
-/// thick segments (`THICK_SEGMENTS` false in `shaders/integral.wgsl`):
-/// drawn where no segment can be thicker than [`GAUSS_MAX`]
-/// ([`thin_stage_holds`]); the same images, about 12 % faster on llvmpipe.
-pub static EXACT_FRAG_THIN_STAGE: StageDesc =
-    exact_frag_stage("exact_frag.wgsl+thin", &[("THICK_SEGMENTS", 0.0)]);
+/// The exact-frag stage's variants ([`integral_stage`] picks one per
+/// frame): [`EXACT_FRAG_STAGE`] where a segment can be optically thick,
+/// else compiled without the closed form for thick segments
+/// (`THICK_SEGMENTS` false in `shaders/integral.wgsl`: about 12 % faster
+/// on llvmpipe) and with the frame's Gauss rule (`GAUSS_NODES`).
+pub static EXACT_FRAG_STAGES: IntegralStages = IntegralStages {
+    full: &EXACT_FRAG_STAGE,
+    thin: [
+        &exact_frag_stage("exact_frag.wgsl+thin4", THIN_CONSTANTS[0]),
+        &exact_frag_stage("exact_frag.wgsl+thin5", THIN_CONSTANTS[1]),
+        &exact_frag_stage("exact_frag.wgsl+thin6", THIN_CONSTANTS[2]),
+    ],
+};
+
+/// The variants of one stage that includes `shaders/integral.wgsl` for its
+/// volume: `full` draws every segment, `thin` only segments no thicker
+/// than [`GAUSS_MAX`](super::integral::GAUSS_MAX), with the Gauss rule of 4, 5 and 6 nodes
+/// ([`GaussRule`]). The same images within the rules' error (below
+/// `f32`'s rounding unit).
+pub struct IntegralStages {
+    pub full: &'static StageDesc,
+    pub thin: [&'static StageDesc; 3],
+}
+
+/// The override constants of the thin stages, by Gauss rule (4, 5, 6
+/// nodes).
+pub const THIN_CONSTANTS: [&[(&str, f64)]; 3] = [
+    &[("THICK_SEGMENTS", 0.0), ("GAUSS_NODES", 4.0)],
+    &[("THICK_SEGMENTS", 0.0), ("GAUSS_NODES", 5.0)],
+    &[("THICK_SEGMENTS", 0.0), ("GAUSS_NODES", 6.0)],
+];
+
+impl IntegralStages {
+    /// Every variant (for shader validation).
+    pub fn all(&self) -> [&'static StageDesc; 4] {
+        [self.full, self.thin[0], self.thin[1], self.thin[2]]
+    }
+}
 
 /// The exact-frag WGSL as the stage `name` with `constants`.
 const fn exact_frag_stage(
@@ -91,38 +123,49 @@ const fn exact_frag_stage(
     }
 }
 
-/// Whether no segment of a frame can reach the closed form's optical
-/// thickness: the largest extinction of the transfer function (its nodes'
-/// extinctions in `f32`, as the stage reads them; the function is linear
-/// between them and constant beyond) times the longest segment a piece can
-/// hold (`max_length`, the mesh's largest cell diameter), with a margin of
-/// [`THIN_MARGIN`] for the rounding of interpolated lengths.
-pub fn thin_stage_holds(tf: &TfBuffer, max_length: f64) -> bool {
-    let tau_max = tf.max_tau() as f64;
-    tau_max.is_finite()
-        && max_length.is_finite()
-        && tau_max * max_length * (1.0 + THIN_MARGIN) <= GAUSS_MAX as f64
+/// The Gauss rule of a frame whose segments are at most `max_length` long,
+/// or `None` where one can reach the closed form's optical thickness: the
+/// largest extinction of the transfer function (its nodes' extinctions in
+/// `f32`, as the stage reads them; the function is linear between them and
+/// constant beyond) times the longest segment a piece can hold
+/// (`max_length`, the mesh's largest cell diameter), with a margin of
+/// [`THIN_MARGIN`] for the rounding of interpolated lengths, is the
+/// thickest segment's depth; the shortest rule holding it
+/// ([`GaussRule::for_depth`]).
+pub fn thin_rule(tf: &TfBuffer, max_length: f64) -> Option<GaussRule> {
+    let depth = tf.max_tau() as f64 * max_length * (1.0 + THIN_MARGIN);
+    if !depth.is_finite() {
+        return None;
+    }
+    GaussRule::for_depth(depth)
 }
 
-/// Relative margin on a segment's length in [`thin_stage_holds`]: the
+/// Relative margin on a segment's length in [`thin_rule`]: the
 /// rasteriser interpolates `l` (or `q_f - q_b`) in `f32`, a few ulps off.
 pub const THIN_MARGIN: f64 = 1e-3;
 
-/// `thin` (the stage's WGSL with `THICK_SEGMENTS` off) where no segment
-/// of length up to `max_length` can be optically thick for `tf`
-/// ([`thin_stage_holds`]), else `full`: the one choice of every stage that
-/// includes `shaders/integral.wgsl` for its volume.
+/// The variant of `stages` for a frame whose segments are at most
+/// `max_length` long, and the Gauss rule it integrates thin pieces with:
+/// the thin stage of [`thin_rule`]'s rule where no segment can be
+/// optically thick, else the full one (6 nodes): the one choice of every
+/// stage that includes `shaders/integral.wgsl` for its volume.
 pub fn integral_stage(
     tf: &TfBuffer,
     max_length: f64,
-    full: &'static StageDesc,
-    thin: &'static StageDesc,
-) -> &'static StageDesc {
-    if thin_stage_holds(tf, max_length) {
-        thin
-    } else {
-        full
+    stages: &IntegralStages,
+) -> (&'static StageDesc, GaussRule) {
+    match thin_rule(tf, max_length) {
+        Some(GaussRule::Four) => (stages.thin[0], GaussRule::Four),
+        Some(GaussRule::Five) => (stages.thin[1], GaussRule::Five),
+        Some(GaussRule::Six) => (stages.thin[2], GaussRule::Six),
+        None => (stages.full, GaussRule::Six),
     }
+}
+
+/// The Gauss rule of [`integral_stage`] for a twin drawing `mesh` with
+/// `tf` (normalised as the stage reads it).
+pub fn twin_rule(tf: &TfBuffer, mesh: &crate::mesh::Mesh) -> GaussRule {
+    thin_rule(tf, SceneLengths::of(mesh).max_diameter).unwrap_or_default()
 }
 
 /// The longest segment a piece of `src`'s mesh can hold: its largest cell
@@ -141,7 +184,7 @@ pub fn bind_exact_frag_stage(
     tf: &TfBuffer,
     max_length: f64,
 ) -> Result<Stage, GpuError> {
-    let stage = integral_stage(tf, max_length, &EXACT_FRAG_STAGE, &EXACT_FRAG_THIN_STAGE);
+    let (stage, _) = integral_stage(tf, max_length, &EXACT_FRAG_STAGES);
     bind_integral_stage(gpu, stage, view, tf, &[])
 }
 
@@ -172,6 +215,7 @@ pub struct ExactFragTwin {
     mapper: ClipMapper,
     tf: TfBuffer,
     consts: Vec<[f32; 4]>,
+    rule: GaussRule,
 }
 
 impl ExactFragTwin {
@@ -192,14 +236,28 @@ impl ExactFragTwin {
             mapper,
             tf,
             consts: closed_form_constants(),
+            rule: GaussRule::Six,
         }
+    }
+
+    /// The twin of the stage drawing `mesh`: with the Gauss rule
+    /// [`integral_stage`] picks for it ([`twin_rule`]).
+    pub fn for_mesh(mut self, mesh: &crate::mesh::Mesh) -> ExactFragTwin {
+        self.rule = twin_rule(&self.tf, mesh);
+        self
+    }
+
+    /// The Gauss rule the twin integrates thin pieces with.
+    pub fn rule(&self) -> GaussRule {
+        self.rule
     }
 }
 
 impl ExactFragTwin {
     /// The integral of the segment `(l, s_f, s_b)` (normalised scalars).
     pub fn volume(&self, l: f32, sf: f32, sb: f32) -> [f32; 4] {
-        self.tf.integrate_segment(&self.consts, l, sf, sb)
+        self.tf
+            .integrate_segment(&self.consts, self.rule, l, sf, sb)
     }
 
     /// The stage's view and clip mapping.
@@ -223,7 +281,7 @@ pub fn fs_main(
     Some(
         stage
             .tf
-            .integrate_segment(&stage.consts, seg.l, seg.s_f, seg.s_b),
+            .integrate_segment(&stage.consts, stage.rule, seg.l, seg.s_f, seg.s_b),
     )
 }
 
@@ -251,6 +309,6 @@ impl SegmentMode for ExactFragMode {
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<SegmentVertex>> {
-        Box::new(ExactFragTwin::new(src.tf, src.camera))
+        Box::new(ExactFragTwin::new(src.tf, src.camera).for_mesh(src.whole))
     }
 }

@@ -38,7 +38,10 @@ use crate::render::iso::{IsoMix, IsoSet, Lighting, AMBIENT, DIFFUSE};
 use crate::render::pieces::PieceSource;
 use crate::tf::{EmissionModel, TransferFunction};
 
-use super::exact_frag::{bind_integral_stage, integral_stage, longest_segment, ExactFragTwin};
+use super::exact_frag::{
+    bind_integral_stage, integral_stage, longest_segment, ExactFragTwin, IntegralStages,
+    THIN_CONSTANTS,
+};
 use super::integral::TfBuffer;
 pub use super::iso_levels::{decided_end, gpu_level};
 use super::preint::{PreintMode, PreintTwin};
@@ -284,10 +287,16 @@ macro_rules! iso_exact_frag_stage {
 /// `--iso` with `exact-frag`: the closed-form integral between crossings.
 pub static ISO_EXACT_FRAG_STAGE: StageDesc = iso_exact_frag_stage!("iso.wgsl+exact_frag", &[]);
 
-/// `--iso` with `exact-frag` where no segment can be optically thick
-/// (`THICK_SEGMENTS` off, [`super::exact_frag::thin_stage_holds`]).
-pub static ISO_EXACT_FRAG_THIN_STAGE: StageDesc =
-    iso_exact_frag_stage!("iso.wgsl+exact_frag+thin", &[("THICK_SEGMENTS", 0.0)]);
+/// `--iso` with `exact-frag`, by segment thickness and Gauss rule (as
+/// [`super::exact_frag::EXACT_FRAG_STAGES`]).
+pub static ISO_EXACT_FRAG_STAGES: IntegralStages = IntegralStages {
+    full: &ISO_EXACT_FRAG_STAGE,
+    thin: [
+        &iso_exact_frag_stage!("iso.wgsl+exact_frag+thin4", THIN_CONSTANTS[0]),
+        &iso_exact_frag_stage!("iso.wgsl+exact_frag+thin5", THIN_CONSTANTS[1]),
+        &iso_exact_frag_stage!("iso.wgsl+exact_frag+thin6", THIN_CONSTANTS[2]),
+    ],
+};
 
 /// `--iso` with `preint3d`.
 pub static ISO_PREINT3D_STAGE: StageDesc = iso_stage!(
@@ -594,7 +603,7 @@ impl IsoMode {
         let (params, surfaces) = iso_buffers(&self.set, &map);
         let volume = match &self.volume {
             Volume::None => VolumeTwin::None,
-            Volume::Integral => VolumeTwin::Integral(ExactFragTwin::new(tf, camera)),
+            Volume::Integral => VolumeTwin::Integral(ExactFragTwin::new(tf, camera).for_mesh(mesh)),
             Volume::Table(p) => VolumeTwin::Table(p.twin_for(mesh, tf, camera)),
         };
         IsoTwin {
@@ -681,7 +690,7 @@ impl ProjectedMode for IsoMode {
             Volume::Integral => {
                 let tf = TfBuffer::new(src.tf, &map);
                 let longest = longest_segment(gpu, src)?;
-                let stage = integral_stage(&tf, longest, self.stage(), &ISO_EXACT_FRAG_THIN_STAGE);
+                let (stage, _) = integral_stage(&tf, longest, &ISO_EXACT_FRAG_STAGES);
                 bind_integral_stage(gpu, stage, &view, &tf, &extra)
             }
             Volume::Table(p) => p.bind_stage(

@@ -47,7 +47,10 @@ use crate::projection::Polyhedron;
 use crate::render::pieces::PieceSource;
 use crate::tf::TransferFunction;
 
-use super::exact_frag::{bind_integral_stage, integral_stage, longest_segment, ExactFragTwin};
+use super::exact_frag::{
+    bind_integral_stage, integral_stage, longest_segment, ExactFragTwin, IntegralStages,
+    THIN_CONSTANTS,
+};
 use super::integral::TfBuffer;
 use super::segment::{ScalarMap, Seg, SegmentMode, SegmentPayload, SegmentVertex, SegmentView};
 use super::segment_view::segment_of;
@@ -451,10 +454,16 @@ pub fn segment_at(
 /// `segment_at`).
 pub static PIECE_QUAD_STAGE: StageDesc = quad_stage("piece_quad.wgsl", &[]);
 
-/// The quad stage without the closed form for optically thick segments
-/// (as [`super::exact_frag::EXACT_FRAG_THIN_STAGE`]).
-pub static PIECE_QUAD_THIN_STAGE: StageDesc =
-    quad_stage("piece_quad.wgsl+thin", &[("THICK_SEGMENTS", 0.0)]);
+/// The quad stage's variants by segment thickness and Gauss rule (as
+/// [`super::exact_frag::EXACT_FRAG_STAGES`]).
+pub static PIECE_QUAD_STAGES: IntegralStages = IntegralStages {
+    full: &PIECE_QUAD_STAGE,
+    thin: [
+        &quad_stage("piece_quad.wgsl+thin4", THIN_CONSTANTS[0]),
+        &quad_stage("piece_quad.wgsl+thin5", THIN_CONSTANTS[1]),
+        &quad_stage("piece_quad.wgsl+thin6", THIN_CONSTANTS[2]),
+    ],
+};
 
 const fn quad_stage(name: &'static str, constants: &'static [(&'static str, f64)]) -> StageDesc {
     StageDesc {
@@ -556,12 +565,14 @@ impl SegmentMode for ExactFragQuads {
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         let tf = TfBuffer::new(src.tf, &ScalarMap::of(src.tf));
         let longest = longest_segment(gpu, src)?;
-        let stage = integral_stage(&tf, longest, &PIECE_QUAD_STAGE, &PIECE_QUAD_THIN_STAGE);
+        let (stage, _) = integral_stage(&tf, longest, &PIECE_QUAD_STAGES);
         bind_integral_stage(gpu, stage, &SegmentView::of(src.camera), &tf, &[])
     }
 
     fn twin(&self, src: &PieceSource) -> Box<dyn CpuStage<QuadVertex>> {
-        Box::new(QuadTwin::new(src.tf, src.camera))
+        Box::new(QuadTwin(
+            ExactFragTwin::new(src.tf, src.camera).for_mesh(src.whole),
+        ))
     }
 
     fn whole_part(

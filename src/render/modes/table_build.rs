@@ -23,7 +23,8 @@ use crate::gpu::{Context, GpuError, Table};
 use crate::tf::TransferFunction;
 
 use super::integral::{
-    closed_form_constants, neg_expm1, Material, TfBuffer, GAUSS_MAX, GL6_BASE, MAX_THICKNESS,
+    closed_form_constants, neg_expm1, GaussRule, Material, TfBuffer, GAUSS_MAX, GL6_BASE,
+    MAX_THICKNESS,
 };
 use super::preint_tables::{TableKind, TableSpec};
 use super::segment::ScalarMap;
@@ -146,7 +147,7 @@ pub fn gpu_build(
 /// closed form at the texel's point `p` (`(s_f, s_b, l)`, from
 /// [`TableSpec::texel_point`], which holds the twin of `cyl_to_table`).
 pub fn build_main(tf: &TfBuffer, consts: &[[f32; 4]], kind: TableKind, p: [f32; 3]) -> [f32; 4] {
-    let mut v = tf.integrate_segment(consts, p[2], p[0], p[1]);
+    let mut v = tf.integrate_segment(consts, GaussRule::Six, p[2], p[0], p[1]);
     if kind == TableKind::Flat {
         v[3] = optical_depth(tf, p[2], p[0], p[1]);
     }
@@ -411,7 +412,7 @@ pub fn build_column(
         k0 += CHUNK as u32;
     }
     for k in kmax + 1..p.nz {
-        out[k as usize] = tf.integrate_segment(consts, k as f32 * dl, sf, sb);
+        out[k as usize] = tf.integrate_segment(consts, GaussRule::Six, k as f32 * dl, sf, sb);
     }
     true
 }

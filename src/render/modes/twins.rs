@@ -81,7 +81,8 @@ pub fn stage_twins() -> Vec<StageTwins> {
             TfBuffer::segment_spans, TfBuffer::span_end,
             integral::neg_expm1, integral::taylor_sf, integral::asym,
             integral::ends_sf,
-            integral::sanitize_thickness, integral::gauss, integral::weights,
+            integral::sanitize_thickness, integral::gauss_node, integral::gauss,
+            integral::weights,
             TfBuffer::add_piece, TfBuffer::integrate_segment),
         twins!("iso.wgsl":
             iso::count_at_most, iso::iso_light, iso::iso_surface, iso::iso_over,
