@@ -79,8 +79,8 @@ pub static EXACT_FRAG_STAGES: IntegralStages = IntegralStages {
 
 /// The variants of one stage that includes `shaders/integral.wgsl` for its
 /// volume: `full` draws every segment, `thin` only segments no thicker
-/// than [`GAUSS_MAX`](super::integral::GAUSS_MAX), with the Gauss rule of 4, 5 and 6 nodes
-/// ([`GaussRule`]). The same images within the rules' error (below
+/// than [`GAUSS_MAX`](super::integral::GAUSS_MAX), with the Gauss rule of
+/// 4, 5 and 6 nodes ([`GaussRule`]). The same images within the rules' error (below
 /// `f32`'s rounding unit).
 pub struct IntegralStages {
     pub full: &'static StageDesc,
@@ -145,20 +145,20 @@ pub fn thin_rule(tf: &TfBuffer, max_length: f64) -> Option<GaussRule> {
 pub const THIN_MARGIN: f64 = 1e-3;
 
 /// The variant of `stages` for a frame whose segments are at most
-/// `max_length` long, and the Gauss rule it integrates thin pieces with:
-/// the thin stage of [`thin_rule`]'s rule where no segment can be
-/// optically thick, else the full one (6 nodes): the one choice of every
-/// stage that includes `shaders/integral.wgsl` for its volume.
+/// `max_length` long: the thin stage of [`thin_rule`]'s Gauss rule where
+/// no segment can be optically thick, else the full one (6 nodes): the
+/// one choice of every stage that includes `shaders/integral.wgsl` for its
+/// volume ([`twin_rule`] is the same choice for a twin).
 pub fn integral_stage(
     tf: &TfBuffer,
     max_length: f64,
     stages: &IntegralStages,
-) -> (&'static StageDesc, GaussRule) {
+) -> &'static StageDesc {
     match thin_rule(tf, max_length) {
-        Some(GaussRule::Four) => (stages.thin[0], GaussRule::Four),
-        Some(GaussRule::Five) => (stages.thin[1], GaussRule::Five),
-        Some(GaussRule::Six) => (stages.thin[2], GaussRule::Six),
-        None => (stages.full, GaussRule::Six),
+        Some(GaussRule::Four) => stages.thin[0],
+        Some(GaussRule::Five) => stages.thin[1],
+        Some(GaussRule::Six) => stages.thin[2],
+        None => stages.full,
     }
 }
 
@@ -184,7 +184,7 @@ pub fn bind_exact_frag_stage(
     tf: &TfBuffer,
     max_length: f64,
 ) -> Result<Stage, GpuError> {
-    let (stage, _) = integral_stage(tf, max_length, &EXACT_FRAG_STAGES);
+    let stage = integral_stage(tf, max_length, &EXACT_FRAG_STAGES);
     bind_integral_stage(gpu, stage, view, tf, &[])
 }
 

@@ -690,7 +690,7 @@ impl ProjectedMode for IsoMode {
             Volume::Integral => {
                 let tf = TfBuffer::new(src.tf, &map);
                 let longest = longest_segment(gpu, src)?;
-                let (stage, _) = integral_stage(&tf, longest, &ISO_EXACT_FRAG_STAGES);
+                let stage = integral_stage(&tf, longest, &ISO_EXACT_FRAG_STAGES);
                 bind_integral_stage(gpu, stage, &view, &tf, &extra)
             }
             Volume::Table(p) => p.bind_stage(

@@ -565,7 +565,7 @@ impl SegmentMode for ExactFragQuads {
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         let tf = TfBuffer::new(src.tf, &ScalarMap::of(src.tf));
         let longest = longest_segment(gpu, src)?;
-        let (stage, _) = integral_stage(&tf, longest, &PIECE_QUAD_STAGES);
+        let stage = integral_stage(&tf, longest, &PIECE_QUAD_STAGES);
         bind_integral_stage(gpu, stage, &SegmentView::of(src.camera), &tf, &[])
     }
 
