@@ -44,9 +44,9 @@ const GL6_BASE: u32 = 129u;
 const TAYLOR_TERMS: u32 = 9u;
 // Terms of the asymptotic series (argument t <= 1/128): below 1e-10.
 const ASYM_TERMS: u32 = 9u;
-// Up to this optical thickness (both ends) the basis integrals are the
-// 6-node Gauss-Legendre rule (accurate to 6e-9 there); above it the closed
-// form of the special functions.
+// Up to this optical thickness (both ends) the basis integrals are a
+// Gauss-Legendre rule (`GAUSS_NODES`: 6 nodes are accurate to 6e-9 up to
+// here); above it the closed form of the special functions.
 const GAUSS_MAX: f32 = 2.0;
 // Whether a segment can be thicker than GAUSS_MAX. A stage whose every
 // segment is thinner (the transfer function's largest extinction times the

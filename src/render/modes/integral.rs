@@ -11,7 +11,8 @@
 //! most 2, else the scaled `erfcx` (increasing extinction) or Dawson
 //! (decreasing) forms, as Taylor series about the 129 tabulated centres up
 //! to argument 8 and asymptotic series above — and the pieces are
-//! composited front to back accumulating optical depth. Neither form
+//! composited front to back (the opacity from the summed optical depth, the
+//! transmittance in front of a piece the product of those before). Neither form
 //! cancels: thin segments, near-equal extinctions and depths of 1e6 keep
 //! full `f32` relative accuracy (`tests/exact_frag.rs` checks the golden
 //! vectors).
@@ -27,8 +28,9 @@ use super::segment::ScalarMap;
 
 const SF_CENTRES: usize = 129;
 pub(crate) const GL6_BASE: usize = 129;
-/// Up to this optical thickness (both ends) the basis integrals are the
-/// 6-node Gauss-Legendre rule; above it the closed form (`GAUSS_MAX`).
+/// Up to this optical thickness (both ends) the basis integrals are a
+/// Gauss-Legendre rule ([`GaussRule`]: 6 nodes up to here, fewer where the
+/// frame's segments are thinner); above it the closed form (`GAUSS_MAX`).
 pub const GAUSS_MAX: f32 = 2.0;
 
 /// The 6-point Gauss-Legendre rule on [0, 1] `(x, w)`: in `f32` as good as
