@@ -15,33 +15,24 @@ use zoovr::image::compare_display;
 use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
 use zoovr::render::{
-    Compositor, Geometry, Mode, ModeStats, ProjectedOptions, ReferenceOptions, RenderOptions,
-    Renderer, SceneSpec, Shading,
+    Compositor, Geometry, Mode, ModeStats, RenderOptions, Renderer, SceneSpec, Shading,
 };
 use zoovr::testdata::mesh_file;
 use zoovr::tf::{EmissionModel, TransferFunction};
 
+/// render_util's options (the `tets` reference field) on a small view,
+/// drawn by the CPU twins.
 fn options(mode: Mode, split_all: bool) -> RenderOptions {
-    RenderOptions {
-        camera: CameraParams {
-            width: 80,
-            height: 60,
-            azimuth: 35.0,
-            elevation: 20.0,
-            ..Default::default()
-        },
-        mode,
-        projected: ProjectedOptions {
-            compositor: Compositor::Cpu,
-            split_all,
-            ..Default::default()
-        },
-        reference: ReferenceOptions {
-            model: FieldModel::Tets,
-            ..Default::default()
-        },
+    let mut o = render_util::options(mode, split_all, FieldModel::Tets);
+    o.camera = CameraParams {
+        width: 80,
+        height: 60,
+        azimuth: 35.0,
+        elevation: 20.0,
         ..Default::default()
-    }
+    };
+    o.projected.compositor = Compositor::Cpu;
+    o
 }
 
 #[test]
