@@ -2,14 +2,16 @@
 // (Roettger, Kraus, Ertl 2000, sections 7-10, without extracted triangles;
 // src/render/iso.rs states the rules). The fragment rebuilds its segment
 // (s_f, s_b, l; shaders/segment.wgsl) and the gradients at its ends
-// (shaders/iso_vertex.wgsl), finds by binary search the isovalues V with
-// min(s_f, s_b) < V <= max(s_f, s_b), and composites front to back: the
-// volume up to the first crossing, the lit surface, the volume up to the
-// next, ..., the volume after the last. `volume(l, s0, s1)` is the stage's
-// volume integral (the exact-frag integral, a table lookup, or nothing for
-// `--mode iso`), defined by the stage next to this file. Only the values a
-// segment crosses are visited, and none behind a surface that made the
-// fragment opaque.
+// (shaders/iso_vertex.wgsl), finds the isovalues V with
+// min(s_f, s_b) < V <= max(s_f, s_b) (`iso_window`), and composites front
+// to back the volume up to the first crossing, the lit surface, the volume
+// up to the next, ..., the volume after the last: `iso_segment`, defined
+// by the file the stage puts next to this one (shaders/iso_split.wgsl,
+// which calls the stage's `volume(l, s0, s1)` once per sub-segment: a
+// table lookup, or nothing for `--mode iso`; shaders/iso_walk.wgsl, which
+// walks the transfer function's nodes and the crossings in one loop for
+// the closed-form integral). Only the values a segment crosses are
+// visited, and none behind a surface that made the fragment opaque.
 //
 // Bindings 3 and 4 (after the volume's own 0-2). Twin: render::modes::iso.
 
@@ -23,14 +25,18 @@ struct IsoParams {
     diffuse: f32,
     // 0: exact mixing, 1: RKE's blend (src/render/iso.rs `IsoMix`).
     mix: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // The bins of `count_at_most`: bin(x) = floor((x - bin_origin) *
+    // bin_scale), clamped to 0 ..= count - 1 (bin_scale 0: one bin).
+    bin_origin: f32,
+    bin_scale: f32,
+    _pad: u32,
 }
 
 // Keep in sync with `IsoSurface` in src/render/modes/iso.rs.
 struct IsoSurface {
-    // x: the normalised isovalue (increasing with the index).
+    // x: the normalised isovalue (increasing with the index); y, z: where
+    // `count_at_most` searches for an x in bin k (this entry's index): the
+    // surfaces of bins k - 1 to k + 1, as indices (exact in f32).
     value: vec4<f32>,
     // Straight colour and opacity of the front (rising) and back sides.
     front: vec4<f32>,
@@ -40,10 +46,21 @@ struct IsoSurface {
 @group(0) @binding(3) var<uniform> iso: IsoParams;
 @group(0) @binding(4) var<storage, read> surfaces: array<IsoSurface>;
 
-// The number of isovalues <= x.
+// The bin of scalar x (`IsoParams`): monotone in x.
+fn iso_bin(x: f32) -> u32 {
+    let t = (x - iso.bin_origin) * iso.bin_scale;
+    return u32(clamp(floor(t), 0.0, f32(iso.count - 1u)));
+}
+
+// The number of isovalues <= x: a binary search among the surfaces of x's
+// bin and its two neighbours (every value of a lower bin is below x, every
+// value of a higher one above, since the bins are monotone; the neighbours
+// absorb a rounding of the bin by one). Evenly spread values put one
+// surface per bin: two steps, however many surfaces.
 fn count_at_most(x: f32) -> u32 {
-    var lo = 0u;
-    var hi = iso.count;
+    let r = surfaces[iso_bin(x)].value;
+    var lo = u32(r.y);
+    var hi = u32(r.z);
     loop {
         if lo >= hi {
             break;
@@ -56,6 +73,26 @@ fn count_at_most(x: f32) -> u32 {
         }
     }
     return lo;
+}
+
+// The crossings of the segment from s_f to s_b: the surfaces a ..< b
+// (returned as (a, b)), the values V with min < V <= max of its ends. The
+// search window lies within the part's scalar range `range` (flat): a
+// no-op inside the triangle, a bound on the lanes a rasteriser shades
+// outside it with extrapolated scalars (whose loops would otherwise run
+// over every isovalue). Most segments cross nothing: two reads decide it
+// before any search.
+fn iso_window(s_f: f32, s_b: f32, range: vec2<f32>) -> vec2<u32> {
+    let wlo = max(min(s_f, s_b), range.x);
+    let whi = min(max(s_f, s_b), range.y);
+    var a = 0u;
+    var b = 0u;
+    if iso.count > 0u && whi >= surfaces[0].value.x
+        && wlo <= surfaces[iso.count - 1u].value.x {
+        a = count_at_most(wlo);
+        b = max(count_at_most(whi), a);
+    }
+    return vec2<u32>(a, b);
 }
 
 // The headlight's factor for gradient g (view space: the view direction is
@@ -97,85 +134,6 @@ fn iso_crosses(v: f32, seg: Seg) -> bool {
     let lo = min(seg.s_f, seg.s_b);
     let hi = max(seg.s_f, seg.s_b);
     return v > lo && v <= hi;
-}
-
-// The segment with its surfaces, front to back. One loop, one call of
-// `volume` (inlined once: the volume integral is the stage's largest
-// function): step i < b ends the volume at crossing k and adds the surface,
-// step b ends it at the segment's back. RKE's blend (iso.mix 1) instead
-// draws every surface's front-face layer (opacity times 1 - u), the whole
-// segment's volume at step b, then the back-face layers (times u).
-fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, range: vec2<f32>) -> vec4<f32> {
-    let lo = min(seg.s_f, seg.s_b);
-    let hi = max(seg.s_f, seg.s_b);
-    // The search window, within the part's scalar range (flat): a no-op
-    // inside the triangle, a bound on the lanes a rasteriser shades
-    // outside it with extrapolated scalars (whose loops would otherwise
-    // run over every isovalue).
-    let wlo = max(lo, range.x);
-    let whi = min(hi, range.y);
-    // Most segments cross nothing: two reads decide it before any search.
-    var a = 0u;
-    var b = 0u;
-    if iso.count > 0u && whi >= surfaces[0].value.x
-        && wlo <= surfaces[iso.count - 1u].value.x {
-        a = count_at_most(wlo);
-        b = max(count_at_most(whi), a);
-    }
-    let rising = seg.s_f <= seg.s_b;
-    let blend = iso.mix == 1u;
-    let d = seg.s_b - seg.s_f;
-    var acc = vec4<f32>(0.0);
-    var back = vec4<f32>(0.0);
-    var u0 = 0.0;
-    var s0 = seg.s_f;
-    for (var i = a; i <= b; i++) {
-        var u = 1.0;
-        var sv = seg.s_b;
-        var k = 0u;
-        if i < b {
-            k = i;
-            if !rising {
-                k = a + b - 1u - i;
-            }
-            let v = surfaces[k].value.x;
-            if !iso_crosses(v, seg) {
-                continue;
-            }
-            u = 0.0;
-            if d != 0.0 {
-                u = clamp((v - seg.s_f) / d, 0.0, 1.0);
-            }
-            sv = v;
-        }
-        if !blend || i == b {
-            var from_u = u0;
-            var from_s = s0;
-            if blend {
-                from_u = 0.0;
-                from_s = seg.s_f;
-            }
-            acc = iso_over(acc, volume((u - from_u) * seg.l, from_s, sv));
-        }
-        if i < b {
-            let g = mix(gf, gb, u);
-            if blend {
-                acc = iso_over(acc, iso_surface(k, rising, g, 1.0 - u));
-                back = iso_over(back, iso_surface(k, rising, g, u));
-            } else {
-                acc = iso_over(acc, iso_surface(k, rising, g, 1.0));
-                // Opaque now: nothing behind shows (each later step would
-                // add t = 0 times itself), so the cost is one surface's,
-                // however many the segment crosses.
-                if acc.w >= 1.0 {
-                    break;
-                }
-            }
-        }
-        u0 = u;
-        s0 = sv;
-    }
-    return iso_over(acc, back);
 }
 
 @fragment

@@ -260,6 +260,12 @@ impl ExactFragTwin {
             .integrate_segment(&self.consts, self.rule, l, sf, sb)
     }
 
+    /// The transfer function, the closed form's constants and the Gauss
+    /// rule the stage integrates with.
+    pub(crate) fn integral(&self) -> (&TfBuffer, &[[f32; 4]], GaussRule) {
+        (&self.tf, &self.consts, self.rule)
+    }
+
     /// The stage's view and clip mapping.
     pub fn view(&self) -> (SegmentView, ClipMapper) {
         (self.view, self.mapper)

@@ -117,7 +117,7 @@ const TAYLOR_TERMS: u32 = 9;
 const ASYM_TERMS: u32 = 9;
 const ASYM_X: f32 = 8.0;
 pub(crate) const MAX_THICKNESS: f32 = 1e30;
-const MAX_SCALAR: f32 = 1e30;
+pub(crate) const MAX_SCALAR: f32 = 1e30;
 
 /// The constants buffer of the closed form: `P, Q, B, G` at the 129 centres
 /// `k/16`, then the 6-point Gauss-Legendre rule on [0, 1] as `(x, w, x, w)`
@@ -371,13 +371,13 @@ pub struct Spans {
 /// The running composite of one segment's pieces (`Composite`).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Composite {
-    color: [f32; 3],
-    depth: f32,
-    alpha: f32,
-    pieces: u32,
+    pub(crate) color: [f32; 3],
+    pub(crate) depth: f32,
+    pub(crate) alpha: f32,
+    pub(crate) pieces: u32,
     /// Transmittance in front of the next piece (the product of the
     /// pieces' own).
-    tr: f32,
+    pub(crate) tr: f32,
 }
 
 /// `1 - exp(-d)` for `d >= 0` without cancellation at small `d`.

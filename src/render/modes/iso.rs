@@ -21,10 +21,13 @@
 //!   [`crate::render::gradients`]); in perspective multiplied by `q = 1/z`
 //!   like the scalars, so they interpolate exactly;
 //! - **stage**: `shaders/iso_vertex.wgsl`, `shaders/segment.wgsl`, the
-//!   volume's files, a one-line `volume(l, s0, s1)` (the closed-form
-//!   integral, the table lookup, or zero), and `shaders/iso.wgsl` with the
-//!   entry point `fs_iso` ([`fs_iso`] is its twin, on the same volume
-//!   twins as the segment modes).
+//!   volume's files, the segment with its crossings, and
+//!   `shaders/iso.wgsl` with the entry point `fs_iso` ([`fs_iso`] is its
+//!   twin, on the same volume twins as the segment modes). The segment is
+//!   `shaders/iso_split.wgsl` over a one-line `volume(l, s0, s1)` per
+//!   sub-segment (the table lookup, or zero: [`super::iso_split`]) or, for
+//!   the closed-form integral, `shaders/iso_walk.wgsl`, one walk over the
+//!   transfer function's nodes and the crossings ([`super::iso_walk`]).
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec2, DVec3};
@@ -43,6 +46,7 @@ use super::exact_frag::{
     THIN_CONSTANTS,
 };
 use super::integral::TfBuffer;
+use super::iso_bins::{iso_bin, IsoBins};
 pub use super::iso_levels::{decided_end, gpu_level};
 use super::preint::{PreintMode, PreintTwin};
 use super::preint_tables::{TableKind, TableStats};
@@ -186,7 +190,10 @@ pub struct IsoParams {
     pub diffuse: f32,
     /// 0: exact mixing, 1: RKE's blend ([`crate::render::iso::IsoMix`]).
     pub mix: u32,
-    pub _pad: [u32; 3],
+    /// The bins of `count_at_most` ([`IsoBins`]).
+    pub bin_origin: f32,
+    pub bin_scale: f32,
+    pub _pad: u32,
 }
 
 /// One surface as the stage reads it. Keep in sync with `IsoSurface` in
@@ -194,7 +201,9 @@ pub struct IsoParams {
 #[repr(C)]
 #[derive(Pod, Zeroable, Clone, Copy, Debug, Default, PartialEq)]
 pub struct IsoSurface {
-    /// `x`: the normalised isovalue.
+    /// `x`: the normalised isovalue; `y`, `z`: the surfaces `count_at_most`
+    /// searches for a scalar in bin `k` (this surface's index), as
+    /// [`IsoBins::window`] gives them.
     pub value: [f32; 4],
     pub front: [f32; 4],
     pub back: [f32; 4],
@@ -204,6 +213,12 @@ pub struct IsoSurface {
 /// (one zero surface when the set is empty: a storage binding is never
 /// empty).
 pub fn iso_buffers(set: &IsoSet, map: &ScalarMap) -> (IsoParams, Vec<IsoSurface>) {
+    let values: Vec<f32> = set
+        .values
+        .iter()
+        .map(|&v| gpu_level(map.apply(v)))
+        .collect();
+    let bins = IsoBins::new(&values);
     let params = IsoParams {
         count: set.values.len() as u32,
         lighting: set.lighting.code(),
@@ -213,14 +228,16 @@ pub fn iso_buffers(set: &IsoSet, map: &ScalarMap) -> (IsoParams, Vec<IsoSurface>
             IsoMix::Exact => 0,
             IsoMix::Blend => 1,
         },
-        _pad: [0; 3],
+        bin_origin: bins.origin,
+        bin_scale: bins.scale,
+        _pad: 0,
     };
-    let mut surfaces: Vec<IsoSurface> = set
-        .values
+    let mut surfaces: Vec<IsoSurface> = values
         .iter()
         .zip(&set.sides)
-        .map(|(&v, sides)| IsoSurface {
-            value: [gpu_level(map.apply(v)), 0.0, 0.0, 0.0],
+        .zip(&bins.windows)
+        .map(|((&v, sides), w)| IsoSurface {
+            value: [v, w[0] as f32, w[1] as f32, 0.0],
             front: sides[0].map(|c| c as f32),
             back: sides[1].map(|c| c as f32),
         })
@@ -265,26 +282,28 @@ const INTEGRAL_BINDINGS: &[Binding] = &[
 /// `--mode iso`: no volume (the integral's bindings are bound, unused).
 pub static ISO_STAGE: StageDesc = iso_stage!(
     "iso.wgsl",
-    ["integral.wgsl"],
+    ["integral.wgsl", "iso_split.wgsl"],
     "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return vec4<f32>(0.0);\n}\n",
     INTEGRAL_BINDINGS
 );
 
 /// The isosurface stage with exact-frag's volume, as `name` with the
-/// integral's `constants`.
+/// integral's `constants`: one walk over nodes and crossings
+/// (`shaders/iso_walk.wgsl`).
 macro_rules! iso_exact_frag_stage {
     ($name:literal, $constants:expr) => {
         iso_stage!(
             $name,
-            ["integral.wgsl"],
-            "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return integrate_segment(l, sf, sb);\n}\n",
+            ["integral.wgsl", "iso_walk.wgsl"],
+            "",
             INTEGRAL_BINDINGS,
             $constants
         )
     };
 }
 
-/// `--iso` with `exact-frag`: the closed-form integral between crossings.
+/// `--iso` with `exact-frag`: the closed-form integral, walked over the
+/// transfer function's nodes and the crossings together.
 pub static ISO_EXACT_FRAG_STAGE: StageDesc = iso_exact_frag_stage!("iso.wgsl+exact_frag", &[]);
 
 /// `--iso` with `exact-frag`, by segment thickness and Gauss rule (as
@@ -301,7 +320,7 @@ pub static ISO_EXACT_FRAG_STAGES: IntegralStages = IntegralStages {
 /// `--iso` with `preint3d`.
 pub static ISO_PREINT3D_STAGE: StageDesc = iso_stage!(
     "iso.wgsl+preint3d",
-    ["preint.wgsl", "preint3d.wgsl"],
+    ["preint.wgsl", "preint3d.wgsl", "iso_split.wgsl"],
     "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
     &[
         Binding::Uniform,
@@ -315,7 +334,7 @@ pub static ISO_PREINT3D_STAGE: StageDesc = iso_stage!(
 /// `--iso` with `preint2d`.
 pub static ISO_PREINT2D_STAGE: StageDesc = iso_stage!(
     "iso.wgsl+preint2d",
-    ["preint.wgsl", "preint2d.wgsl"],
+    ["preint.wgsl", "preint2d.wgsl", "iso_split.wgsl"],
     "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
     &[
         Binding::Uniform,
@@ -329,7 +348,7 @@ pub static ISO_PREINT2D_STAGE: StageDesc = iso_stage!(
 /// `--iso` with `preint2d-cyl`.
 pub static ISO_PREINT2D_CYL_STAGE: StageDesc = iso_stage!(
     "iso.wgsl+preint2d_cyl",
-    ["preint.wgsl", "preint2d_cyl.wgsl"],
+    ["preint.wgsl", "preint2d_cyl.wgsl", "iso_split.wgsl"],
     "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
     &[
         Binding::Uniform,
@@ -372,14 +391,17 @@ impl VolumeTwin {
 pub struct IsoTwin {
     view: SegmentView,
     mapper: ClipMapper,
-    params: IsoParams,
-    surfaces: Vec<IsoSurface>,
-    volume: VolumeTwin,
+    pub(crate) params: IsoParams,
+    pub(crate) surfaces: Vec<IsoSurface>,
+    pub(crate) volume: VolumeTwin,
 }
 
-/// Twin of `count_at_most`: the number of isovalues `<= x`.
+/// Twin of `count_at_most`: the number of isovalues `<= x`, searched among
+/// the surfaces of `x`'s bin and its neighbours ([`IsoBins`]).
 pub fn count_at_most(stage: &IsoTwin, x: f32) -> u32 {
-    let (mut lo, mut hi) = (0u32, stage.params.count);
+    let p = &stage.params;
+    let r = stage.surfaces[iso_bin(p.bin_origin, p.bin_scale, p.count, x) as usize].value;
+    let (mut lo, mut hi) = (r[1] as u32, r[2] as u32);
     while lo < hi {
         let mid = (lo + hi) / 2;
         if stage.surfaces[mid as usize].value[0] <= x {
@@ -389,6 +411,18 @@ pub fn count_at_most(stage: &IsoTwin, x: f32) -> u32 {
         }
     }
     lo
+}
+
+/// Twin of `iso_window`: the surfaces `a..b` the segment from `s_f` to
+/// `s_b` crosses, searched within the part's range `range`.
+pub fn iso_window(stage: &IsoTwin, s_f: f32, s_b: f32, range: [f32; 2]) -> [u32; 2] {
+    let (wlo, whi) = (s_f.min(s_b).max(range[0]), s_f.max(s_b).min(range[1]));
+    let n = stage.params.count as usize;
+    if n > 0 && whi >= stage.surfaces[0].value[0] && wlo <= stage.surfaces[n - 1].value[0] {
+        let a = count_at_most(stage, wlo);
+        return [a, count_at_most(stage, whi).max(a)];
+    }
+    [0, 0]
 }
 
 /// Twin of `iso_light`.
@@ -424,65 +458,6 @@ pub fn iso_crosses(v: f32, seg: &Seg) -> bool {
     v > lo && v <= hi
 }
 
-/// Twin of `iso_segment`.
-pub fn iso_segment(
-    stage: &IsoTwin,
-    seg: &Seg,
-    gf: [f32; 3],
-    gb: [f32; 3],
-    range: [f32; 2],
-) -> [f32; 4] {
-    let (lo, hi) = (seg.s_f.min(seg.s_b), seg.s_f.max(seg.s_b));
-    let n = stage.params.count as usize;
-    let (mut a, mut b) = (0, 0);
-    // The search window within the part's range (a no-op inside the
-    // triangle).
-    let (wlo, whi) = (lo.max(range[0]), hi.min(range[1]));
-    if n > 0 && whi >= stage.surfaces[0].value[0] && wlo <= stage.surfaces[n - 1].value[0] {
-        a = count_at_most(stage, wlo);
-        b = count_at_most(stage, whi).max(a);
-    }
-    let rising = seg.s_f <= seg.s_b;
-    let blend = stage.params.mix == 1;
-    let d = seg.s_b - seg.s_f;
-    let (mut acc, mut back) = ([0.0f32; 4], [0.0f32; 4]);
-    let (mut u0, mut s0) = (0.0f32, seg.s_f);
-    for i in a..=b {
-        let (mut u, mut sv, mut k) = (1.0f32, seg.s_b, 0);
-        if i < b {
-            k = if rising { i } else { a + b - 1 - i };
-            let v = stage.surfaces[k as usize].value[0];
-            if !iso_crosses(v, seg) {
-                continue;
-            }
-            u = if d != 0.0 {
-                ((v - seg.s_f) / d).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            sv = v;
-        }
-        if !blend || i == b {
-            let (from_u, from_s) = if blend { (0.0, seg.s_f) } else { (u0, s0) };
-            acc = iso_over(acc, stage.volume.volume((u - from_u) * seg.l, from_s, sv));
-        }
-        if i < b {
-            let g = std::array::from_fn(|c| gf[c] + (gb[c] - gf[c]) * u);
-            if blend {
-                acc = iso_over(acc, iso_surface(stage, k, rising, g, 1.0 - u));
-                back = iso_over(back, iso_surface(stage, k, rising, g, u));
-            } else {
-                acc = iso_over(acc, iso_surface(stage, k, rising, g, 1.0));
-                if acc[3] >= 1.0 {
-                    break;
-                }
-            }
-        }
-        (u0, s0) = (u, sv);
-    }
-    iso_over(acc, back)
-}
-
 /// Twin of `fs_iso` in `shaders/iso.wgsl`, the fragment at weights `bary`
 /// of `tri` drawn with `stage`'s bindings.
 pub fn fs_iso(stage: &IsoTwin, tri: [&IsoVertex; 3], bary: [f64; 3]) -> Option<[f32; 4]> {
@@ -498,7 +473,11 @@ pub fn fs_iso(stage: &IsoTwin, tri: [&IsoVertex; 3], bary: [f64; 3]) -> Option<[
         gf = gf.map(|g| g / qf);
         gb = gb.map(|g| g / qb);
     }
-    Some(iso_segment(stage, &seg, gf, gb, tri[0].range))
+    let range = tri[0].range;
+    Some(match &stage.volume {
+        VolumeTwin::Integral(t) => super::iso_walk::iso_segment(stage, t, &seg, gf, gb, range),
+        _ => super::iso_split::iso_segment(stage, &seg, gf, gb, range),
+    })
 }
 
 impl CpuStage<IsoVertex> for IsoTwin {
@@ -599,13 +578,25 @@ impl IsoMode {
         tf: &TransferFunction,
         camera: &crate::camera::Camera,
     ) -> IsoTwin {
-        let map = ScalarMap::of(tf);
-        let (params, surfaces) = iso_buffers(&self.set, &map);
         let volume = match &self.volume {
             Volume::None => VolumeTwin::None,
             Volume::Integral => VolumeTwin::Integral(ExactFragTwin::new(tf, camera).for_mesh(mesh)),
             Volume::Table(p) => VolumeTwin::Table(p.twin_for(mesh, tf, camera)),
         };
+        IsoTwin::new(&self.set, &ScalarMap::of(tf), camera, volume)
+    }
+}
+
+impl IsoTwin {
+    /// The twin of a stage drawing `set`'s surfaces (scalars through `map`)
+    /// over `volume`, seen by `camera`.
+    pub fn new(
+        set: &IsoSet,
+        map: &ScalarMap,
+        camera: &crate::camera::Camera,
+        volume: VolumeTwin,
+    ) -> IsoTwin {
+        let (params, surfaces) = iso_buffers(set, map);
         IsoTwin {
             view: SegmentView::of(camera),
             mapper: ClipMapper::for_camera(camera),

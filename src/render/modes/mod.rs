@@ -28,8 +28,11 @@ pub mod exact;
 pub mod exact_frag;
 pub mod integral;
 pub mod iso;
+pub mod iso_bins;
 pub mod iso_levels;
 pub mod iso_seams;
+pub mod iso_split;
+pub mod iso_walk;
 pub mod piece_quad;
 pub mod preint;
 pub mod preint2d;
@@ -201,6 +204,14 @@ pub const SHADERS: &[(&str, &str)] = &[
         include_str!("../../../shaders/integral.wgsl"),
     ),
     ("iso.wgsl", include_str!("../../../shaders/iso.wgsl")),
+    (
+        "iso_split.wgsl",
+        include_str!("../../../shaders/iso_split.wgsl"),
+    ),
+    (
+        "iso_walk.wgsl",
+        include_str!("../../../shaders/iso_walk.wgsl"),
+    ),
     (
         "iso_vertex.wgsl",
         include_str!("../../../shaders/iso_vertex.wgsl"),
