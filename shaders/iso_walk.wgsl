@@ -2,7 +2,8 @@
 // mode with surfaces): one walk front to back over the events of the
 // segment, the transfer function's nodes strictly between its ends
 // (`segment_spans`, `span_end` of shaders/integral.wgsl) and its crossings
-// (`iso_window` of shaders/iso.wgsl), merged in order. Each event ends a
+// (the surfaces `iso_window` of shaders/iso.wgsl gives, found with one
+// search and stepped through), merged in order. Each event ends a
 // linear piece of the volume (`add_piece`); a crossing then adds its lit
 // surface. So a crossing costs one piece and one surface, not a second
 // integral with its own node search and end evaluations (as splitting the
@@ -25,9 +26,26 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, range: vec2<f32>) -> vec4
     let l = select(0.0, min(seg.l, MAX_THICKNESS), ok && seg.l > 0.0);
     let s_f = select(0.0, clamp(seg.s_f, -MAX_SCALAR, MAX_SCALAR), ok);
     let s_b = select(0.0, clamp(seg.s_b, -MAX_SCALAR, MAX_SCALAR), ok);
-    // Crossings a ..< b, front to back (descending where the scalar falls).
-    let w = iso_window(s_f, s_b, range);
+    // The crossings, front to back: the values in (wlo, whi] (the window
+    // of `iso_window`), ascending from the first above wlo where the
+    // scalar rises, descending from the last at or below whi where it
+    // falls. One search finds the first; the walk steps from it.
     let rising = s_f <= s_b;
+    let wlo = max(min(s_f, s_b), range.x);
+    let whi = min(max(s_f, s_b), range.y);
+    var k = 0u;
+    var more = false;
+    if iso.count > 0u && whi >= surfaces[0].value.x
+        && wlo <= surfaces[iso.count - 1u].value.x {
+        if rising {
+            k = count_at_most(wlo);
+            more = k < iso.count;
+        } else {
+            k = count_at_most(whi);
+            more = k > 0u;
+            k = max(k, 1u) - 1u;
+        }
+    }
     let blend = iso.mix == 1u;
     let d = s_b - s_f;
     var inv = 0.0;
@@ -48,14 +66,14 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, range: vec2<f32>) -> vec4
     var m_s0 = sp.m_first;
     var e = span_end(sp, 0u, s_f);
     var n = 0u;
-    var j = w.x;
     loop {
         // The next crossing's fraction (2: none left, after every node).
-        var k = 0u;
         var xi = 2.0;
-        if j < w.y {
-            k = select(w.x + w.y - 1u - j, j, rising);
-            xi = clamp((surfaces[k].value.x - s_f) * inv, 0.0, 1.0);
+        if more {
+            let v = surfaces[k].value.x;
+            if v > wlo && v <= whi {
+                xi = clamp((v - s_f) * inv, 0.0, 1.0);
+            }
         }
         // A crossing at a node comes first (either order gives the same
         // pieces; this one takes the node's front material at a jump).
@@ -74,7 +92,6 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, range: vec2<f32>) -> vec4
         x_prev = x;
         m_prev = m;
         if at_iso {
-            j++;
             let g = mix(gf, gb, xi);
             if blend {
                 front = iso_over(front, iso_surface(k, rising, g, 1.0 - xi));
@@ -89,6 +106,13 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, range: vec2<f32>) -> vec4
                 if acc.tr <= 0.0 {
                     break;
                 }
+            }
+            if rising {
+                k++;
+                more = k < iso.count;
+            } else {
+                more = k > 0u;
+                k = max(k, 1u) - 1u;
             }
         } else {
             n++;

@@ -159,14 +159,11 @@ pub fn boundary_gradient(poly: &Polyhedron, x: DVec3, flat: DVec3) -> DVec3 {
     }
     let mut best = (f64::INFINITY, flat);
     for t in &poly.triangles {
-        let Some(p) = t
-            .iter()
-            .map(|&i| poly.points.get(i as usize).copied())
-            .collect::<Option<Vec<_>>>()
-        else {
+        let p = t.map(|i| poly.points.get(i as usize).copied());
+        let (Some(p0), Some(p1), Some(p2)) = (p[0], p[1], p[2]) else {
             continue;
         };
-        let tri = [p[0], p[1], p[2]];
+        let tri = [p0, p1, p2];
         let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
         let nn = n.length_squared();
         if nn.is_nan() || nn <= 0.0 {

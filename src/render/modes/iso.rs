@@ -763,12 +763,20 @@ impl ProjectedMode for IsoMode {
                 });
             }
         }
+        // A tie vertex (no region) knows the boundary triangles its ray
+        // enters and leaves by (`Projected::tie_faces`); any other searches
+        // the boundary.
         for (i, g) in payload.grads.iter_mut().enumerate() {
             if done[i] || !used.get(i).copied().unwrap_or(true) {
                 continue;
             }
+            let faces = proj.tie_faces.get(i);
             *g = [0, 1].map(|side| {
-                boundary_gradient(part, view_point(proj, i, side), flat / scale) * scale
+                let x = view_point(proj, i, side);
+                faces
+                    .and_then(|f| face_gradient(part, f[side], x))
+                    .unwrap_or_else(|| boundary_gradient(part, x, flat / scale))
+                    * scale
             });
         }
         payload.done = done;

@@ -5,19 +5,21 @@
 
 /// The bins that start `count_at_most`'s search: as many as there are
 /// surfaces, of equal width between the first and the last value, so that
-/// evenly spread values put one surface in each and the search takes two
-/// steps however many there are (a binary search over all of them took
-/// seven at 100 surfaces, each a gather on a software rasteriser).
+/// evenly spread values put about one surface in each and the search takes
+/// one or two steps however many there are (a binary search over all of
+/// them took seven at 100 surfaces, each a gather on a software
+/// rasteriser).
 ///
 /// Bin `k` of scalar `x` is `floor((x - origin) * scale)` clamped to
-/// `0 ..= n - 1`, in `f32` (`iso_bin`), which is monotone in `x`: every
-/// value in a lower bin than `x`'s is below `x`, every value in a higher
-/// bin above it. The search for `x` in bin `k` runs over the surfaces of
-/// bins `k - 1` to `k + 1` ([`IsoBins::window`]): the neighbours absorb a
-/// GPU that rounds `x`'s bin differently by one. Bins narrower than
-/// [`IsoBins::MIN_WIDTH`] of the values' magnitude (where that rounding
-/// could be wider than a bin) are not made: one bin holds every surface,
-/// a binary search over all of them.
+/// `0 ..= n - 1`, in `f32` (`iso_bin`): `x` lies between the bin's edges
+/// `origin + k / scale` and `origin + (k + 1) / scale` up to the rounding
+/// of those two operations. The search for `x` in bin `k` runs over the
+/// surfaces whose values lie between the edges widened by
+/// [`IsoBins::margin`], far more than that rounding (on any GPU: IEEE
+/// subtraction and multiplication, a few ulps at most): every value below
+/// the window is below `x`, every value above it above `x`. Bins narrower
+/// than [`IsoBins::MIN_WIDTH`] of the values' magnitude are not made: one
+/// bin holds every surface, a binary search over all of them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IsoBins {
     pub origin: f32,
@@ -25,16 +27,23 @@ pub struct IsoBins {
     pub scale: f32,
     /// The number of bins: the number of surfaces.
     pub count: u32,
-    /// For each bin `k` (of `n`), the first surface of bin `k - 1` and the
-    /// end of the surfaces of bin `k + 1`.
+    /// For each bin `k` (of `n`), the surfaces its search runs over:
+    /// `windows[k][0] .. windows[k][1]`.
     pub windows: Vec<[u32; 2]>,
 }
 
 impl IsoBins {
     /// The narrowest bin, relative to the largest magnitude of the first
-    /// and last values (at least 1): many `f32` ulps, so that a scalar's
-    /// bin can be off by one at most between GPU and CPU.
+    /// and last values (at least 1): many `f32` ulps.
     pub const MIN_WIDTH: f32 = 1e-4;
+
+    /// How far beyond its edges a bin's window reaches: `1e-3` of the bin
+    /// plus `4e-6` of it per bin (the rounding of `(x - origin) * scale`,
+    /// relative to `t` up to `n`, in units of `x`), plus 16 ulps of the
+    /// values' magnitude (the rounding of `x` and of the edges).
+    pub fn margin(width: f64, n: usize, magnitude: f64) -> f64 {
+        width * (1e-3 + 4e-6 * n as f64) + 16.0 * f32::EPSILON as f64 * magnitude
+    }
 
     /// The bins of the sorted values `values` (normalised, `f32`).
     pub fn new(values: &[f32]) -> IsoBins {
@@ -54,25 +63,34 @@ impl IsoBins {
         } else {
             0.0
         };
-        let mut bins = IsoBins {
+        let windows = if scale > 0.0 {
+            let w = 1.0 / scale as f64;
+            let margin = IsoBins::margin(w, n, magnitude as f64);
+            let edge = |k: usize| first as f64 + k as f64 * w;
+            (0..n)
+                .map(|k| {
+                    let lo = if k == 0 {
+                        0
+                    } else {
+                        values.partition_point(|&v| (v as f64) < edge(k) - margin)
+                    };
+                    let hi = if k + 1 == n {
+                        n
+                    } else {
+                        values.partition_point(|&v| v as f64 <= edge(k + 1) + margin)
+                    };
+                    [lo as u32, hi.max(lo) as u32]
+                })
+                .collect()
+        } else {
+            vec![[0, n as u32]; n]
+        };
+        IsoBins {
             origin: first,
             scale,
             count: n as u32,
-            windows: Vec::with_capacity(n),
-        };
-        // start[k]: the first surface of bin k (the values are sorted and
-        // the bins monotone); start[n] = n.
-        let mut start = vec![n as u32; n + 1];
-        for (i, &v) in values.iter().enumerate().rev() {
-            start[bins.bin(v) as usize] = i as u32;
+            windows,
         }
-        for k in (0..n).rev() {
-            start[k] = start[k].min(start[k + 1]);
-        }
-        bins.windows = (0..n)
-            .map(|k| [start[k.saturating_sub(1)], start[(k + 2).min(n)]])
-            .collect();
-        bins
     }
 
     /// The bin of `x` (`iso_bin`).
@@ -118,6 +136,11 @@ mod tests {
             vec![0.3, 0.3 + 1e-7, 0.3 + 2e-7],
             vec![-1e30, 0.0, 1e30],
             vec![1e6, 1e6 + 0.125, 1e6 + 0.25],
+            // Values on a bin's edge and an ulp below the next (bins of
+            // 0.25): a scalar rounded into the neighbouring bin must still
+            // find them.
+            vec![0.0, 0.25, 0.5f32.next_down(), 0.75f32.next_up(), 1.0],
+            vec![0.0, 0.5f32.next_down(), 0.75, 1.0],
         ];
         // 99 values in a cluster, one far away: bins of 1/100 of the range
         // put the cluster in one.
@@ -156,16 +179,16 @@ mod tests {
             xs.extend((0..200).map(|_| rng.range(-1.0, 2.0) as f32));
             for x in xs {
                 let want = values.iter().filter(|&&v| v <= x).count() as u32;
-                let k = bins.bin(x);
-                for k in [k.saturating_sub(1), k, (k + 1).min(n - 1)] {
-                    // A bin one off is absorbed only where the scalar lies
-                    // at its edge: check the rounding the window allows.
-                    if k != bins.bin(x) && bins.scale > 0.0 {
-                        let t = (x - bins.origin) * bins.scale;
-                        if (t - t.round()).abs() > 1e-3 {
-                            continue;
-                        }
-                    }
+                // The bin, and where the scalar lies at an edge (within
+                // far more than a GPU's rounding of `t`) the bins on both
+                // sides of it.
+                let mut ks = vec![bins.bin(x)];
+                let t = (x - bins.origin) * bins.scale;
+                if bins.scale > 0.0 && (t - t.round()).abs() <= 5e-4 {
+                    let m = t.round() as i64;
+                    ks.extend([m - 1, m].map(|k| k.clamp(0, n as i64 - 1) as u32));
+                }
+                for k in ks {
                     assert_eq!(
                         count_in(&values, &bins, k, x),
                         want,
@@ -177,15 +200,15 @@ mod tests {
         }
     }
 
-    /// Evenly spread values get one surface per bin (the search's two
-    /// steps); sets too narrow for bins get one window over all.
+    /// Evenly spread values get at most one surface per bin (the search's
+    /// one step); sets too narrow for bins get one window over all.
     #[test]
     fn even_values_fill_one_bin_each() {
         let values: Vec<f32> = (1..=100).map(|k| k as f32 / 101.0).collect();
         let bins = IsoBins::new(&values);
         assert!(bins.scale > 0.0);
         for (k, w) in bins.windows.iter().enumerate() {
-            assert!(w[1] - w[0] <= 4, "bin {k}: {w:?}");
+            assert!(w[1] - w[0] <= 1, "bin {k}: {w:?}");
         }
         let narrow = IsoBins::new(&[0.3, 0.3 + 1e-7, 0.3 + 2e-7]);
         assert_eq!(narrow.scale, 0.0);

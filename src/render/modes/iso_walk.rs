@@ -7,7 +7,7 @@
 
 use super::exact_frag::ExactFragTwin;
 use super::integral::{neg_expm1, Composite, Material, MAX_SCALAR, MAX_THICKNESS};
-use super::iso::{iso_over, iso_surface, iso_window, IsoTwin};
+use super::iso::{count_at_most, iso_over, iso_surface, IsoTwin};
 use super::segment::Seg;
 
 /// Twin of `iso_segment` in `shaders/iso_walk.wgsl`, with `vol`'s transfer
@@ -35,8 +35,21 @@ pub fn iso_segment(
         }
     };
     let (s_f, s_b) = (clamped(seg.s_f), clamped(seg.s_b));
-    let [a, b] = iso_window(stage, s_f, s_b, range);
     let rising = s_f <= s_b;
+    let (wlo, whi) = (s_f.min(s_b).max(range[0]), s_f.max(s_b).min(range[1]));
+    let count = stage.params.count;
+    let value = |k: u32| stage.surfaces[k as usize].value[0];
+    let (mut k, mut more) = (0u32, false);
+    if count > 0 && whi >= value(0) && wlo <= value(count - 1) {
+        if rising {
+            k = count_at_most(stage, wlo);
+            more = k < count;
+        } else {
+            k = count_at_most(stage, whi);
+            more = k > 0;
+            k = k.max(1) - 1;
+        }
+    }
     let blend = stage.params.mix == 1;
     let d = s_b - s_f;
     let inv = if d != 0.0 { 1.0 / d } else { 0.0 };
@@ -50,12 +63,14 @@ pub fn iso_segment(
     let (mut x_prev, mut m_prev) = (0.0f32, sp.m_first);
     let (mut x_s0, mut m_s0) = (0.0f32, sp.m_first);
     let (mut e_m, mut e_x) = tf.span_end(&sp, 0, s_f);
-    let (mut n, mut j) = (0u32, a);
+    let mut n = 0u32;
     loop {
-        let (mut k, mut xi) = (0u32, 2.0f32);
-        if j < b {
-            k = if rising { j } else { a + b - 1 - j };
-            xi = ((stage.surfaces[k as usize].value[0] - s_f) * inv).clamp(0.0, 1.0);
+        let mut xi = 2.0f32;
+        if more {
+            let v = value(k);
+            if v > wlo && v <= whi {
+                xi = ((v - s_f) * inv).clamp(0.0, 1.0);
+            }
         }
         let at_iso = xi <= e_x;
         let span = e_x - x_s0;
@@ -70,7 +85,6 @@ pub fn iso_segment(
         }
         (x_prev, m_prev) = (x, m);
         if at_iso {
-            j += 1;
             let g = std::array::from_fn(|c| gf[c] + (gb[c] - gf[c]) * xi);
             if blend {
                 front = iso_over(front, iso_surface(stage, k, rising, g, 1.0 - xi));
@@ -85,6 +99,13 @@ pub fn iso_segment(
                 if acc.tr <= 0.0 {
                     break;
                 }
+            }
+            if rising {
+                k += 1;
+                more = k < count;
+            } else {
+                more = k > 0;
+                k = k.max(1) - 1;
             }
         } else {
             n += 1;
@@ -112,6 +133,7 @@ mod tests {
     use super::*;
     use crate::camera::{Camera, CameraParams};
     use crate::render::iso::{IsoMix, IsoOptions, IsoSet, IsoSpec, Lighting, SideStyle};
+    use crate::render::modes::iso::iso_window;
     use crate::render::modes::iso::VolumeTwin;
     use crate::render::modes::iso_split;
     use crate::render::modes::segment::ScalarMap;
