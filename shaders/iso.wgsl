@@ -36,7 +36,9 @@ struct IsoParams {
 struct IsoSurface {
     // x: the normalised isovalue (increasing with the index); y, z: where
     // `count_at_most` searches for an x in bin k (this entry's index): the
-    // surfaces of bins k - 1 to k + 1, as indices (exact in f32).
+    // surfaces y ..< z, those within the bin's edges widened far beyond
+    // any rounding of the bin (src/render/modes/iso_bins.rs), as indices
+    // (exact in f32).
     value: vec4<f32>,
     // Straight colour and opacity of the front (rising) and back sides.
     front: vec4<f32>,
@@ -53,10 +55,9 @@ fn iso_bin(x: f32) -> u32 {
 }
 
 // The number of isovalues <= x: a binary search among the surfaces of x's
-// bin and its two neighbours (every value of a lower bin is below x, every
-// value of a higher one above, since the bins are monotone; the neighbours
-// absorb a rounding of the bin by one). Evenly spread values put one
-// surface per bin: two steps, however many surfaces.
+// bin (every value below its window is below x, every value above it
+// above x). Evenly spread values put about one surface in each bin: one
+// step, however many surfaces.
 fn count_at_most(x: f32) -> u32 {
     let r = surfaces[iso_bin(x)].value;
     var lo = u32(r.y);

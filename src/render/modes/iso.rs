@@ -203,7 +203,7 @@ pub struct IsoParams {
 pub struct IsoSurface {
     /// `x`: the normalised isovalue; `y`, `z`: the surfaces `count_at_most`
     /// searches for a scalar in bin `k` (this surface's index), as
-    /// [`IsoBins::window`] gives them.
+    /// [`IsoBins::windows`] gives them.
     pub value: [f32; 4],
     pub front: [f32; 4],
     pub back: [f32; 4],
@@ -397,7 +397,7 @@ pub struct IsoTwin {
 }
 
 /// Twin of `count_at_most`: the number of isovalues `<= x`, searched among
-/// the surfaces of `x`'s bin and its neighbours ([`IsoBins`]).
+/// the surfaces of `x`'s bin ([`IsoBins`]).
 pub fn count_at_most(stage: &IsoTwin, x: f32) -> u32 {
     let p = &stage.params;
     let r = stage.surfaces[iso_bin(p.bin_origin, p.bin_scale, p.count, x) as usize].value;

@@ -84,7 +84,7 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
                 && snap_is_steep_at(area2, long, l, (part.rate)()))
                 || (!part.isovalues.is_empty()
                     && isovalue_shift(part, t, part.snap_of(t), area2 / long, ISO_SLIVER_REL)
-                        .is_some());
+                        .is_some_and(|shift| iso_centre_near(part, t, p, shift)));
             continue;
         }
         let dl = l[0].max(l[1]).max(l[2]) - l[0].min(l[1]).min(l[2]);
@@ -175,6 +175,83 @@ fn isovalue_shift(part: &PartTriangles, t: &[u32; 3], snap: f64, w: f64, rel: f6
         (Some(a), Some(b)) => Some(a.max(b)),
         (a, b) => a.or(b),
     }
+}
+
+/// The most centres [`iso_centre_near`] looks at in one triangle; a larger
+/// triangle is drawn steep without looking (three vertices of its own cost
+/// less than the search).
+const ISO_STEEP_CENTRES: i64 = 64;
+
+/// Whether a pixel centre in the wide exact triangle `t` at `p` (grown by
+/// [`TIE_BAND_PX`]) has an exact entry or exit scalar within `shift` (the
+/// snap's, from [`isovalue_shift`]) and [`ISO_SLIVER_REL`] of the corner
+/// scalars (the `f32` stage's rounding) of one of `part.isovalues`: only
+/// such a centre can fall on the other side of a value than the exact
+/// triangle puts it, so only then is the triangle drawn steep (with a
+/// dense set of isovalues nearly every triangle holds one, but a value's
+/// line meets a centre within the margin rarely). The scalars at a centre
+/// are the exact corners' interpolated as the GPU interpolates them
+/// (perspective-correct). True for a triangle holding more than
+/// [`ISO_STEEP_CENTRES`] centres' box, or one that is degenerate.
+fn iso_centre_near(part: &PartTriangles, t: &[u32; 3], p: [DVec2; 3], shift: f64) -> bool {
+    let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+    let (lo, hi) = (
+        p[0].min(p[1]).min(p[2]) - TIE_BAND_PX,
+        p[0].max(p[1]).max(p[2]) + TIE_BAND_PX,
+    );
+    let (i0, i1) = (
+        (lo.x - 0.5).ceil().max(0.0),
+        (hi.x - 0.5).floor().min(part.width as f64 - 1.0),
+    );
+    let (j0, j1) = (
+        (lo.y - 0.5).ceil().max(0.0),
+        (hi.y - 0.5).floor().min(part.height as f64 - 1.0),
+    );
+    if !(area != 0.0 && i0.is_finite() && i1.is_finite() && j0.is_finite() && j1.is_finite()) {
+        return true;
+    }
+    let (i0, i1, j0, j1) = (i0 as i64, i1 as i64, j0 as i64, j1 as i64);
+    if (i1 - i0 + 1).max(0) * (j1 - j0 + 1).max(0) > ISO_STEEP_CENTRES {
+        return true;
+    }
+    let v = t.map(|i| &part.proj.vertices[i as usize]);
+    let ortho = part.proj.view.ortho;
+    // Per side: the corner scalars, their weights' factors q = 1/z (1
+    // orthographic) and the margin.
+    let sides = [0, 1].map(|side| {
+        let s = v.map(|v| if side == 0 { v.s_front } else { v.s_back });
+        let q = v.map(|v| {
+            let z = if side == 0 { v.z_front } else { v.z_back };
+            if ortho || z.is_nan() || z <= 0.0 {
+                1.0
+            } else {
+                1.0 / z
+            }
+        });
+        let big = s[0].abs().max(s[1].abs()).max(s[2].abs());
+        (s, q, shift + ISO_SLIVER_REL * big)
+    });
+    for j in j0..=j1 {
+        for i in i0..=i1 {
+            let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+            if !in_grown_triangle(p, c) {
+                continue;
+            }
+            let b1 = (c - p[0]).perp_dot(p[2] - p[0]) / area;
+            let b2 = (p[1] - p[0]).perp_dot(c - p[0]) / area;
+            let b = [1.0 - b1 - b2, b1, b2];
+            for (s, q, margin) in &sides {
+                let w = [b[0] * q[0], b[1] * q[1], b[2] * q[2]];
+                let at = (w[0] * s[0] + w[1] * s[1] + w[2] * s[2]) / (w[0] + w[1] + w[2]);
+                let d = to_nearest(part.isovalues, at);
+                // NaN: as near.
+                if d.is_nan() || d <= *margin {
+                    return true;
+                }
+            }
+        }
+    }
+    false
 }
 
 /// The distance from `s` to the nearest of the sorted `values`.
