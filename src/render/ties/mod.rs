@@ -70,12 +70,16 @@
 //!   are decided too ([`PartTriangles::isovalues`]). A sliver is weighed
 //!   by how far the snap actually moved its corners
 //!   ([`PartTriangles::snap`]), not by the most it can. A wider triangle
-//!   whose entry or exit scalars reach an isovalue (within the snap's
-//!   shift) is drawn **steep** instead ([`snap_is_steep`]: the exact
-//!   triangle's values at its snapped corners), so that every centre in
-//!   it takes the exact triangle's scalars, whatever the volume's rate
-//!   (a surface on a face of a zero-extinction volume was otherwise
-//!   missed at 2 of 9,080 centres in perspective, `tests/iso.rs`).
+//!   holding a centre whose exact entry or exit scalar comes within the
+//!   snap's shift of an isovalue is drawn **steep** instead
+//!   ([`snap_is_steep`]: the exact triangle's values at its snapped
+//!   corners), so that every centre in it takes the exact triangle's
+//!   scalars, whatever the volume's rate (a surface on a face of a
+//!   zero-extinction volume was otherwise missed at 2 of 9,080 centres in
+//!   perspective, `tests/iso.rs`). Only such centres can change side: with
+//!   many isovalues nearly every triangle holds one, but few hold such a
+//!   centre (bluntfin, 100 values: 26,665 steep triangles of 330,322,
+//!   against 101,008 when every triangle holding a value was).
 //!
 //! **Optically thin parts** ([`thin_outline`]) need none of this. Where
 //! the thickness is 0 all along a part's outline (a piece in general
