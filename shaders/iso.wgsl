@@ -25,20 +25,14 @@ struct IsoParams {
     diffuse: f32,
     // 0: exact mixing, 1: RKE's blend (src/render/iso.rs `IsoMix`).
     mix: u32,
-    // The bins of `count_at_most`: bin(x) = floor((x - bin_origin) *
-    // bin_scale), clamped to 0 ..= count - 1 (bin_scale 0: one bin).
-    bin_origin: f32,
-    bin_scale: f32,
-    _pad: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // Keep in sync with `IsoSurface` in src/render/modes/iso.rs.
 struct IsoSurface {
-    // x: the normalised isovalue (increasing with the index); y, z: where
-    // `count_at_most` searches for an x in bin k (this entry's index): the
-    // surfaces y ..< z, those within the bin's edges widened far beyond
-    // any rounding of the bin (src/render/modes/iso_bins.rs), as indices
-    // (exact in f32).
+    // x: the normalised isovalue (increasing with the index).
     value: vec4<f32>,
     // Straight colour and opacity of the front (rising) and back sides.
     front: vec4<f32>,
@@ -48,20 +42,12 @@ struct IsoSurface {
 @group(0) @binding(3) var<uniform> iso: IsoParams;
 @group(0) @binding(4) var<storage, read> surfaces: array<IsoSurface>;
 
-// The bin of scalar x (`IsoParams`): monotone in x.
-fn iso_bin(x: f32) -> u32 {
-    let t = (x - iso.bin_origin) * iso.bin_scale;
-    return u32(clamp(floor(t), 0.0, f32(iso.count - 1u)));
-}
-
-// The number of isovalues <= x: a binary search among the surfaces of x's
-// bin (every value below its window is below x, every value above it
-// above x). Evenly spread values put about one surface in each bin: one
-// step, however many surfaces.
-fn count_at_most(x: f32) -> u32 {
-    let r = surfaces[iso_bin(x)].value;
-    var lo = u32(r.y);
-    var hi = u32(r.z);
+// The number of isovalues <= x, for an x between the values of surfaces
+// first - 1 and end (every surface below `first` is at most x, every one
+// from `end` on above it): a binary search among first ..< end.
+fn count_at_most(x: f32, first: u32, end: u32) -> u32 {
+    var lo = first;
+    var hi = end;
     loop {
         if lo >= hi {
             break;
@@ -77,21 +63,20 @@ fn count_at_most(x: f32) -> u32 {
 }
 
 // The crossings of the segment from s_f to s_b: the surfaces a ..< b
-// (returned as (a, b)), the values V with min < V <= max of its ends. The
-// search window lies within the part's scalar range `range` (flat): a
-// no-op inside the triangle, a bound on the lanes a rasteriser shades
-// outside it with extrapolated scalars (whose loops would otherwise run
-// over every isovalue). Most segments cross nothing: two reads decide it
-// before any search.
-fn iso_window(s_f: f32, s_b: f32, range: vec2<f32>) -> vec2<u32> {
-    let wlo = max(min(s_f, s_b), range.x);
-    let whi = min(max(s_f, s_b), range.y);
-    var a = 0u;
-    var b = 0u;
-    if iso.count > 0u && whi >= surfaces[0].value.x
-        && wlo <= surfaces[iso.count - 1u].value.x {
-        a = count_at_most(wlo);
-        b = max(count_at_most(whi), a);
+// (returned as (a, b)), the values V with min < V <= max of its ends,
+// among the part's candidates (`VertexIn::candidates`, flat: the values
+// within its scalar range, so that a segment inside the triangle crosses
+// no other, and a rasteriser's lanes outside it, shaded with extrapolated
+// scalars, search and loop over no more). A part holding no value
+// searches nothing.
+fn iso_window(s_f: f32, s_b: f32, candidates: vec2<f32>) -> vec2<u32> {
+    let first = u32(candidates.x);
+    let end = u32(candidates.y);
+    var a = first;
+    var b = first;
+    if first < end {
+        a = count_at_most(min(s_f, s_b), first, end);
+        b = max(count_at_most(max(s_f, s_b), first, end), a);
     }
     return vec2<u32>(a, b);
 }
@@ -150,7 +135,7 @@ fn fs_iso(f: VertexOut) -> FragOut {
         gb = gb / f.back.y;
     }
     var out: FragOut;
-    out.color = iso_segment(seg, gf, gb, f.range);
+    out.color = iso_segment(seg, gf, gb, f.candidates);
     out.depth = piece_depth(f.piece);
     return out;
 }

@@ -11,8 +11,8 @@
 // (iso.mix 1) instead draws every surface's front-face layer (opacity
 // times 1 - u), the whole segment's volume at step b, then the back-face
 // layers (times u).
-fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, range: vec2<f32>) -> vec4<f32> {
-    let w = iso_window(seg.s_f, seg.s_b, range);
+fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, candidates: vec2<f32>) -> vec4<f32> {
+    let w = iso_window(seg.s_f, seg.s_b, candidates);
     let a = w.x;
     let b = w.y;
     let rising = seg.s_f <= seg.s_b;

@@ -7,9 +7,9 @@
 // fills it): grad_front = g_f (orthographic) or g_f q_f (perspective), and
 // grad_back likewise with q_b. The gradient is linear on each boundary
 // triangle (smooth shading) or constant (flat), so, as s q, g q is affine in
-// screen position and the fragment divides by the interpolated q. range is
-// the part's normalised scalar range (flat), where the isovalues are
-// searched.
+// screen position and the fragment divides by the interpolated q.
+// candidates (flat) are the surfaces the part can cross, as indices
+// candidates.x ..< candidates.y (exact in f32): the only ones searched.
 
 // Keep in sync with `IsoVertex` in src/render/modes/iso.rs.
 struct VertexIn {
@@ -20,7 +20,7 @@ struct VertexIn {
     @location(4) piece: u32,
     @location(5) grad_front: vec3<f32>,
     @location(6) grad_back: vec3<f32>,
-    @location(7) range: vec2<f32>,
+    @location(7) candidates: vec2<f32>,
 }
 
 // Default (perspective-correct, with w = 1 screen-linear) interpolation, as
@@ -33,7 +33,7 @@ struct VertexOut {
     @location(3) @interpolate(flat) piece: u32,
     @location(4) grad_front: vec3<f32>,
     @location(5) grad_back: vec3<f32>,
-    @location(6) @interpolate(flat) range: vec2<f32>,
+    @location(6) @interpolate(flat) candidates: vec2<f32>,
 }
 
 @vertex
@@ -46,6 +46,6 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.piece = v.piece;
     out.grad_front = v.grad_front;
     out.grad_back = v.grad_back;
-    out.range = v.range;
+    out.candidates = v.candidates;
     return out;
 }

@@ -19,30 +19,32 @@
 //
 // Twin: render::modes::iso_walk.
 
-fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, range: vec2<f32>) -> vec4<f32> {
+fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, candidates: vec2<f32>) -> vec4<f32> {
     // As `integrate_segment` takes a segment: no volume where the length is
     // not positive, nothing at all where a scalar is NaN.
     let ok = seg.s_f == seg.s_f && seg.s_b == seg.s_b;
     let l = select(0.0, min(seg.l, MAX_THICKNESS), ok && seg.l > 0.0);
     let s_f = select(0.0, clamp(seg.s_f, -MAX_SCALAR, MAX_SCALAR), ok);
     let s_b = select(0.0, clamp(seg.s_b, -MAX_SCALAR, MAX_SCALAR), ok);
-    // The crossings, front to back: the values in (wlo, whi] (the window
-    // of `iso_window`), ascending from the first above wlo where the
-    // scalar rises, descending from the last at or below whi where it
-    // falls. One search finds the first; the walk steps from it.
+    // The crossings, front to back: the values in (lo, hi] among the
+    // part's candidates (the window of `iso_window`), ascending from the
+    // first above lo where the scalar rises, descending from the last at
+    // or below hi where it falls. One search finds the first; the walk
+    // steps from it.
     let rising = s_f <= s_b;
-    let wlo = max(min(s_f, s_b), range.x);
-    let whi = min(max(s_f, s_b), range.y);
-    var k = 0u;
+    let lo = min(s_f, s_b);
+    let hi = max(s_f, s_b);
+    let first = u32(candidates.x);
+    let end = u32(candidates.y);
+    var k = first;
     var more = false;
-    if iso.count > 0u && whi >= surfaces[0].value.x
-        && wlo <= surfaces[iso.count - 1u].value.x {
+    if first < end {
         if rising {
-            k = count_at_most(wlo);
-            more = k < iso.count;
+            k = count_at_most(lo, first, end);
+            more = k < end;
         } else {
-            k = count_at_most(whi);
-            more = k > 0u;
+            k = count_at_most(hi, first, end);
+            more = k > first;
             k = max(k, 1u) - 1u;
         }
     }
@@ -71,7 +73,7 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, range: vec2<f32>) -> vec4
         var xi = 2.0;
         if more {
             let v = surfaces[k].value.x;
-            if v > wlo && v <= whi {
+            if v > lo && v <= hi {
                 xi = clamp((v - s_f) * inv, 0.0, 1.0);
             }
         }
@@ -109,9 +111,9 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, range: vec2<f32>) -> vec4
             }
             if rising {
                 k++;
-                more = k < iso.count;
+                more = k < end;
             } else {
-                more = k > 0u;
+                more = k > first;
                 k = max(k, 1u) - 1u;
             }
         } else {

@@ -42,8 +42,9 @@
 //! segment keeps its place in the exact order, so surfaces and volume are
 //! composited in their true order along every ray. Only the isovalues
 //! between the segment's ends are visited (a binary search in the sorted
-//! values; the GPU stages search only the few values of the scalar's bin,
-//! [`crate::render::modes::iso_bins`]): the cost does not grow with the
+//! values; the GPU stages search only the values within the piece's own
+//! scalar range, [`crate::render::modes::iso::IsoVertex::candidates`]):
+//! the cost does not grow with the
 //! number of surfaces that a segment does not cross.
 
 use std::fmt;

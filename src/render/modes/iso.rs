@@ -46,7 +46,6 @@ use super::exact_frag::{
     THIN_CONSTANTS,
 };
 use super::integral::TfBuffer;
-use super::iso_bins::{iso_bin, IsoBins};
 pub use super::iso_levels::{decided_end, gpu_level};
 use super::preint::{PreintMode, PreintTwin};
 use super::preint_tables::{TableKind, TableStats};
@@ -96,16 +95,19 @@ pub struct IsoVertex {
     pub grad_front: [f32; 3],
     /// `g_b` or `g_b q_b`.
     pub grad_back: [f32; 3],
-    /// The part's normalised scalar range, widened by [`RANGE_MARGIN`]
-    /// (flat): every segment of the part lies in it, so the stage searches
-    /// the isovalues only there. A rasteriser may shade lanes outside the
-    /// triangle (llvmpipe runs whole pixel blocks) with extrapolated
-    /// scalars; without the bound their crossing loops ran over every
-    /// isovalue, which made a frame's cost grow with their number.
-    pub range: [f32; 2],
+    /// The surfaces the part can cross (flat): indices
+    /// `candidates[0] .. candidates[1]` (exact in `f32`), those whose
+    /// values lie within the part's normalised scalar range widened by
+    /// [`RANGE_MARGIN`]. Every segment of the part lies in that range, so
+    /// the stage searches only these (a part holding no value, none). A
+    /// rasteriser may shade lanes outside the triangle (llvmpipe runs
+    /// whole pixel blocks) with extrapolated scalars; without the bound
+    /// their crossing loops ran over every isovalue, which made a frame's
+    /// cost grow with their number.
+    pub candidates: [f32; 2],
 }
 
-/// How far [`IsoVertex::range`] is widened beyond the part's scalars
+/// How far the range of [`IsoVertex::candidates`] is widened beyond the part's scalars
 /// (normalised units, relative above 1): far above the `f32` rounding of a
 /// fragment's interpolated scalars, so that the bound never changes a
 /// fragment inside the triangle.
@@ -149,7 +151,7 @@ impl GpuVertex for IsoVertex {
         self.seg.is_finite()
             && self.grad_front.iter().all(|v| v.is_finite())
             && self.grad_back.iter().all(|v| v.is_finite())
-            && self.range.iter().all(|v| !v.is_nan())
+            && self.candidates.iter().all(|v| !v.is_nan())
     }
     fn with_clip(self, pos: [f32; 4]) -> Self {
         IsoVertex {
@@ -164,7 +166,7 @@ impl GpuVertex for IsoVertex {
             grad_back: [0, 1, 2].map(|k| lerp(tri, bary, |v| v.grad_back[k])),
             // Flat: the first vertex's (every vertex of a part has the
             // part's).
-            range: tri[0].range,
+            candidates: tri[0].candidates,
         }
     }
     fn transparent(self) -> Self {
@@ -190,10 +192,7 @@ pub struct IsoParams {
     pub diffuse: f32,
     /// 0: exact mixing, 1: RKE's blend ([`crate::render::iso::IsoMix`]).
     pub mix: u32,
-    /// The bins of `count_at_most` ([`IsoBins`]).
-    pub bin_origin: f32,
-    pub bin_scale: f32,
-    pub _pad: u32,
+    pub _pad: [u32; 3],
 }
 
 /// One surface as the stage reads it. Keep in sync with `IsoSurface` in
@@ -201,9 +200,7 @@ pub struct IsoParams {
 #[repr(C)]
 #[derive(Pod, Zeroable, Clone, Copy, Debug, Default, PartialEq)]
 pub struct IsoSurface {
-    /// `x`: the normalised isovalue; `y`, `z`: the surfaces `count_at_most`
-    /// searches for a scalar in bin `k` (this surface's index), as
-    /// [`IsoBins::windows`] gives them.
+    /// `x`: the normalised isovalue.
     pub value: [f32; 4],
     pub front: [f32; 4],
     pub back: [f32; 4],
@@ -213,12 +210,6 @@ pub struct IsoSurface {
 /// (one zero surface when the set is empty: a storage binding is never
 /// empty).
 pub fn iso_buffers(set: &IsoSet, map: &ScalarMap) -> (IsoParams, Vec<IsoSurface>) {
-    let values: Vec<f32> = set
-        .values
-        .iter()
-        .map(|&v| gpu_level(map.apply(v)))
-        .collect();
-    let bins = IsoBins::new(&values);
     let params = IsoParams {
         count: set.values.len() as u32,
         lighting: set.lighting.code(),
@@ -228,16 +219,14 @@ pub fn iso_buffers(set: &IsoSet, map: &ScalarMap) -> (IsoParams, Vec<IsoSurface>
             IsoMix::Exact => 0,
             IsoMix::Blend => 1,
         },
-        bin_origin: bins.origin,
-        bin_scale: bins.scale,
-        _pad: 0,
+        _pad: [0; 3],
     };
-    let mut surfaces: Vec<IsoSurface> = values
+    let mut surfaces: Vec<IsoSurface> = set
+        .values
         .iter()
         .zip(&set.sides)
-        .zip(&bins.windows)
-        .map(|((&v, sides), w)| IsoSurface {
-            value: [v, w[0] as f32, w[1] as f32, 0.0],
+        .map(|(&v, sides)| IsoSurface {
+            value: [gpu_level(map.apply(v)), 0.0, 0.0, 0.0],
             front: sides[0].map(|c| c as f32),
             back: sides[1].map(|c| c as f32),
         })
@@ -396,12 +385,10 @@ pub struct IsoTwin {
     pub(crate) volume: VolumeTwin,
 }
 
-/// Twin of `count_at_most`: the number of isovalues `<= x`, searched among
-/// the surfaces of `x`'s bin ([`IsoBins`]).
-pub fn count_at_most(stage: &IsoTwin, x: f32) -> u32 {
-    let p = &stage.params;
-    let r = stage.surfaces[iso_bin(p.bin_origin, p.bin_scale, p.count, x) as usize].value;
-    let (mut lo, mut hi) = (r[1] as u32, r[2] as u32);
+/// Twin of `count_at_most`: the number of isovalues `<= x` for an `x`
+/// between surfaces `first - 1` and `end`, searched among `first..end`.
+pub fn count_at_most(stage: &IsoTwin, x: f32, first: u32, end: u32) -> u32 {
+    let (mut lo, mut hi) = (first, end);
     while lo < hi {
         let mid = (lo + hi) / 2;
         if stage.surfaces[mid as usize].value[0] <= x {
@@ -414,15 +401,14 @@ pub fn count_at_most(stage: &IsoTwin, x: f32) -> u32 {
 }
 
 /// Twin of `iso_window`: the surfaces `a..b` the segment from `s_f` to
-/// `s_b` crosses, searched within the part's range `range`.
-pub fn iso_window(stage: &IsoTwin, s_f: f32, s_b: f32, range: [f32; 2]) -> [u32; 2] {
-    let (wlo, whi) = (s_f.min(s_b).max(range[0]), s_f.max(s_b).min(range[1]));
-    let n = stage.params.count as usize;
-    if n > 0 && whi >= stage.surfaces[0].value[0] && wlo <= stage.surfaces[n - 1].value[0] {
-        let a = count_at_most(stage, wlo);
-        return [a, count_at_most(stage, whi).max(a)];
+/// `s_b` crosses, among the part's `candidates` ([`IsoVertex::candidates`]).
+pub fn iso_window(stage: &IsoTwin, s_f: f32, s_b: f32, candidates: [f32; 2]) -> [u32; 2] {
+    let (first, end) = (candidates[0] as u32, candidates[1] as u32);
+    if first < end {
+        let a = count_at_most(stage, s_f.min(s_b), first, end);
+        return [a, count_at_most(stage, s_f.max(s_b), first, end).max(a)];
     }
-    [0, 0]
+    [first, first]
 }
 
 /// Twin of `iso_light`.
@@ -473,10 +459,10 @@ pub fn fs_iso(stage: &IsoTwin, tri: [&IsoVertex; 3], bary: [f64; 3]) -> Option<[
         gf = gf.map(|g| g / qf);
         gb = gb.map(|g| g / qb);
     }
-    let range = tri[0].range;
+    let candidates = tri[0].candidates;
     Some(match &stage.volume {
-        VolumeTwin::Integral(t) => super::iso_walk::iso_segment(stage, t, &seg, gf, gb, range),
-        _ => super::iso_split::iso_segment(stage, &seg, gf, gb, range),
+        VolumeTwin::Integral(t) => super::iso_walk::iso_segment(stage, t, &seg, gf, gb, candidates),
+        _ => super::iso_split::iso_segment(stage, &seg, gf, gb, candidates),
     })
 }
 
@@ -514,22 +500,28 @@ impl CpuStage<IsoVertex> for IsoTwin {
 pub struct IsoPayload {
     seg: SegmentPayload,
     grads: Vec<[DVec3; 2]>,
-    /// The part's [`IsoVertex::range`].
-    range: [f32; 2],
+    /// The part's [`IsoVertex::candidates`].
+    candidates: [f32; 2],
     /// Scratch: the vertices whose gradients are set.
     done: Vec<bool>,
 }
 
-/// The part's normalised scalar range widened by [`RANGE_MARGIN`]
-/// ([`IsoVertex::range`]); the whole line for a part without scalars.
-fn part_range(part: &Polyhedron, map: &ScalarMap) -> [f32; 2] {
+/// The surfaces of `set` (their values through `map` as the stage holds
+/// them) within the part's normalised scalar range widened by
+/// [`RANGE_MARGIN`] ([`IsoVertex::candidates`]); every surface for a part
+/// without scalars.
+fn part_candidates(part: &Polyhedron, map: &ScalarMap, set: &IsoSet) -> [f32; 2] {
+    let n = set.values.len();
     let (lo, hi) = crate::render::pieces::value_range(part.scalars.iter().copied());
     if lo.is_nan() || hi.is_nan() || lo > hi {
-        return [f32::NEG_INFINITY, f32::INFINITY];
+        return [0.0, n as f32];
     }
     let (lo, hi) = (map.apply(lo), map.apply(hi));
     let widen = |v: f64, sign: f64| v + sign * RANGE_MARGIN * v.abs().max(1.0);
-    [widen(lo, -1.0) as f32, widen(hi, 1.0) as f32]
+    let level = |v: &f64| gpu_level(map.apply(*v)) as f64;
+    let first = set.values.partition_point(|v| level(v) <= widen(lo, -1.0));
+    let end = set.values.partition_point(|v| level(v) <= widen(hi, 1.0));
+    [first as f32, end.max(first) as f32]
 }
 
 /// Isosurfaces alone or over a volume, on the projected-cell driver.
@@ -710,7 +702,7 @@ impl ProjectedMode for IsoMode {
     ) {
         payload.seg.set(src);
         let scale = payload.seg.map.scale;
-        payload.range = part_range(part, &payload.seg.map);
+        payload.candidates = part_candidates(part, &payload.seg.map, &self.set);
         // Where a boundary triangle's scalar is an isovalue, a surface
         // meets the face shared with the next piece: the two pieces
         // interpolate the face's scalar on different triangles with
@@ -811,7 +803,7 @@ impl ProjectedMode for IsoMode {
             seg,
             grad_front: f32x3(g[0], qf),
             grad_back: f32x3(g[1], qb),
-            range: payload.range,
+            candidates: payload.candidates,
         }
     }
 }

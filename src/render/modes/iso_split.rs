@@ -13,9 +13,9 @@ pub fn iso_segment(
     seg: &Seg,
     gf: [f32; 3],
     gb: [f32; 3],
-    range: [f32; 2],
+    candidates: [f32; 2],
 ) -> [f32; 4] {
-    let [a, b] = iso_window(stage, seg.s_f, seg.s_b, range);
+    let [a, b] = iso_window(stage, seg.s_f, seg.s_b, candidates);
     let rising = seg.s_f <= seg.s_b;
     let blend = stage.params.mix == 1;
     let d = seg.s_b - seg.s_f;

@@ -18,7 +18,7 @@ pub fn iso_segment(
     seg: &Seg,
     gf: [f32; 3],
     gb: [f32; 3],
-    range: [f32; 2],
+    candidates: [f32; 2],
 ) -> [f32; 4] {
     let (tf, consts, rule) = vol.integral();
     let ok = !seg.s_f.is_nan() && !seg.s_b.is_nan();
@@ -36,17 +36,17 @@ pub fn iso_segment(
     };
     let (s_f, s_b) = (clamped(seg.s_f), clamped(seg.s_b));
     let rising = s_f <= s_b;
-    let (wlo, whi) = (s_f.min(s_b).max(range[0]), s_f.max(s_b).min(range[1]));
-    let count = stage.params.count;
+    let (lo, hi) = (s_f.min(s_b), s_f.max(s_b));
+    let (first, end) = (candidates[0] as u32, candidates[1] as u32);
     let value = |k: u32| stage.surfaces[k as usize].value[0];
-    let (mut k, mut more) = (0u32, false);
-    if count > 0 && whi >= value(0) && wlo <= value(count - 1) {
+    let (mut k, mut more) = (first, false);
+    if first < end {
         if rising {
-            k = count_at_most(stage, wlo);
-            more = k < count;
+            k = count_at_most(stage, lo, first, end);
+            more = k < end;
         } else {
-            k = count_at_most(stage, whi);
-            more = k > 0;
+            k = count_at_most(stage, hi, first, end);
+            more = k > first;
             k = k.max(1) - 1;
         }
     }
@@ -68,7 +68,7 @@ pub fn iso_segment(
         let mut xi = 2.0f32;
         if more {
             let v = value(k);
-            if v > wlo && v <= whi {
+            if v > lo && v <= hi {
                 xi = ((v - s_f) * inv).clamp(0.0, 1.0);
             }
         }
@@ -102,9 +102,9 @@ pub fn iso_segment(
             }
             if rising {
                 k += 1;
-                more = k < count;
+                more = k < end;
             } else {
-                more = k > 0;
+                more = k > first;
                 k = k.max(1) - 1;
             }
         } else {
@@ -241,7 +241,7 @@ mod tests {
                 };
                 let g = |rng: &mut Rng| [rng.range(-1.0, 1.0) as f32, rng.f64() as f32, 0.5];
                 let (gf, gb) = (g(&mut rng), g(&mut rng));
-                let range = [f32::NEG_INFINITY, f32::INFINITY];
+                let range = [0.0, twin.params.count as f32];
                 let walk = iso_segment(&twin, &vol, &seg, gf, gb, range);
                 let split_twin = IsoTwin::new(
                     &set,
@@ -306,7 +306,7 @@ mod tests {
                     l: rng.range(0.0, 2.0) as f32,
                     ok: true,
                 };
-                let range = [f32::NEG_INFINITY, f32::INFINITY];
+                let range = [0.0, twin.params.count as f32];
                 let got = iso_segment(&twin, &vol, &seg, [0.0; 3], [0.0; 3], range);
                 let (l, s_f, s_b) = (seg.l as f64, raw(seg.s_f), raw(seg.s_b));
                 let want = set.composite(l, s_f, s_b, [DVec3::Z; 2], DVec3::Z, |l, a, b| {

@@ -28,7 +28,6 @@ pub mod exact;
 pub mod exact_frag;
 pub mod integral;
 pub mod iso;
-pub mod iso_bins;
 pub mod iso_levels;
 pub mod iso_seams;
 pub mod iso_split;

@@ -32,8 +32,8 @@ use std::any::type_name_of_val as path;
 use super::exact::exptable::{self, ExpTable};
 use super::integral::{self, TfBuffer};
 use super::{
-    exact, exact_frag, iso, iso_bins, iso_split, iso_walk, piece_quad, preint, preint2d,
-    preint2d_cyl, preint3d, segment, segment_view, table_build,
+    exact, exact_frag, iso, iso_split, iso_walk, piece_quad, preint, preint2d, preint2d_cyl,
+    preint3d, segment, segment_view, table_build,
 };
 use crate::gpu::{common, layer};
 use crate::integrate::cylinder;
@@ -85,7 +85,7 @@ pub fn stage_twins() -> Vec<StageTwins> {
             integral::weights,
             TfBuffer::add_piece, TfBuffer::integrate_segment),
         twins!("iso.wgsl":
-            iso_bins::iso_bin, iso::count_at_most, iso::iso_window, iso::iso_light,
+            iso::count_at_most, iso::iso_window, iso::iso_light,
             iso::iso_surface, iso::iso_over, iso::iso_crosses, iso::fs_iso),
         twins!("iso_split.wgsl": iso_split::iso_segment),
         twins!("iso_walk.wgsl": iso_walk::iso_segment),
