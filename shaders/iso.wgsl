@@ -34,9 +34,10 @@ struct IsoParams {
 struct IsoSurface {
     // x: the normalised isovalue (increasing with the index).
     value: vec4<f32>,
-    // Straight colour and opacity of the front (rising) and back sides.
-    front: vec4<f32>,
-    back: vec4<f32>,
+    // Straight colour and opacity of the front (rising, 0) and back (1)
+    // sides (`front`, `back` in the Rust struct): indexed, so that a
+    // fragment loads only the side it sees.
+    sides: array<vec4<f32>, 2>,
 }
 
 @group(0) @binding(3) var<uniform> iso: IsoParams;
@@ -97,10 +98,7 @@ fn iso_light(g: vec3<f32>) -> f32 {
 // Premultiplied colour and opacity of surface k crossed rising or falling,
 // its opacity times w.
 fn iso_surface(k: u32, rising: bool, g: vec3<f32>, w: f32) -> vec4<f32> {
-    var c = surfaces[k].back;
-    if rising {
-        c = surfaces[k].front;
-    }
+    let c = surfaces[k].sides[select(1u, 0u, rising)];
     let a = clamp(c.w * w, 0.0, 1.0);
     return vec4<f32>(c.xyz * (iso_light(g) * a), a);
 }

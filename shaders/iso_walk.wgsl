@@ -28,26 +28,18 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, candidates: vec2<f32>) ->
     let s_b = select(0.0, clamp(seg.s_b, -MAX_SCALAR, MAX_SCALAR), ok);
     // The crossings, front to back: the values in (lo, hi] among the
     // part's candidates (the window of `iso_window`), ascending from the
-    // first above lo where the scalar rises, descending from the last at
-    // or below hi where it falls. One search finds the first; the walk
-    // steps from it.
+    // first above s_f (= lo) where the scalar rises, descending from the
+    // last at or below s_f (= hi) where it falls. One search at s_f finds
+    // the first (no branch on the direction: a SIMD group would run both
+    // sides' searches); the walk steps from it.
     let rising = s_f <= s_b;
     let lo = min(s_f, s_b);
     let hi = max(s_f, s_b);
     let first = u32(candidates.x);
     let end = u32(candidates.y);
-    var k = first;
-    var more = false;
-    if first < end {
-        if rising {
-            k = count_at_most(lo, first, end);
-            more = k < end;
-        } else {
-            k = count_at_most(hi, first, end);
-            more = k > first;
-            k = max(k, 1u) - 1u;
-        }
-    }
+    let c = count_at_most(s_f, first, end);
+    var k = select(max(c, 1u) - 1u, c, rising);
+    var more = select(c > first, c < end, rising);
     let blend = iso.mix == 1u;
     let d = s_b - s_f;
     var inv = 0.0;
@@ -109,13 +101,8 @@ fn iso_segment(seg: Seg, gf: vec3<f32>, gb: vec3<f32>, candidates: vec2<f32>) ->
                     break;
                 }
             }
-            if rising {
-                k++;
-                more = k < end;
-            } else {
-                more = k > first;
-                k = max(k, 1u) - 1u;
-            }
+            more = select(k > first, k + 1u < end, rising);
+            k = select(max(k, 1u) - 1u, k + 1u, rising);
         } else {
             n++;
             if n > sp.count {

@@ -202,7 +202,11 @@ pub struct IsoParams {
 pub struct IsoSurface {
     /// `x`: the normalised isovalue.
     pub value: [f32; 4],
+    /// Straight colour and opacity of the front side (the stage's
+    /// `sides[0]`: indexed there, so a fragment loads only the side it
+    /// sees).
     pub front: [f32; 4],
+    /// The back side (`sides[1]`).
     pub back: [f32; 4],
 }
 

@@ -39,17 +39,12 @@ pub fn iso_segment(
     let (lo, hi) = (s_f.min(s_b), s_f.max(s_b));
     let (first, end) = (candidates[0] as u32, candidates[1] as u32);
     let value = |k: u32| stage.surfaces[k as usize].value[0];
-    let (mut k, mut more) = (first, false);
-    if first < end {
-        if rising {
-            k = count_at_most(stage, lo, first, end);
-            more = k < end;
-        } else {
-            k = count_at_most(stage, hi, first, end);
-            more = k > first;
-            k = k.max(1) - 1;
-        }
-    }
+    let c = count_at_most(stage, s_f, first, end);
+    let (mut k, mut more) = if rising {
+        (c, c < end)
+    } else {
+        (c.max(1) - 1, c > first)
+    };
     let blend = stage.params.mix == 1;
     let d = s_b - s_f;
     let inv = if d != 0.0 { 1.0 / d } else { 0.0 };
@@ -100,13 +95,11 @@ pub fn iso_segment(
                     break;
                 }
             }
-            if rising {
-                k += 1;
-                more = k < end;
+            (k, more) = if rising {
+                (k + 1, k + 1 < end)
             } else {
-                more = k > first;
-                k = k.max(1) - 1;
-            }
+                (k.max(1) - 1, k > first)
+            };
         } else {
             n += 1;
             if n > sp.count {
