@@ -107,10 +107,10 @@ pub struct IsoVertex {
     pub candidates: [f32; 2],
 }
 
-/// How far the range of [`IsoVertex::candidates`] is widened beyond the part's scalars
-/// (normalised units, relative above 1): far above the `f32` rounding of a
-/// fragment's interpolated scalars, so that the bound never changes a
-/// fragment inside the triangle.
+/// How far the scalar range of [`IsoVertex::candidates`] is widened beyond
+/// the part's scalars (normalised units, relative above 1): far above the
+/// `f32` rounding of a fragment's interpolated scalars, so that the bound
+/// never changes a fragment inside the triangle.
 pub const RANGE_MARGIN: f64 = 1e-3;
 
 impl IsoVertex {

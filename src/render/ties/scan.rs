@@ -138,10 +138,7 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
             if depth {
                 return true;
             }
-            let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
-            let b1 = (c - p[0]).perp_dot(p[2] - p[0]) / area;
-            let b2 = (p[1] - p[0]).perp_dot(c - p[0]) / area;
-            let b = [1.0 - b1 - b2, b1, b2];
+            let b = centre_weights(p, (p[1] - p[0]).perp_dot(p[2] - p[0]), c);
             (0..2).any(|side| {
                 let s: f64 = (0..3).map(|k| b[k] * vals[k][side]).sum();
                 let margin = iso_shift + ISO_SLIVER_REL * s.abs();
@@ -237,9 +234,7 @@ fn iso_centre_near(part: &PartTriangles, t: &[u32; 3], p: [DVec2; 3], shift: f64
             if !in_grown_triangle(p, c) {
                 continue;
             }
-            let b1 = (c - p[0]).perp_dot(p[2] - p[0]) / area;
-            let b2 = (p[1] - p[0]).perp_dot(c - p[0]) / area;
-            let b = [1.0 - b1 - b2, b1, b2];
+            let b = centre_weights(p, area, c);
             for (s, q, margin) in &sides {
                 let w = [b[0] * q[0], b[1] * q[1], b[2] * q[2]];
                 let at = (w[0] * s[0] + w[1] * s[1] + w[2] * s[2]) / (w[0] + w[1] + w[2]);
@@ -252,6 +247,15 @@ fn iso_centre_near(part: &PartTriangles, t: &[u32; 3], p: [DVec2; 3], shift: f64
         }
     }
     false
+}
+
+/// The screen-space barycentric weights of centre `c` in the triangle at
+/// `p`, whose doubled signed area is `area`.
+#[inline]
+fn centre_weights(p: [DVec2; 3], area: f64, c: DVec2) -> [f64; 3] {
+    let b1 = (c - p[0]).perp_dot(p[2] - p[0]) / area;
+    let b2 = (p[1] - p[0]).perp_dot(c - p[0]) / area;
+    [1.0 - b1 - b2, b1, b2]
 }
 
 /// The distance from `s` to the nearest of the sorted `values`.
