@@ -125,11 +125,9 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
         // changes no decision.
         let depth = narrow_for_depth && matters(part.rate_bound) && matters((part.rate)());
         // Where only an isovalue matters: the centres whose exact scalars
-        // are within the shift (and the f32 stages' rounding) of one.
-        let vals = t.map(|i| {
-            let v = &part.proj.vertices[i as usize];
-            [v.s_front, v.s_back]
-        });
+        // (perspective-correct, as the GPU interpolates them) are within
+        // the shift (and the f32 stages' rounding) of one.
+        let sides = [0, 1].map(|side| side_corners(part, t, side));
         out.extend(near.iter().copied().filter(|&(i, j)| {
             let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
             if !in_grown_triangle(p, c) {
@@ -139,8 +137,8 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
                 return true;
             }
             let b = centre_weights(p, (p[1] - p[0]).perp_dot(p[2] - p[0]), c);
-            (0..2).any(|side| {
-                let s: f64 = (0..3).map(|k| b[k] * vals[k][side]).sum();
+            sides.iter().any(|(s, q)| {
+                let s = at_centre(b, s, q);
                 let margin = iso_shift + ISO_SLIVER_REL * s.abs();
                 // Not for NaN.
                 to_nearest(part.isovalues, s) <= margin
@@ -211,20 +209,9 @@ fn iso_centre_near(part: &PartTriangles, t: &[u32; 3], p: [DVec2; 3], shift: f64
     if (i1 - i0 + 1).max(0) * (j1 - j0 + 1).max(0) > ISO_STEEP_CENTRES {
         return true;
     }
-    let v = t.map(|i| &part.proj.vertices[i as usize]);
-    let ortho = part.proj.view.ortho;
-    // Per side: the corner scalars, their weights' factors q = 1/z (1
-    // orthographic) and the margin.
+    // Per side: the corner scalars, their weights' factors and the margin.
     let sides = [0, 1].map(|side| {
-        let s = v.map(|v| if side == 0 { v.s_front } else { v.s_back });
-        let q = v.map(|v| {
-            let z = if side == 0 { v.z_front } else { v.z_back };
-            if ortho || z.is_nan() || z <= 0.0 {
-                1.0
-            } else {
-                1.0 / z
-            }
-        });
+        let (s, q) = side_corners(part, t, side);
         let big = s[0].abs().max(s[1].abs()).max(s[2].abs());
         (s, q, shift + ISO_SLIVER_REL * big)
     });
@@ -236,9 +223,7 @@ fn iso_centre_near(part: &PartTriangles, t: &[u32; 3], p: [DVec2; 3], shift: f64
             }
             let b = centre_weights(p, area, c);
             for (s, q, margin) in &sides {
-                let w = [b[0] * q[0], b[1] * q[1], b[2] * q[2]];
-                let at = (w[0] * s[0] + w[1] * s[1] + w[2] * s[2]) / (w[0] + w[1] + w[2]);
-                let d = to_nearest(part.isovalues, at);
+                let d = to_nearest(part.isovalues, at_centre(b, s, q));
                 // NaN: as near.
                 if d.is_nan() || d <= *margin {
                     return true;
@@ -247,6 +232,34 @@ fn iso_centre_near(part: &PartTriangles, t: &[u32; 3], p: [DVec2; 3], shift: f64
         }
     }
     false
+}
+
+/// The entry (`side` 0) or exit (1) scalars at the corners of the exact
+/// triangle `t`, with the factors `q = 1/z` of their screen-space weights
+/// (1 orthographic, and where a depth is not a positive number, which has
+/// no perspective weight).
+fn side_corners(part: &PartTriangles, t: &[u32; 3], side: usize) -> ([f64; 3], [f64; 3]) {
+    let v = t.map(|i| &part.proj.vertices[i as usize]);
+    let ortho = part.proj.view.ortho;
+    let s = v.map(|v| if side == 0 { v.s_front } else { v.s_back });
+    let q = v.map(|v| {
+        let z = if side == 0 { v.z_front } else { v.z_back };
+        if ortho || z.is_nan() || z <= 0.0 {
+            1.0
+        } else {
+            1.0 / z
+        }
+    });
+    (s, q)
+}
+
+/// The scalar at a centre with screen-space weights `b` in a triangle with
+/// corner scalars `s` and weight factors `q` ([`side_corners`]):
+/// perspective-correct, as the GPU interpolates it.
+#[inline]
+fn at_centre(b: [f64; 3], s: &[f64; 3], q: &[f64; 3]) -> f64 {
+    let w = [b[0] * q[0], b[1] * q[1], b[2] * q[2]];
+    (w[0] * s[0] + w[1] * s[1] + w[2] * s[2]) / (w[0] + w[1] + w[2])
 }
 
 /// The screen-space barycentric weights of centre `c` in the triangle at

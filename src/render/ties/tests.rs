@@ -440,6 +440,68 @@ fn a_sliver_holding_an_isovalue_has_its_centres_decided() {
     assert!(scan(&[0.9]).is_empty());
 }
 
+/// A long sliver in perspective, its ends at depths 1 and 100: the GPU
+/// interpolates the scalar at a centre perspective-correctly, so the
+/// centres whose scalars come near an isovalue lie far from where an
+/// affine interpolation along the sliver puts them. With the snap's
+/// largest shift (0.14 of the scalar here, across a sliver 0.02 px wide)
+/// the centres within it of the value are decided exactly, and only they.
+#[test]
+fn a_sliver_in_perspective_weighs_its_centres_perspective_correctly() {
+    let mut proj = Projected::default();
+    proj.view.ortho = false;
+    let v = |x: f64, y: f64, s: f64, z: f64| RegionVertex {
+        px: x,
+        py: y,
+        z_front: z,
+        z_back: z,
+        l: 1e-6,
+        s_front: s,
+        s_back: s,
+        ..Default::default()
+    };
+    // The scalar along the sliver (screen fraction u at x = 0.5 + 20 u),
+    // exact and affine; the third corner is on the exact line.
+    let persp = |u: f64| (u / 100.0) / ((1.0 - u) + u / 100.0);
+    let z_at = |u: f64| 1.0 / ((1.0 - u) + u / 100.0);
+    proj.vertices.push(v(0.5, 1.49, 0.0, 1.0));
+    proj.vertices.push(v(20.5, 1.49, 1.0, 100.0));
+    proj.vertices.push(v(10.5, 1.51, persp(0.5), z_at(0.5)));
+    proj.triangles.push([0, 1, 2]);
+    let rate = || 0.0;
+    let scan = |isovalues: &[f64]| {
+        let part = PartTriangles {
+            proj: &proj,
+            drawn: &[],
+            exact: &proj.triangles,
+            width: 24,
+            height: 4,
+            rate: &rate,
+            rate_bound: 0.0,
+            l_range: (1e-6, 1e-6),
+            snap: &[],
+            weighed: false,
+            clipped: false,
+            isovalues,
+        };
+        let mut scratch = TieScratch::default();
+        scan_triangles(&part, true, &mut scratch);
+        scratch.forced
+    };
+    let columns = |forced: Vec<(u32, u32)>| -> Vec<u32> {
+        assert!(forced.iter().all(|&(_, j)| j == 1), "{forced:?}");
+        forced.into_iter().map(|(i, _)| i).collect()
+    };
+    // The grown sliver holds the centres (i + 0.5, 1.5) for i in 4..=16.
+    // The value at centre (10.5, 1.5), u = 1/2, is 1/101 (affine 1/2).
+    // Within 0.14 of it: the centres up to u = 0.946 (x = 19.4), so all of
+    // them; affine, those up to x = 3.5 only, so none.
+    assert_eq!(columns(scan(&[persp(0.5)])), (4..=16).collect::<Vec<u32>>());
+    // 0.7: within 0.14 of it only beyond x = 20.3, so none; affine from
+    // x = 11.7 to 17.3 (12 to 16).
+    assert_eq!(columns(scan(&[0.7])), Vec::<u32>::new());
+}
+
 /// A tet in general position has its outline at zero thickness
 /// ([`Projected::outline_profile`]); the thickness at positions near the
 /// outline, by the exact test, is within the gradient bound
