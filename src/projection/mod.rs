@@ -189,6 +189,15 @@ pub(crate) enum VertexKind {
     Crossing { front: [u32; 2], back: [u32; 2] },
 }
 
+/// A seam given by its end points (pixel positions): the centres within
+/// `band` pixels of it are decided on the exact geometry
+/// ([`Projected::seam_lines`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SeamLine {
+    pub ends: [DVec2; 2],
+    pub band: f64,
+}
+
 /// A boundary triangle as seen on screen: pixel positions of its corners
 /// with their depths and scalars.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -439,10 +448,10 @@ pub struct Projected {
     /// outline ([`crate::render::ties`]). Set by the mode, empty otherwise.
     pub seams: Vec<(u32, u32)>,
     /// Seams given by their end points (pixel positions) rather than by
-    /// vertices: the isosurface modes' lines where a boundary triangle's
-    /// scalar equals an isovalue (`render::modes::iso`). Decided as
-    /// [`Projected::seams`].
-    pub seam_lines: Vec<[DVec2; 2]>,
+    /// vertices, each with its own band: the isosurface modes' lines where
+    /// a boundary triangle's scalar equals an isovalue
+    /// (`render::modes::iso_seams`). Decided as [`Projected::seams`].
+    pub seam_lines: Vec<SeamLine>,
     /// For the values of tie decisions ([`crate::render::ties`], no
     /// regions): the piece's boundary triangles (indices into
     /// [`Polyhedron::triangles`]) where each vertex's ray enters and leaves.

@@ -54,6 +54,14 @@ pub trait ProjectedMode: Sync {
         &[]
     }
 
+    /// The scalar of `src` that the stage finding
+    /// [`ProjectedMode::fragment_isovalues`] maps to 0: its rounding is
+    /// relative to the distance from it
+    /// ([`super::ties::PartTriangles::iso_origin`]).
+    fn fragment_iso_origin(&self, _src: &PieceSource) -> f64 {
+        0.0
+    }
+
     /// Whether the mode draws the volume (only `--mode iso` does not).
     fn draws_volume(&self) -> bool {
         true

@@ -355,6 +355,7 @@ fn draw_part<M: ProjectedMode>(
         weighed: src.colour_draw && src.iso.is_none() && mode.fragment_isovalues().is_empty(),
         clipped: !std::ptr::eq(projected, part),
         isovalues: mode.fragment_isovalues(),
+        iso_origin: mode.fragment_iso_origin(src),
     };
     // Steep triangles (`snap_is_steep`) take the exact triangle's values
     // at their snapped corners; the others share the exact corners'. The

@@ -650,6 +650,10 @@ impl ProjectedMode for IsoMode {
         &self.set.values
     }
 
+    fn fragment_iso_origin(&self, src: &PieceSource) -> f64 {
+        ScalarMap::of(src.tf).offset
+    }
+
     fn draws_volume(&self) -> bool {
         !matches!(self.volume, Volume::None)
     }
@@ -720,6 +724,7 @@ impl ProjectedMode for IsoMode {
                 face,
                 &self.set.values,
                 payload.seg.ortho,
+                payload.seg.map.offset,
                 &mut proj.seam_lines,
             );
         }

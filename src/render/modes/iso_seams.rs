@@ -14,7 +14,8 @@
 
 use glam::DVec2;
 
-use crate::projection::FaceTri;
+use crate::projection::{FaceTri, SeamLine};
+use crate::render::ties::{iso_margin, TIE_BAND_PX};
 
 /// Appends to `out` the lines where the scalar of the boundary triangle
 /// `face` equals one of `values` (sorted): the segment between the two
@@ -24,13 +25,47 @@ use crate::projection::FaceTri;
 /// `s`). A value the triangle's scalars do not strictly bracket has no such
 /// line: a face at the value everywhere is not crossed there, and a line
 /// through a corner alone meets the other pieces' outline there.
-pub fn iso_lines(face: &FaceTri, values: &[f64], ortho: bool, out: &mut Vec<[DVec2; 2]>) {
+///
+/// Each line's band ([`SeamLine::band`]) is [`TIE_BAND_PX`] grown by the
+/// distance over which the face's scalar changes by the `f32` stage's
+/// margin ([`iso_margin`] with `origin`, the scalar the stage maps to 0):
+/// on either side of the line, within that distance, the stage's level
+/// and its rounding can put a centre on the other side of the value in
+/// one piece than in the piece sharing the face (or than the ray caster,
+/// on the mesh's boundary). The distance is the margin over the scalar's
+/// least screen gradient on the face (in perspective, `|grad(s/z) - V
+/// grad(1/z)|` over the largest `1/z`), at most the face's extent.
+pub fn iso_lines(
+    face: &FaceTri,
+    values: &[f64],
+    ortho: bool,
+    origin: f64,
+    out: &mut Vec<SeamLine>,
+) {
     let (lo, hi) = crate::render::pieces::value_range(face.s.iter().copied());
     // Also for NaN (no range).
     if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
         return;
     }
     let first = values.partition_point(|&v| v <= lo);
+    if values.get(first).is_none_or(|&v| v >= hi) {
+        return;
+    }
+    let margin = iso_margin(origin, lo, hi);
+    let extent = {
+        let p = &face.p;
+        let (a, b) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+        (b - a).length()
+    };
+    // The screen gradients of `s` (orthographic), or of `s / z` and `1 / z`.
+    let q = if ortho {
+        [1.0; 3]
+    } else {
+        face.z.map(|z| 1.0 / z)
+    };
+    let grad_a = affine_gradient(face.p, [0, 1, 2].map(|k| face.s[k] * q[k]));
+    let grad_q = affine_gradient(face.p, q);
+    let q_max = q[0].abs().max(q[1].abs()).max(q[2].abs());
     for &v in &values[first..] {
         if v >= hi {
             break;
@@ -62,9 +97,32 @@ pub fn iso_lines(face: &FaceTri, values: &[f64], ortho: bool, out: &mut Vec<[DVe
             }
         }
         if n == 2 {
-            out.push(ends);
+            // The least gradient along the line; a face seen edge-on has
+            // none finite (no centre lies inside it): the plain band.
+            let grad = (grad_a - grad_q * v).length() / q_max;
+            let reach = if grad.is_infinite() {
+                0.0
+            } else if grad > 0.0 {
+                (margin / grad).min(extent)
+            } else {
+                // Zero or NaN: the whole face.
+                extent
+            };
+            out.push(SeamLine {
+                ends,
+                band: TIE_BAND_PX + reach,
+            });
         }
     }
+}
+
+/// The screen gradient of the function that is affine on the triangle at
+/// pixel positions `p` with values `f` at its corners (infinite or NaN for
+/// a triangle of no area).
+fn affine_gradient(p: [DVec2; 3], f: [f64; 3]) -> DVec2 {
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let (d1, d2) = (f[1] - f[0], f[2] - f[0]);
+    DVec2::new(d1 * e2.y - d2 * e1.y, d2 * e1.x - d1 * e2.x) / e1.perp_dot(e2)
 }
 
 #[cfg(test)]
@@ -89,10 +147,10 @@ mod iso_line_tests {
             [0.0, 4.0, 0.0],
         );
         let mut out = Vec::new();
-        iso_lines(&f, &[-1.0, 1.0, 3.0, 4.0, 9.0], true, &mut out);
+        iso_lines(&f, &[-1.0, 1.0, 3.0, 4.0, 9.0], true, 0.0, &mut out);
         assert_eq!(out.len(), 2, "{out:?}");
         for (line, x) in out.iter().zip([1.0, 3.0]) {
-            let mut ends = line.map(|e| [e.x, e.y]);
+            let mut ends = line.ends.map(|e| [e.x, e.y]);
             ends.sort_by(|a, b| a[1].total_cmp(&b[1]));
             assert!((ends[0][0] - x).abs() < 1e-12 && ends[0][1].abs() < 1e-12);
             assert!((ends[1][0] - x).abs() < 1e-12 && (ends[1][1] - (4.0 - x)).abs() < 1e-12);
@@ -101,19 +159,70 @@ mod iso_line_tests {
         // the value everywhere, have no line; a value at a corner between
         // the others runs from that corner.
         out.clear();
-        iso_lines(&f, &[0.0], true, &mut out);
+        iso_lines(&f, &[0.0], true, 0.0, &mut out);
         let flat = face([[0.0, 0.0], [4.0, 0.0], [0.0, 4.0]], [1.0; 3], [2.0; 3]);
-        iso_lines(&flat, &[2.0], true, &mut out);
+        iso_lines(&flat, &[2.0], true, 0.0, &mut out);
         assert!(out.is_empty());
         let g = face(
             [[0.0, 0.0], [4.0, 0.0], [0.0, 4.0]],
             [1.0; 3],
             [1.0, 0.0, 2.0],
         );
-        iso_lines(&g, &[1.0], true, &mut out);
+        iso_lines(&g, &[1.0], true, 0.0, &mut out);
         assert_eq!(out.len(), 1);
-        assert!(out[0].contains(&DVec2::ZERO));
-        assert!(out[0].contains(&DVec2::new(2.0, 2.0)));
+        assert!(out[0].ends.contains(&DVec2::ZERO));
+        assert!(out[0].ends.contains(&DVec2::new(2.0, 2.0)));
+    }
+
+    #[test]
+    fn the_band_covers_the_stage_margin_over_the_gradient() {
+        use crate::numeric::tolerance::ISO_SLIVER_REL;
+        use crate::render::ties::TIE_BAND_PX;
+        // s = x / 100 on the triangle (0,0), (400,0), (0,400): a gradient
+        // of 0.01 per pixel, the line x = 100 for the value 1.
+        let f = face(
+            [[0.0, 0.0], [400.0, 0.0], [0.0, 400.0]],
+            [1.0; 3],
+            [0.0, 4.0, 0.0],
+        );
+        let band = |origin: f64, ortho: bool| {
+            let mut out = Vec::new();
+            iso_lines(&f, &[1.0], ortho, origin, &mut out);
+            assert_eq!(out.len(), 1);
+            out[0].band
+        };
+        // Origin 0: the margin is 1e-5 of the farthest corner (4), 4e-5,
+        // over 0.01 per pixel.
+        let near = TIE_BAND_PX + ISO_SLIVER_REL * 4.0 / 0.01;
+        assert!(
+            (band(0.0, true) - near).abs() < 1e-12,
+            "{}",
+            band(0.0, true)
+        );
+        // At equal depths perspective is the same.
+        assert!((band(0.0, false) - near).abs() < 1e-12);
+        // Origin -1000: 1e-5 of 1004 over 0.01 is about one pixel.
+        let far = TIE_BAND_PX + ISO_SLIVER_REL * 1004.0 / 0.01;
+        assert!((band(-1000.0, true) - far).abs() < 1e-9);
+        // An origin far enough to reach past the face: its extent.
+        let whole = TIE_BAND_PX + 400.0 * std::f64::consts::SQRT_2;
+        assert!((band(-1e9, true) - whole).abs() < 1e-9);
+        // In perspective the scalar's screen gradient on the line is
+        // `|grad(s/z) - V grad(1/z)| / (1/z)`, least where `1/z` is
+        // largest: the band takes that.
+        let g = face(
+            [[0.0, 0.0], [400.0, 0.0], [0.0, 400.0]],
+            [1.0, 2.0, 2.0],
+            [0.0, 4.0, 0.0],
+        );
+        let mut out = Vec::new();
+        iso_lines(&g, &[1.0], false, 0.0, &mut out);
+        // s/z and 1/z affine: corners (0, 2, 0) and (1, 1/2, 1/2); on the
+        // line s = 1, grad(s/z) - grad(1/z) = (1/200, 0) - (-1/800, -1/800)
+        // = (1/160, 1/800), over the largest 1/z (1).
+        let grad = (1.0f64 / 160.0).hypot(1.0 / 800.0);
+        let expected = TIE_BAND_PX + ISO_SLIVER_REL * 4.0 / grad;
+        assert!((out[0].band - expected).abs() < 1e-12, "{out:?}");
     }
 
     #[test]
@@ -130,16 +239,18 @@ mod iso_line_tests {
             [0.0, 1.0, 0.0],
         );
         let mut out = Vec::new();
-        iso_lines(&f, &[0.5], false, &mut out);
+        iso_lines(&f, &[0.5], false, 0.0, &mut out);
         assert_eq!(out.len(), 1);
         assert!(
             out[0]
+                .ends
                 .iter()
                 .any(|e| (*e - DVec2::new(6.0, 0.0)).length() < 1e-12),
             "{out:?}"
         );
         assert!(
             out[0]
+                .ends
                 .iter()
                 .any(|e| (*e - DVec2::new(6.0, 2.0)).length() < 1e-12),
             "{out:?}"

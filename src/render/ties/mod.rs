@@ -57,6 +57,11 @@
 //!   isosurface modes, whose two pieces on either side of the face
 //!   interpolate its scalar on different snapped triangles), where a
 //!   centre must go to the same side in every part that shares the edge;
+//!   a line's band grows by the distance over which the face's scalar
+//!   changes by the `f32` stage's margin ([`iso_margin`]: its level below
+//!   the value and its rounding, relative to the distance from the
+//!   transfer function's first node), which can be far wider than the
+//!   snap's where the field is gentle;
 //! - inside **slivers**, exact triangles narrower than [`SLIVER_TIE_PX`]:
 //!   the snap of their corners shifts the interpolated values by their
 //!   screen gradient times the snap, which across a sliver is a large part
@@ -100,13 +105,13 @@ mod scan;
 
 use glam::{DVec2, DVec3};
 
-use band::{inside_by_float, near_centres, near_edge};
+use band::{centres_within, inside_by_float, near_centres, near_edge};
 pub use scan::scan_triangles;
 
 use crate::camera::Camera;
 use crate::gpu::{GpuVertex, SUBPIXEL};
 use crate::numeric::tolerance::{
-    PLUCKER_FILTER_K, RASTER_FILTER_MAX_COORD_PX, RASTER_FILTER_PX, THIN_OUTLINE_PX,
+    ISO_SLIVER_REL, PLUCKER_FILTER_K, RASTER_FILTER_MAX_COORD_PX, RASTER_FILTER_PX, THIN_OUTLINE_PX,
 };
 use crate::projection::coverage::PixelGrid;
 use crate::projection::{Polyhedron, Projected, RegionVertex};
@@ -537,6 +542,31 @@ pub struct PartTriangles<'a> {
     /// side of an isovalue than the piece beside it puts it; those centres
     /// are decided exactly too.
     pub isovalues: &'a [f64],
+    /// The scalar the mode's `f32` stage maps to 0 (the transfer
+    /// function's first node, [`crate::render::modes::segment::ScalarMap`]):
+    /// the stage's rounding, and the margin of its levels below the
+    /// isovalues ([`crate::numeric::tolerance::ISO_LEVEL_F32`]), are
+    /// relative to a scalar's distance from it, not to the scalar itself
+    /// ([`iso_margin`]).
+    pub iso_origin: f64,
+}
+
+/// How close (raw scalar) an entry or exit scalar of the `f32` isosurface
+/// stages in `[lo, hi]` may come to an isovalue and still be read on the
+/// other side of it than the exact scalar lies, beyond what the snap of
+/// the corners does: the stage compares the normalised scalar with a level
+/// [`crate::numeric::tolerance::ISO_LEVEL_F32`] of the normalised value
+/// below it, and rounds the interpolated scalar to a few ulps of the
+/// largest normalised corner scalar; both are relative to the distance
+/// from `origin` ([`PartTriangles::iso_origin`]), and [`ISO_SLIVER_REL`]
+/// of the farther of `lo` and `hi` holds them. In raw terms this is large
+/// where the isovalue lies far from the transfer function's first node
+/// against the field's change near it: a field from -1000 to 1000 with
+/// the surface at 0 where it changes by 4e-3 per pixel has the stage's
+/// level a quarter of a pixel from the value, and its rounding a tenth.
+#[inline]
+pub fn iso_margin(origin: f64, lo: f64, hi: f64) -> f64 {
+    ISO_SLIVER_REL * (lo - origin).abs().max((hi - origin).abs())
 }
 
 impl PartTriangles<'_> {
@@ -580,8 +610,13 @@ pub fn decide_ties(
     for &(ia, ib) in &part.proj.seams {
         near_centres(pos(ia), pos(ib), part.width, part.height, forced);
     }
-    for &[a, b] in &part.proj.seam_lines {
-        near_centres(a, b, part.width, part.height, forced);
+    for line in &part.proj.seam_lines {
+        let [a, b] = line.ends;
+        if line.band <= TIE_BAND_PX {
+            near_centres(a, b, part.width, part.height, forced);
+        } else {
+            centres_within(a, b, line.band, part.width, part.height, forced);
+        }
     }
     centres.extend_from_slice(forced);
     if centres.is_empty() {

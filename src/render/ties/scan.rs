@@ -10,10 +10,9 @@ use glam::DVec2;
 
 use super::band::{centres_within, in_grown_triangle};
 use super::{
-    snap_is_steep_at, PartTriangles, TieScratch, SLIVER_DEPTH_TOL, SLIVER_TIE_PX, SNAP_PX,
-    TIE_BAND_PX,
+    iso_margin, snap_is_steep_at, PartTriangles, TieScratch, SLIVER_DEPTH_TOL, SLIVER_TIE_PX,
+    SNAP_PX, TIE_BAND_PX,
 };
-use crate::numeric::tolerance::ISO_SLIVER_REL;
 
 /// One pass over the part's exact triangles for what the snap of their
 /// corners can do: marks the [`snap_is_steep`] ones (`scratch.steep[k]`
@@ -83,7 +82,7 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
             steep[n] = (snap_is_steep_at(area2, long, l, part.rate_bound)
                 && snap_is_steep_at(area2, long, l, (part.rate)()))
                 || (!part.isovalues.is_empty()
-                    && isovalue_shift(part, t, part.snap_of(t), area2 / long, ISO_SLIVER_REL)
+                    && isovalue_shift(part, t, part.snap_of(t), area2 / long, true)
                         .is_some_and(|shift| iso_centre_near(part, t, p, shift)));
             continue;
         }
@@ -100,7 +99,7 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
         let iso_shift = if part.isovalues.is_empty() {
             0.0
         } else {
-            isovalue_shift(part, t, snap, w, 0.0).unwrap_or(0.0)
+            isovalue_shift(part, t, snap, w, false).unwrap_or(0.0)
         };
         let narrow_for_depth = w < reach.min(SLIVER_TIE_PX);
         // False for NaN too.
@@ -139,7 +138,7 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
             let b = centre_weights(p, (p[1] - p[0]).perp_dot(p[2] - p[0]), c);
             sides.iter().any(|(s, q)| {
                 let s = at_centre(b, s, q);
-                let margin = iso_shift + ISO_SLIVER_REL * s.abs();
+                let margin = iso_shift + iso_margin(part.iso_origin, s, s);
                 // Not for NaN.
                 to_nearest(part.isovalues, s) <= margin
             })
@@ -150,15 +149,26 @@ pub fn scan_triangles(part: &PartTriangles, slivers: bool, scratch: &mut TieScra
 /// The snap's largest shift of the entry or exit scalars of the exact
 /// triangle `t` (width `w` pixels, corners moved by at most `snap`: of
 /// their spread, `snap` over the width) where their range, grown by that
-/// shift and by `rel` of their size, holds one of `part.isovalues`;
-/// `None` where neither does (or a value is NaN). The slivers' rule and
-/// the wide triangles' steep rule in [`scan_triangles`].
-fn isovalue_shift(part: &PartTriangles, t: &[u32; 3], snap: f64, w: f64, rel: f64) -> Option<f64> {
+/// shift (and with `rounding` by the stage's [`iso_margin`]), holds one
+/// of `part.isovalues`; `None` where neither does (or a value is NaN).
+/// The slivers' rule and the wide triangles' steep rule in
+/// [`scan_triangles`].
+fn isovalue_shift(
+    part: &PartTriangles,
+    t: &[u32; 3],
+    snap: f64,
+    w: f64,
+    rounding: bool,
+) -> Option<f64> {
     let v = t.map(|i| &part.proj.vertices[i as usize]);
     let side = |s: [f64; 3]| {
         let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
         let shift = (hi - lo) * snap / w;
-        let grow = shift + rel * lo.abs().max(hi.abs());
+        let grow = if rounding {
+            shift + iso_margin(part.iso_origin, lo, hi)
+        } else {
+            shift
+        };
         let k = part.isovalues.partition_point(|&x| x < lo - grow);
         // False for NaN too.
         part.isovalues
@@ -179,8 +189,8 @@ const ISO_STEEP_CENTRES: i64 = 64;
 
 /// Whether a pixel centre in the wide exact triangle `t` at `p` (grown by
 /// [`TIE_BAND_PX`]) has an exact entry or exit scalar within `shift` (the
-/// snap's, from [`isovalue_shift`]) and [`ISO_SLIVER_REL`] of the corner
-/// scalars (the `f32` stage's rounding) of one of `part.isovalues`: only
+/// snap's, from [`isovalue_shift`]) and the stage's [`iso_margin`] of the
+/// corner scalars of one of `part.isovalues`: only
 /// such a centre can fall on the other side of a value than the exact
 /// triangle puts it, so only then is the triangle drawn steep (with a
 /// dense set of isovalues nearly every triangle holds one, but a value's
@@ -212,8 +222,8 @@ fn iso_centre_near(part: &PartTriangles, t: &[u32; 3], p: [DVec2; 3], shift: f64
     // Per side: the corner scalars, their weights' factors and the margin.
     let sides = [0, 1].map(|side| {
         let (s, q) = side_corners(part, t, side);
-        let big = s[0].abs().max(s[1].abs()).max(s[2].abs());
-        (s, q, shift + ISO_SLIVER_REL * big)
+        let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
+        (s, q, shift + iso_margin(part.iso_origin, lo, hi))
     });
     for j in j0..=j1 {
         for i in i0..=i1 {

@@ -334,6 +334,7 @@ fn one_pass_finds_the_steep_triangles_and_the_sliver_centres() {
             weighed: false,
             clipped: false,
             isovalues: &[],
+            iso_origin: 0.0,
         };
         let slivers = rng.below(2) == 0;
         let mut scratch = TieScratch::default();
@@ -430,6 +431,7 @@ fn a_sliver_holding_an_isovalue_has_its_centres_decided() {
             weighed: false,
             clipped: false,
             isovalues,
+            iso_origin: 0.0,
         };
         let mut scratch = TieScratch::default();
         scan_triangles(&part, true, &mut scratch);
@@ -483,6 +485,7 @@ fn a_sliver_in_perspective_weighs_its_centres_perspective_correctly() {
             weighed: false,
             clipped: false,
             isovalues,
+            iso_origin: 0.0,
         };
         let mut scratch = TieScratch::default();
         scan_triangles(&part, true, &mut scratch);
@@ -593,6 +596,7 @@ fn thin_outlines_are_left_to_the_rasteriser_only_where_the_bound_holds() {
                 weighed,
                 clipped,
                 isovalues: &[],
+                iso_origin: 0.0,
             })
         };
         let thin = 0.9 * SLIVER_DEPTH_TOL / (g * THIN_OUTLINE_PX);
