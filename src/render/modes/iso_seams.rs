@@ -22,19 +22,23 @@ use crate::render::ties::{iso_margin, TIE_BAND_PX};
 /// points of its edges where the field, linear on the triangle in space,
 /// takes the value, at their pixel positions (in perspective the pixel
 /// position divides the edge in the ratio of the points' `s / z`, not of
-/// `s`). A value the triangle's scalars do not strictly bracket has no such
-/// line: a face at the value everywhere is not crossed there, and a line
-/// through a corner alone meets the other pieces' outline there.
+/// `s`), each with a band ([`SeamLine::band`]) holding the centres the
+/// pieces sharing the face must decide exactly.
 ///
-/// Each line's band ([`SeamLine::band`]) is [`TIE_BAND_PX`] grown by the
-/// distance over which the face's scalar changes by the `f32` stage's
-/// margin ([`iso_margin`] with `origin`, the scalar the stage maps to 0):
-/// on either side of the line, within that distance, the stage's level
-/// and its rounding can put a centre on the other side of the value in
-/// one piece than in the piece sharing the face (or than the ray caster,
-/// on the mesh's boundary). The distance is the margin over the scalar's
-/// least screen gradient on the face (in perspective, `|grad(s/z) - V
-/// grad(1/z)|` over the largest `1/z`), at most the face's extent.
+/// Within the `f32` stage's margin of a value ([`iso_margin`] with
+/// `origin`, the scalar the stage maps to 0), the stage's level and its
+/// rounding can put a centre on the other side of the value in one piece
+/// than in the piece sharing the face (or than the ray caster, on the
+/// mesh's boundary). So the line runs where the face's scalar is the
+/// middle of its part of that margin, `[V - m, V + m]` within the range of
+/// its corners (`V` itself for a value well inside the range; next to a
+/// corner or an edge for a value at or just beyond it), and its band is
+/// [`TIE_BAND_PX`] grown by the distance over which the scalar changes by
+/// half that part: the part over the scalar's least screen gradient on
+/// the face (in perspective, `|grad(s/z) - v grad(1/z)|` over the largest
+/// `1/z`), at most the face's extent. A face at one value everywhere has
+/// no line (the stage's level below the value keeps it uncrossed on both
+/// sides).
 pub fn iso_lines(
     face: &FaceTri,
     values: &[f64],
@@ -47,11 +51,11 @@ pub fn iso_lines(
     if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
         return;
     }
-    let first = values.partition_point(|&v| v <= lo);
-    if values.get(first).is_none_or(|&v| v >= hi) {
+    let margin = iso_margin(origin, lo, hi);
+    let first = values.partition_point(|&v| v <= lo - margin);
+    if values.get(first).is_none_or(|&v| v >= hi + margin) {
         return;
     }
-    let margin = iso_margin(origin, lo, hi);
     let extent = {
         let p = &face.p;
         let (a, b) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
@@ -66,10 +70,22 @@ pub fn iso_lines(
     let grad_a = affine_gradient(face.p, [0, 1, 2].map(|k| face.s[k] * q[k]));
     let grad_q = affine_gradient(face.p, q);
     let q_max = q[0].abs().max(q[1].abs()).max(q[2].abs());
-    for &v in &values[first..] {
-        if v >= hi {
+    for &value in &values[first..] {
+        if value >= hi + margin {
             break;
         }
+        // The face's scalars within the margin of the value, `[a, b]`:
+        // the line at their middle, `v`, strictly inside the face's range,
+        // and the band holding them.
+        let (a, b) = ((value - margin).max(lo), (value + margin).min(hi));
+        if a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
+            continue;
+        }
+        let v = if a > lo && b < hi {
+            value
+        } else {
+            0.5 * (a + b)
+        };
         let mut ends = [DVec2::ZERO; 2];
         let mut n = 0;
         for k in 0..3 {
@@ -103,7 +119,7 @@ pub fn iso_lines(
             let reach = if grad.is_infinite() {
                 0.0
             } else if grad > 0.0 {
-                (margin / grad).min(extent)
+                (0.5 * (b - a) / grad).min(extent)
             } else {
                 // Zero or NaN: the whole face.
                 extent
@@ -148,18 +164,30 @@ mod iso_line_tests {
         );
         let mut out = Vec::new();
         iso_lines(&f, &[-1.0, 1.0, 3.0, 4.0, 9.0], true, 0.0, &mut out);
-        assert_eq!(out.len(), 2, "{out:?}");
+        // (4 is at the corner (4, 0): a line within the margin next to it.)
+        assert_eq!(out.len(), 3, "{out:?}");
+        assert!(out[2]
+            .ends
+            .iter()
+            .all(|e| (*e - DVec2::new(4.0, 0.0)).length() < 1e-4));
         for (line, x) in out.iter().zip([1.0, 3.0]) {
             let mut ends = line.ends.map(|e| [e.x, e.y]);
             ends.sort_by(|a, b| a[1].total_cmp(&b[1]));
             assert!((ends[0][0] - x).abs() < 1e-12 && ends[0][1].abs() < 1e-12);
             assert!((ends[1][0] - x).abs() < 1e-12 && (ends[1][1] - (4.0 - x)).abs() < 1e-12);
         }
-        // A value at a corner with the others on one side, and a face at
-        // the value everywhere, have no line; a value at a corner between
-        // the others runs from that corner.
+        // A value at an edge with the other corner on one side has a line
+        // next to the edge, within the margin (1e-5 of 4 here) of it, whose
+        // band holds that margin; a face at the value everywhere has none;
+        // a value at a corner between the others runs from that corner.
         out.clear();
         iso_lines(&f, &[0.0], true, 0.0, &mut out);
+        assert_eq!(out.len(), 1);
+        let m = crate::numeric::tolerance::ISO_SLIVER_REL * 4.0;
+        assert!(out[0].ends.iter().all(|e| (e.x - m / 2.0).abs() < 1e-12));
+        let band = crate::render::ties::TIE_BAND_PX + m / 2.0;
+        assert!((out[0].band - band).abs() < 1e-12, "{out:?}");
+        out.clear();
         let flat = face([[0.0, 0.0], [4.0, 0.0], [0.0, 4.0]], [1.0; 3], [2.0; 3]);
         iso_lines(&flat, &[2.0], true, 0.0, &mut out);
         assert!(out.is_empty());
@@ -204,8 +232,9 @@ mod iso_line_tests {
         // Origin -1000: 1e-5 of 1004 over 0.01 is about one pixel.
         let far = TIE_BAND_PX + ISO_SLIVER_REL * 1004.0 / 0.01;
         assert!((band(-1000.0, true) - far).abs() < 1e-9);
-        // An origin far enough to reach past the face: its extent.
-        let whole = TIE_BAND_PX + 400.0 * std::f64::consts::SQRT_2;
+        // An origin so far that the margin holds the face's whole range:
+        // the line at its middle (x = 200), the band to both ends.
+        let whole = TIE_BAND_PX + 200.0;
         assert!((band(-1e9, true) - whole).abs() < 1e-9);
         // In perspective the scalar's screen gradient on the line is
         // `|grad(s/z) - V grad(1/z)| / (1/z)`, least where `1/z` is
