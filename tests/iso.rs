@@ -527,6 +527,63 @@ fn a_surface_far_from_the_first_node_where_the_field_is_gentle() {
     }
 }
 
+/// Surfaces close together where a field of a wide range changes slowly:
+/// `f = 24.6 + 7350 u^5 + u + 0.1 y` (`u = 2x - 1 + 0.2 (y - 1/2)`) spans
+/// about -7,300 to 7,400, and the values 24.55, 24.555 and 24.56 lie where
+/// it changes by about 5e-3 per pixel. Normalised from the transfer
+/// function's first node, the `f32` stages put their levels 7e-3 below
+/// each value (`ISO_LEVEL_F32` of 7,350): more than the values' spacing
+/// and a pixel and a half; centred on the values
+/// (`ScalarMap::centred`) every pixel matches. Translucent, surfaces
+/// alone and mixed with the volume (exact-frag), both projections.
+#[test]
+fn close_surfaces_far_from_the_first_node_are_resolved() {
+    let scene = box_scene(12, |p| {
+        let u = 2.0 * p.x - 1.0 + 0.2 * (p.y - 0.5);
+        24.6 + 7350.0 * u.powi(5) + u + 0.1 * p.y
+    });
+    let mut r = Renderer::new(scene.geometry());
+    for alone in [true, false] {
+        let set = iso(
+            "24.55:#ff8000:0.5,24.555:#0080ff:0.5,24.56:#80ff00:0.5",
+            Lighting::Smooth,
+            alone,
+        );
+        for (azimuth, elevation, ortho) in [(30.0, 25.0, false), (-20.0, 60.0, true)] {
+            let camera = CameraParams {
+                width: 300,
+                height: 240,
+                azimuth,
+                elevation,
+                zoom: 1.3,
+                ortho,
+                ..Default::default()
+            };
+            let mut ref_opts = options(Mode::Raycast, ortho, &set, Compositor::Cpu);
+            ref_opts.camera = camera;
+            let expected = render(&mut r, &scene, &ref_opts);
+            let modes: &[Mode] = if alone {
+                &[Mode::Iso, Mode::ExactFrag]
+            } else {
+                &[Mode::ExactFrag]
+            };
+            for &mode in modes {
+                for c in compositors() {
+                    let mut opts = options(mode, ortho, &set, c);
+                    opts.camera = camera;
+                    let got = render(&mut r, &scene, &opts);
+                    let (off, max) = off_pixels(&got, &expected, pixel_tol(c));
+                    eprintln!("alone={alone} {azimuth}/{elevation} ortho={ortho} {mode:?} {c:?}: max {max:.2e}, {} off {:?}", off.len(), &off[..off.len().min(4)]);
+                    assert!(
+                        off.is_empty() && max <= pixel_tol(c),
+                        "alone={alone} {azimuth}/{elevation} {mode:?} {c:?}: {off:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// Off pixels allowed per 96 x 96 image of bluntfin's nearly uniform field
 /// (about 4,000 pixels covered), measured at most 32 (at most 3 of them by
 /// more than 0.05): rays that graze the surface, whose scalars come within

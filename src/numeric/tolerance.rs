@@ -465,7 +465,9 @@ pub const ISO_LEVEL_F64: f64 = 1e-12;
 pub const ISO_LEVEL_ULPS: f64 = 4.0;
 
 /// The same margin for the GPU stages and their twins, relative to the
-/// normalised isovalue `|V|` (`f32`, about 16 ulps): the fragment's
+/// normalised isovalue `|V|` (`f32`, about 16 ulps; normalised from the
+/// middle of the isovalues where the stage allows,
+/// `render::modes::segment::ScalarMap::centred`): the fragment's
 /// `s = (s q) / q` is interpolated in `f32`, and where the corners all hold
 /// `V` (the case the margin is for) it rounds to within a few ulps of `V`.
 /// Relative to `V`, not to the normalised range: a margin of 1e-6 of the

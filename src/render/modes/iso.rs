@@ -567,6 +567,17 @@ impl IsoMode {
         }
     }
 
+    /// The map of the stage's scalars for one frame of `tf`: centred on
+    /// the isovalues ([`ScalarMap::centred`]) except for a table volume,
+    /// whose lookups need the transfer function's first node at 0 and its
+    /// last at 1.
+    pub fn map(&self, tf: &TransferFunction) -> ScalarMap {
+        match &self.volume {
+            Volume::Table(_) => ScalarMap::of(tf),
+            Volume::None | Volume::Integral => ScalarMap::centred(tf, &self.set.values),
+        }
+    }
+
     /// The twin for one frame of `tf` seen by `camera` over `mesh`.
     pub fn twin_for(
         &self,
@@ -574,12 +585,20 @@ impl IsoMode {
         tf: &TransferFunction,
         camera: &crate::camera::Camera,
     ) -> IsoTwin {
+        let map = self.map(tf);
         let volume = match &self.volume {
             Volume::None => VolumeTwin::None,
-            Volume::Integral => VolumeTwin::Integral(ExactFragTwin::new(tf, camera).for_mesh(mesh)),
+            Volume::Integral => VolumeTwin::Integral(
+                ExactFragTwin::with(
+                    SegmentView::of(camera),
+                    ClipMapper::for_camera(camera),
+                    TfBuffer::new(tf, &map),
+                )
+                .for_mesh(mesh),
+            ),
             Volume::Table(p) => VolumeTwin::Table(p.twin_for(mesh, tf, camera)),
         };
-        IsoTwin::new(&self.set, &ScalarMap::of(tf), camera, volume)
+        IsoTwin::new(&self.set, &map, camera, volume)
     }
 }
 
@@ -651,7 +670,7 @@ impl ProjectedMode for IsoMode {
     }
 
     fn fragment_iso_origin(&self, src: &PieceSource) -> f64 {
-        ScalarMap::of(src.tf).offset
+        self.map(src.tf).offset
     }
 
     fn draws_volume(&self) -> bool {
@@ -666,7 +685,7 @@ impl ProjectedMode for IsoMode {
     }
 
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
-        let map = ScalarMap::of(src.tf);
+        let map = self.map(src.tf);
         let (params, surfaces) = iso_buffers(&self.set, &map);
         let extra = [
             Resource::Uniform(bytemuck::bytes_of(&params)),
@@ -709,6 +728,7 @@ impl ProjectedMode for IsoMode {
         _refined: &mut usize,
     ) {
         payload.seg.set(src);
+        payload.seg.map = self.map(src.tf);
         let scale = payload.seg.map.scale;
         payload.candidates = part_candidates(part, &payload.seg.map, &self.set);
         // Where a boundary triangle's scalar is an isovalue, a surface
