@@ -83,8 +83,8 @@
 //!   zero-extinction volume was otherwise missed at 2 of 9,080 centres in
 //!   perspective, `tests/iso.rs`). Only such centres can change side: with
 //!   many isovalues nearly every triangle holds one, but few hold such a
-//!   centre (bluntfin, 100 values: 26,665 steep triangles of 330,322,
-//!   against 101,008 when every triangle holding a value was).
+//!   centre (bluntfin, 100 values: 26,914 steep triangles of 335,392,
+//!   against about 101,000 when every triangle holding a value was).
 //!
 //! **Optically thin parts** ([`thin_outline`]) need none of this. Where
 //! the thickness is 0 all along a part's outline (a piece in general
