@@ -508,22 +508,7 @@ fn a_surface_far_from_the_first_node_where_the_field_is_gentle() {
             ortho,
             ..Default::default()
         };
-        let mut ref_opts = options(Mode::Raycast, ortho, &set, Compositor::Cpu);
-        ref_opts.camera = camera;
-        let expected = render(&mut r, &scene, &ref_opts);
-        for mode in [Mode::Iso, Mode::ExactFrag] {
-            for c in compositors() {
-                let mut opts = options(mode, ortho, &set, c);
-                opts.camera = camera;
-                let got = render(&mut r, &scene, &opts);
-                let (off, max) = off_pixels(&got, &expected, pixel_tol(c));
-                eprintln!("{azimuth}/{elevation} ortho={ortho} {mode:?} {c:?}: max {max:.2e}, off {off:?}");
-                assert!(
-                    off.is_empty() && max <= pixel_tol(c),
-                    "{azimuth}/{elevation} ortho={ortho} {mode:?} {c:?}: {off:?}"
-                );
-            }
-        }
+        every_pixel_right(&mut r, &scene, &set, camera, &[Mode::Iso, Mode::ExactFrag]);
     }
 }
 
@@ -559,27 +544,47 @@ fn close_surfaces_far_from_the_first_node_are_resolved() {
                 ortho,
                 ..Default::default()
             };
-            let mut ref_opts = options(Mode::Raycast, ortho, &set, Compositor::Cpu);
-            ref_opts.camera = camera;
-            let expected = render(&mut r, &scene, &ref_opts);
             let modes: &[Mode] = if alone {
                 &[Mode::Iso, Mode::ExactFrag]
             } else {
                 &[Mode::ExactFrag]
             };
-            for &mode in modes {
-                for c in compositors() {
-                    let mut opts = options(mode, ortho, &set, c);
-                    opts.camera = camera;
-                    let got = render(&mut r, &scene, &opts);
-                    let (off, max) = off_pixels(&got, &expected, pixel_tol(c));
-                    eprintln!("alone={alone} {azimuth}/{elevation} ortho={ortho} {mode:?} {c:?}: max {max:.2e}, {} off {:?}", off.len(), &off[..off.len().min(4)]);
-                    assert!(
-                        off.is_empty() && max <= pixel_tol(c),
-                        "alone={alone} {azimuth}/{elevation} {mode:?} {c:?}: {off:?}"
-                    );
-                }
-            }
+            every_pixel_right(&mut r, &scene, &set, camera, modes);
+        }
+    }
+}
+
+/// Renders `set` over `scene` through `camera` with each of `modes`, on
+/// the CPU twin and the GPU, and asserts that every pixel is within the
+/// pixel tolerance of the ray caster's (`faces`).
+fn every_pixel_right(
+    r: &mut Renderer,
+    scene: &Scene,
+    set: &IsoOptions,
+    camera: CameraParams,
+    modes: &[Mode],
+) {
+    let ortho = camera.ortho;
+    let mut ref_opts = options(Mode::Raycast, ortho, set, Compositor::Cpu);
+    ref_opts.camera = camera;
+    let expected = render(r, scene, &ref_opts);
+    for &mode in modes {
+        for c in compositors() {
+            let mut opts = options(mode, ortho, set, c);
+            opts.camera = camera;
+            let got = render(r, scene, &opts);
+            let (off, max) = off_pixels(&got, &expected, pixel_tol(c));
+            let (a, e) = (camera.azimuth, camera.elevation);
+            eprintln!(
+                "{a}/{e} ortho={ortho} alone={} {mode:?} {c:?}: max {max:.2e}, {} off {:?}",
+                set.alone,
+                off.len(),
+                &off[..off.len().min(4)]
+            );
+            assert!(
+                off.is_empty() && max <= pixel_tol(c),
+                "{a}/{e} ortho={ortho} {mode:?} {c:?}: {off:?}"
+            );
         }
     }
 }

@@ -392,6 +392,31 @@ fn one_pass_finds_the_steep_triangles_and_the_sliver_centres() {
     );
 }
 
+/// The centres [`scan_triangles`] leaves for the tie decisions in the
+/// optically thin part `proj` (a `width` x `height` image) with
+/// `isovalues`.
+fn sliver_centres(proj: &Projected, width: u32, height: u32, isovalues: &[f64]) -> Vec<(u32, u32)> {
+    let rate = || 0.0;
+    let part = PartTriangles {
+        proj,
+        drawn: &[],
+        exact: &proj.triangles,
+        width,
+        height,
+        rate: &rate,
+        rate_bound: 0.0,
+        l_range: (1e-6, 1e-6),
+        snap: &[],
+        weighed: false,
+        clipped: false,
+        isovalues,
+        iso_origin: 0.0,
+    };
+    let mut scratch = TieScratch::default();
+    scan_triangles(&part, true, &mut scratch);
+    scratch.forced
+}
+
 /// A sliver (a region seen nearly edge-on) whose entry scalar runs from
 /// 0.2 to 0.4 across its 0.02 px: the snap of its corners shifts the
 /// interpolated scalar by far more than the distance of a centre inside
@@ -416,27 +441,7 @@ fn a_sliver_holding_an_isovalue_has_its_centres_decided() {
     proj.vertices.push(v(4.5, 1.49, 0.2));
     proj.vertices.push(v(2.5, 1.51, 0.4));
     proj.triangles.push([0, 1, 2]);
-    let rate = || 0.0;
-    let scan = |isovalues: &[f64]| {
-        let part = PartTriangles {
-            proj: &proj,
-            drawn: &[],
-            exact: &proj.triangles,
-            width: 6,
-            height: 4,
-            rate: &rate,
-            rate_bound: 0.0,
-            l_range: (1e-6, 1e-6),
-            snap: &[],
-            weighed: false,
-            clipped: false,
-            isovalues,
-            iso_origin: 0.0,
-        };
-        let mut scratch = TieScratch::default();
-        scan_triangles(&part, true, &mut scratch);
-        scratch.forced
-    };
+    let scan = |isovalues: &[f64]| sliver_centres(&proj, 6, 4, isovalues);
     assert_eq!(scan(&[0.3]), vec![(1, 1), (2, 1), (3, 1)]);
     assert!(scan(&[]).is_empty());
     assert!(scan(&[0.9]).is_empty());
@@ -470,27 +475,7 @@ fn a_sliver_in_perspective_weighs_its_centres_perspective_correctly() {
     proj.vertices.push(v(20.5, 1.49, 1.0, 100.0));
     proj.vertices.push(v(10.5, 1.51, persp(0.5), z_at(0.5)));
     proj.triangles.push([0, 1, 2]);
-    let rate = || 0.0;
-    let scan = |isovalues: &[f64]| {
-        let part = PartTriangles {
-            proj: &proj,
-            drawn: &[],
-            exact: &proj.triangles,
-            width: 24,
-            height: 4,
-            rate: &rate,
-            rate_bound: 0.0,
-            l_range: (1e-6, 1e-6),
-            snap: &[],
-            weighed: false,
-            clipped: false,
-            isovalues,
-            iso_origin: 0.0,
-        };
-        let mut scratch = TieScratch::default();
-        scan_triangles(&part, true, &mut scratch);
-        scratch.forced
-    };
+    let scan = |isovalues: &[f64]| sliver_centres(&proj, 24, 4, isovalues);
     let columns = |forced: Vec<(u32, u32)>| -> Vec<u32> {
         assert!(forced.iter().all(|&(_, j)| j == 1), "{forced:?}");
         forced.into_iter().map(|(i, _)| i).collect()
