@@ -472,17 +472,15 @@ fn surfaces_on_a_tet_mesh_at_every_pixel() {
 
 /// A surface far from the transfer function's first node where the field
 /// changes slowly: `f = 1000 u^3 + u + 0.05 y` (`u = 2x - 1`) spans about
-/// -1000 to 1000 and the surface at 0 lies where it changes by about 1e-2
-/// per pixel. The `f32` stages see the field normalised from the first node,
-/// so their level lies 1e-6 of that distance (1e-3) below the value, and
-/// they round to about 1e-4: a quarter and a fortieth of a pixel, far wider
-/// than the snap's band. The centres next to the lines where a face's
-/// scalar is the value must be decided exactly over that width, or the two
-/// pieces sharing the face put them on different sides (the surface
-/// missing or drawn twice: 0.44 at 2 to 15 pixels of a 400 x 300 image),
-/// and so must those where the surface meets the mesh's boundary. Every
-/// pixel, translucent, surfaces alone (`--mode iso` and exact-frag), both
-/// projections.
+/// -1000 to 1000, and the surface at 0 lies where it changes by about 1e-2
+/// per pixel. Normalised from the first node, the `f32` stages' level lies
+/// 1e-3 below the value (a quarter of a pixel) and the two pieces sharing
+/// a face put centres next to it on different sides unless the seams'
+/// band holds that margin (the surface missing or drawn twice: 0.5 at 3
+/// pixels here before either); centred on the value
+/// (`ScalarMap::centred`) the level is the value. Every pixel,
+/// translucent, `--mode iso` and exact-frag, both projections. (The band
+/// alone: `iso_seams` tests; it still matters for the table modes' map.)
 #[test]
 fn a_surface_far_from_the_first_node_where_the_field_is_gentle() {
     let scene = box_scene(11, |p| {
@@ -515,12 +513,11 @@ fn a_surface_far_from_the_first_node_where_the_field_is_gentle() {
 /// Surfaces close together where a field of a wide range changes slowly:
 /// `f = 24.6 + 7350 u^5 + u + 0.1 y` (`u = 2x - 1 + 0.2 (y - 1/2)`) spans
 /// about -7,300 to 7,400, and the values 24.55, 24.555 and 24.56 lie where
-/// it changes by about 5e-3 per pixel. Normalised from the transfer
-/// function's first node, the `f32` stages put their levels 7e-3 below
-/// each value (`ISO_LEVEL_F32` of 7,350): more than the values' spacing
-/// and a pixel and a half; centred on the values
-/// (`ScalarMap::centred`) every pixel matches. Translucent, surfaces
-/// alone and mixed with the volume (exact-frag), both projections.
+/// it changes by about 5e-3 per pixel. Normalised from the first node,
+/// the `f32` stages put their levels 7e-3 (`ISO_LEVEL_F32` of 7,350) below
+/// each value, a pixel and a half; centred on the values
+/// (`ScalarMap::centred`) every pixel matches (translucent, alone and mixed
+/// with exact-frag's volume, both projections).
 #[test]
 fn close_surfaces_far_from_the_first_node_are_resolved() {
     let scene = box_scene(12, |p| {
