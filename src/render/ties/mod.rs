@@ -60,8 +60,8 @@
 //!   a line's band grows by the distance over which the face's scalar
 //!   changes by the `f32` stage's margin ([`iso_margin`]: its level below
 //!   the value and its rounding, relative to the distance from the
-//!   transfer function's first node), which can be far wider than the
-//!   snap's where the field is gentle;
+//!   scalar the stage maps to 0), which can be far wider than the snap's
+//!   where the field is gentle;
 //! - inside **slivers**, exact triangles narrower than [`SLIVER_TIE_PX`]:
 //!   the snap of their corners shifts the interpolated values by their
 //!   screen gradient times the snap, which across a sliver is a large part
@@ -542,8 +542,9 @@ pub struct PartTriangles<'a> {
     /// side of an isovalue than the piece beside it puts it; those centres
     /// are decided exactly too.
     pub isovalues: &'a [f64],
-    /// The scalar the mode's `f32` stage maps to 0 (the transfer
-    /// function's first node, [`crate::render::modes::segment::ScalarMap`]):
+    /// The scalar the mode's `f32` stage maps to 0 (the middle of the
+    /// isovalues, or a table mode's first node of the transfer function:
+    /// [`crate::render::modes::segment::ScalarMap`]):
     /// the stage's rounding, and the margin of its levels below the
     /// isovalues ([`crate::numeric::tolerance::ISO_LEVEL_F32`]), are
     /// relative to a scalar's distance from it, not to the scalar itself
@@ -560,10 +561,12 @@ pub struct PartTriangles<'a> {
 /// largest normalised corner scalar; both are relative to the distance
 /// from `origin` ([`PartTriangles::iso_origin`]), and [`ISO_SLIVER_REL`]
 /// of the farther of `lo` and `hi` holds them. In raw terms this is large
-/// where the isovalue lies far from the transfer function's first node
-/// against the field's change near it: a field from -1000 to 1000 with
-/// the surface at 0 where it changes by 4e-3 per pixel has the stage's
-/// level a quarter of a pixel from the value, and its rounding a tenth.
+/// where the isovalue lies far from the origin against the field's change
+/// near it: normalised from the first node of a field from -1000 to 1000
+/// (the table modes' map), a surface at 0 where the field changes by 4e-3
+/// per pixel has the stage's level a quarter of a pixel from the value,
+/// and its rounding a tenth; the stages without a table are centred on
+/// the isovalues ([`crate::render::modes::segment::ScalarMap::centred`]).
 #[inline]
 pub fn iso_margin(origin: f64, lo: f64, hi: f64) -> f64 {
     ISO_SLIVER_REL * (lo - origin).abs().max((hi - origin).abs())
