@@ -49,8 +49,10 @@
 //!
 //! **Opaque isosurfaces** (Livnat and Hansen's view-dependent culling)
 //! hide what lies behind them, in every mode that draws surfaces mixed
-//! with the volume (a frame of surfaces alone is cheaper to draw than the
-//! pass): at a centre where a cell's chord enters it on one
+//! with the volume, and in a frame of surfaces alone (`--mode iso`,
+//! `--iso-only`) with at least [`ALONE_MIN_OPAQUE`] of them (with fewer
+//! such a frame, which draws only the pieces holding a value, is cheaper
+//! to draw than the pass): at a centre where a cell's chord enters it on one
 //! side of an opaque surface's value and leaves it on the other
 //! ([`Credit::crosses`], with the margin of
 //! [`OCCLUSION_ISO_REL`], the entry and exit scalars the `faces` field's on
@@ -65,8 +67,8 @@
 //! one layer: their pieces are never hidden, and their cells never
 //! credited. Independent emission is not bounded by the opacity in front
 //! (no culling of its volume), and neither is a frame that counts
-//! coverage, nor a frame that draws no volume (`--mode iso`,
-//! `--iso-only`). A transfer function whose largest extinction times the
+//! coverage, nor a frame of surfaces alone with fewer opaque surfaces than
+//! [`ALONE_MIN_OPAQUE`]. A transfer function whose largest extinction times the
 //! mesh's diagonal cannot reach the cut credits no volume, and without
 //! opaque surfaces skips the pass at once.
 
@@ -102,6 +104,20 @@ pub const BLOCK_MIN: usize = 32;
 /// The largest block.
 pub const BLOCK_MAX: usize = 4096;
 
+/// The fewest surfaces opaque on both sides for which a frame of surfaces
+/// alone (`--mode iso`, `--iso-only`) runs the pass. Such a frame draws
+/// only the pieces holding a value, each cheaply, and the pass's credits
+/// cost about as much per piece: one closed surface hides little more
+/// than its own far side. Stacked surfaces hide nearly everything behind
+/// the front one (512 x 512, `zoovr render --stats`, renderer total,
+/// 2026-12-07, lavapipe; values spread evenly over the field's range):
+/// bluntfin 0.20 / 0.25 / 0.28 / 0.52 s for 6 / 8 / 10 / 100 values
+/// without the pass, 0.20 / 0.25 / 0.27 / 0.31 s with it (5 values: 0.19
+/// s against 0.21 s); the generated 1M-hex grid 1.67 / 3.14 / 8.18 s for
+/// 5 / 10 / 100 values without it, 1.51 / 2.40 / 2.11 s with it (one
+/// value: 0.91 s either way).
+pub const ALONE_MIN_OPAQUE: usize = 8;
+
 /// The optical depth in front of a centre beyond which nothing behind it
 /// can change a channel by more than `transmittance` (by default
 /// [`OCCLUSION_TRANSMITTANCE`]): `ln(c / transmittance)` with `c` the
@@ -131,7 +147,16 @@ pub fn may_hide(
     diagonal: f64,
     transmittance: f64,
 ) -> bool {
-    if !volume || tf.model() != EmissionModel::Glow {
+    let opaque = iso.map_or(0, |set| {
+        set.sides
+            .iter()
+            .filter(|sides| sides.iter().all(|side| side[3] >= 1.0))
+            .count()
+    });
+    if !volume {
+        return opaque >= ALONE_MIN_OPAQUE && tf_cut_depth(tf, transmittance).is_finite();
+    }
+    if tf.model() != EmissionModel::Glow {
         return false;
     }
     let cut = tf_cut_depth(tf, transmittance);
@@ -141,13 +166,8 @@ pub fn may_hide(
         let c = n.color.iter().fold(1.0f64, |m, c| m.max(c.abs()));
         a.max(n.tau).max(n.tau * c)
     });
-    let opaque = iso.is_some_and(|set| {
-        set.sides
-            .iter()
-            .any(|sides| sides.iter().all(|side| side[3] >= 1.0))
-    });
     // False for NaN too.
-    cut.is_finite() && (tau_max * diagonal >= cut || opaque)
+    cut.is_finite() && (tau_max * diagonal >= cut || opaque > 0)
 }
 
 /// What the pass found.
@@ -214,13 +234,15 @@ pub fn hidden_pieces(
     let credit = Credit {
         volume: src.volume && cut.is_finite() && tau_max * mesh.diagonal() >= cut,
         // A frame drawing the surfaces alone draws only the pieces holding
-        // a value, so cheaply that the pass would cost more than it saves
-        // (bluntfin, one opaque surface, 512 x 512: 0.16-0.20 s with it
-        // against 0.125 s without).
-        opaque: if src.volume {
-            opaque_values(src)
-        } else {
-            Vec::new()
+        // a value, so cheaply that the pass pays only for many stacked
+        // surfaces ([`ALONE_MIN_OPAQUE`]).
+        opaque: {
+            let values = opaque_values(src);
+            if src.volume || values.len() >= ALONE_MIN_OPAQUE {
+                values
+            } else {
+                Vec::new()
+            }
         },
         min_chord: OCCLUSION_ISO_CHORD * mesh.diagonal(),
         tf_range: (lo.min(hi), (hi - lo).abs()),
