@@ -77,36 +77,96 @@ pub fn tet_gradient(p: [DVec3; 4], s: [f64; 4]) -> DVec3 {
 /// consistent tetrahedra that use it, weighted by their (unsigned) volume;
 /// zero for a point no tetrahedron of positive volume uses.
 pub fn point_gradients(mesh: &Mesh, scalars: &[f64]) -> Vec<DVec3> {
+    point_gradients_where(mesh, scalars, |_| true)
+}
+
+/// Cells per batch of [`point_gradients_where`]: their tetrahedra's
+/// gradients are computed in parallel, then summed in cell order (a few
+/// MiB of contributions at a time).
+const GRADIENT_BATCH: usize = 1 << 15;
+
+/// [`point_gradients`] at the points of the cells for which `wanted` holds
+/// (the same values, bit for bit: each such point's sum runs over every
+/// tetrahedron around it, in the same order), zero at every other point.
+/// A frame needs the gradients only where it draws a surface; the cells
+/// around the wanted points are the only ones visited.
+pub fn point_gradients_where(
+    mesh: &Mesh,
+    scalars: &[f64],
+    wanted: impl Fn(usize) -> bool + Sync,
+) -> Vec<DVec3> {
+    use rayon::prelude::*;
     let n = mesh.points.len();
+    let cells = mesh.cells.len();
+    let wanted_cells: Vec<bool> = (0..cells).into_par_iter().map(&wanted).collect();
+    let mut want = vec![false; n];
+    for c in (0..cells).filter(|&c| wanted_cells[c]) {
+        for &p in mesh.cells.nodes(c) {
+            if let Some(w) = want.get_mut(p as usize) {
+                *w = true;
+            }
+        }
+    }
+    // The cells with a wanted point: they hold every tetrahedron around one.
+    let visit: Vec<usize> = (0..cells)
+        .into_par_iter()
+        .filter(|&c| {
+            mesh.cells
+                .nodes(c)
+                .iter()
+                .any(|&p| want.get(p as usize) == Some(&true))
+        })
+        .collect();
     let mut sum = vec![DVec3::ZERO; n];
     let mut weight = vec![0.0f64; n];
-    let mut tets = Vec::new();
-    for c in 0..mesh.cells.len() {
-        tets.clear();
-        tetrahedralize_cell(&mesh.cells, c, &mut tets);
-        'tet: for t in &tets {
-            let (mut p, mut s) = ([DVec3::ZERO; 4], [0.0; 4]);
-            for k in 0..4 {
-                match (mesh.points.get(t[k] as usize), scalars.get(t[k] as usize)) {
-                    (Some(&pk), Some(&sk)) if sk.is_finite() => (p[k], s[k]) = (pk, sk),
-                    _ => continue 'tet,
+    for batch in visit.chunks(GRADIENT_BATCH) {
+        // Each cell's tetrahedra with their gradient times volume and
+        // volume, in cell order.
+        let parts: Vec<Vec<([u32; 4], DVec3, f64)>> = batch
+            .par_chunks(256)
+            .map(|chunk| {
+                let mut out = Vec::new();
+                let mut tets = Vec::new();
+                for &c in chunk {
+                    tets.clear();
+                    tetrahedralize_cell(&mesh.cells, c, &mut tets);
+                    out.extend(
+                        tets.iter()
+                            .filter_map(|&t| tet_contribution(mesh, scalars, t)),
+                    );
                 }
-            }
-            let vol = ((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0).abs();
-            if vol.is_nan() || vol <= 0.0 {
-                continue;
-            }
-            let g = tet_gradient(p, s);
+                out
+            })
+            .collect();
+        for (t, gv, vol) in parts.iter().flatten() {
             for &i in t {
-                sum[i as usize] += g * vol;
-                weight[i as usize] += vol;
+                sum[i as usize] += *gv;
+                weight[i as usize] += *vol;
             }
         }
     }
     sum.iter()
         .zip(&weight)
-        .map(|(&g, &w)| if w > 0.0 { g / w } else { DVec3::ZERO })
+        .zip(&want)
+        .map(|((&g, &w), &keep)| if keep && w > 0.0 { g / w } else { DVec3::ZERO })
         .collect()
+}
+
+/// Tetrahedron `t`'s gradient times its volume, and its volume; `None`
+/// for one with a point or scalar missing or not finite, or of no volume.
+fn tet_contribution(mesh: &Mesh, scalars: &[f64], t: [u32; 4]) -> Option<([u32; 4], DVec3, f64)> {
+    let (mut p, mut s) = ([DVec3::ZERO; 4], [0.0; 4]);
+    for k in 0..4 {
+        match (mesh.points.get(t[k] as usize), scalars.get(t[k] as usize)) {
+            (Some(&pk), Some(&sk)) if sk.is_finite() => (p[k], s[k]) = (pk, sk),
+            _ => return None,
+        }
+    }
+    let vol = ((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0).abs();
+    if vol.is_nan() || vol <= 0.0 {
+        return None;
+    }
+    Some((t, tet_gradient(p, s) * vol, vol))
 }
 
 /// `g` in view coordinates of a camera with unit axes `right`, `up` and
@@ -226,6 +286,71 @@ mod tests {
                 .map(|&n| (mesh.points[n as usize], s[n as usize])),
         );
         assert!((fit - g).length() < 1e-12);
+    }
+
+    /// The sum of the module docs, cell after cell on one thread.
+    fn sequential_point_gradients(mesh: &Mesh, scalars: &[f64]) -> Vec<DVec3> {
+        let n = mesh.points.len();
+        let (mut sum, mut weight) = (vec![DVec3::ZERO; n], vec![0.0f64; n]);
+        let mut tets = Vec::new();
+        for c in 0..mesh.cells.len() {
+            tets.clear();
+            tetrahedralize_cell(&mesh.cells, c, &mut tets);
+            for &t in &tets {
+                if let Some((t, gv, vol)) = tet_contribution(mesh, scalars, t) {
+                    for i in t {
+                        sum[i as usize] += gv;
+                        weight[i as usize] += vol;
+                    }
+                }
+            }
+        }
+        sum.iter()
+            .zip(&weight)
+            .map(|(&g, &w)| if w > 0.0 { g / w } else { DVec3::ZERO })
+            .collect()
+    }
+
+    #[test]
+    fn gradients_where_wanted_are_every_points_bit_for_bit_and_zero_elsewhere() {
+        // More cells than a batch, a curved field, a NaN scalar.
+        let mesh = warped_hex_grid(
+            33,
+            &Warp {
+                amplitude: 0.1,
+                seed: 3,
+            },
+        );
+        assert!(mesh.cells.len() > GRADIENT_BATCH);
+        let mut s: Vec<f64> = mesh
+            .points
+            .iter()
+            .map(|p| (3.0 * p.x).sin() * p.y + p.z * p.z)
+            .collect();
+        s[1000] = f64::NAN;
+        let all = sequential_point_gradients(&mesh, &s);
+        assert_eq!(point_gradients(&mesh, &s), all);
+        // The cells of a slab and every 97th cell.
+        let wanted = |c: usize| {
+            let z = mesh.points[mesh.cells.nodes(c)[0] as usize].z;
+            (0.4..0.5).contains(&z) || c % 97 == 0
+        };
+        let some = point_gradients_where(&mesh, &s, wanted);
+        let mut want = vec![false; mesh.points.len()];
+        for c in (0..mesh.cells.len()).filter(|&c| wanted(c)) {
+            for &p in mesh.cells.nodes(c) {
+                want[p as usize] = true;
+            }
+        }
+        let kept = want.iter().filter(|&&w| w).count();
+        assert!(kept > 1000 && kept < mesh.points.len() / 2, "{kept}");
+        for (k, (g, w)) in some.iter().zip(&want).enumerate() {
+            if *w {
+                assert_eq!(*g, all[k], "point {k}");
+            } else {
+                assert_eq!(*g, DVec3::ZERO, "point {k}");
+            }
+        }
     }
 
     #[test]

@@ -121,9 +121,13 @@ fn iso_mode(scene: &Scene, opts: &RenderOptions) -> Result<modes::iso::IsoMode, 
         Mode::Exact | Mode::ExactFrag => Volume::Integral,
         m => Volume::Table(modes::preint::PreintMode::for_mode(m, opts)?),
     };
-    let grads = (set.lighting == iso::Lighting::Smooth)
-        .then(|| gradients::point_gradients(&scene.mesh, values));
-    Ok(IsoMode::new(volume, set, grads))
+    let smooth = set.lighting == iso::Lighting::Smooth;
+    let mode = IsoMode::new(volume, set, None);
+    Ok(if smooth {
+        mode.with_surface_gradients(&scene.tf, &scene.mesh, values)
+    } else {
+        mode
+    })
 }
 
 /// State reused across frames of one geometry: the geometry itself, the

@@ -113,6 +113,13 @@ pub struct IsoVertex {
 /// never changes a fragment inside the triangle.
 pub const RANGE_MARGIN: f64 = 1e-3;
 
+/// How far a cell's normalised scalar range is widened (relative above 1)
+/// when deciding whether its points need gradients
+/// ([`IsoMode::with_surface_gradients`]): ten times [`RANGE_MARGIN`], so
+/// that every piece whose candidates hold a value (its range lies in its
+/// cell's, up to the rounding of interpolated scalars) finds them.
+pub const GRADIENT_MARGIN: f64 = 10.0 * RANGE_MARGIN;
+
 impl IsoVertex {
     /// Vertex attributes (`@location`s of `VertexIn`).
     pub const ATTRIBUTES: [wgpu::VertexAttribute; 8] = wgpu::vertex_attr_array![
@@ -545,6 +552,43 @@ impl IsoMode {
             set,
             gradients,
         }
+    }
+
+    /// This mode with the points' gradients for smooth light
+    /// ([`crate::render::gradients::point_gradients_where`]) where it can
+    /// draw a surface: at the points of every cell of `mesh` whose range of
+    /// `values` (normalised by [`Self::map`]) widened by [`GRADIENT_MARGIN`]
+    /// holds an isovalue, zero elsewhere. Each piece's range lies in its
+    /// cell's, so every piece that can search a value
+    /// ([`IsoVertex::candidates`], with a tenth of that margin) has its
+    /// gradients; the others cross nothing and read none. A narrow set of
+    /// values then visits few cells (the generated 1M-hex grid, one value:
+    /// 0.2 s of the frame's 0.9 s for every point's gradient).
+    pub fn with_surface_gradients(
+        mut self,
+        tf: &TransferFunction,
+        mesh: &crate::mesh::Mesh,
+        values: &[f64],
+    ) -> IsoMode {
+        let map = self.map(tf);
+        let levels: Vec<f64> = self.set.values.iter().map(|&v| map.apply(v)).collect();
+        let wanted = |c: usize| {
+            let scalar = |p: &u32| values.get(*p as usize).copied().unwrap_or(f64::NAN);
+            let (lo, hi) =
+                crate::render::pieces::value_range(mesh.cells.nodes(c).iter().map(scalar));
+            // As the candidates: a cell without a range may search any.
+            if lo.is_nan() || hi.is_nan() || lo > hi {
+                return true;
+            }
+            let widen = |v: f64, sign: f64| v + sign * GRADIENT_MARGIN * v.abs().max(1.0);
+            let (a, b) = (widen(map.apply(lo), -1.0), widen(map.apply(hi), 1.0));
+            let k = levels.partition_point(|&x| x < a);
+            levels.get(k).is_some_and(|&x| x <= b)
+        };
+        self.gradients = Some(crate::render::gradients::point_gradients_where(
+            mesh, values, wanted,
+        ));
+        self
     }
 
     /// What the last frame's table build did (a table volume).
