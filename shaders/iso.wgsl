@@ -25,7 +25,11 @@ struct IsoParams {
     diffuse: f32,
     // 0: exact mixing, 1: RKE's blend (src/render/iso.rs `IsoMix`).
     mix: u32,
-    _pad0: u32,
+    // A table volume's lookups take the transfer function's normalised
+    // scalar (first node 0, last 1); the fragment's are centred on the
+    // isovalues (src/render/modes/segment.rs `ScalarMap::centred`): this
+    // is the centre in the table's terms, 0 for the other volumes.
+    table_offset: f32,
     _pad1: u32,
     _pad2: u32,
 }

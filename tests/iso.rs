@@ -545,7 +545,7 @@ fn close_surfaces_far_from_the_first_node_are_resolved() {
             let modes: &[Mode] = if alone {
                 &[Mode::Iso, Mode::ExactFrag]
             } else {
-                &[Mode::ExactFrag]
+                &[Mode::ExactFrag, Mode::Preint3d, Mode::Preint2dCyl]
             };
             every_pixel_right(&mut r, &scene, &set, camera, modes);
         }

@@ -199,7 +199,11 @@ pub struct IsoParams {
     pub diffuse: f32,
     /// 0: exact mixing, 1: RKE's blend ([`crate::render::iso::IsoMix`]).
     pub mix: u32,
-    pub _pad: [u32; 3],
+    /// The scalar map's origin in a table volume's normalised terms
+    /// ([`IsoMode::table_offset`]), added to the scalars of its lookups;
+    /// 0 for the other volumes.
+    pub table_offset: f32,
+    pub _pad: [u32; 2],
 }
 
 /// One surface as the stage reads it. Keep in sync with `IsoSurface` in
@@ -219,8 +223,12 @@ pub struct IsoSurface {
 
 /// The uniform and the surface list of `set`, its values through `map`
 /// (one zero surface when the set is empty: a storage binding is never
-/// empty).
-pub fn iso_buffers(set: &IsoSet, map: &ScalarMap) -> (IsoParams, Vec<IsoSurface>) {
+/// empty), a table volume's lookups offset by `table_offset`.
+pub fn iso_buffers(
+    set: &IsoSet,
+    map: &ScalarMap,
+    table_offset: f32,
+) -> (IsoParams, Vec<IsoSurface>) {
     let params = IsoParams {
         count: set.values.len() as u32,
         lighting: set.lighting.code(),
@@ -230,7 +238,8 @@ pub fn iso_buffers(set: &IsoSet, map: &ScalarMap) -> (IsoParams, Vec<IsoSurface>
             IsoMix::Exact => 0,
             IsoMix::Blend => 1,
         },
-        _pad: [0; 3],
+        table_offset,
+        _pad: [0; 2],
     };
     let mut surfaces: Vec<IsoSurface> = set
         .values
@@ -317,11 +326,13 @@ pub static ISO_EXACT_FRAG_STAGES: IntegralStages = IntegralStages {
     ],
 };
 
-/// `--iso` with `preint3d`.
+/// `--iso` with `preint3d`. The table stages' `volume` looks up each
+/// sub-segment with its centred scalars offset into the table's terms
+/// ([`IsoParams::table_offset`]).
 pub static ISO_PREINT3D_STAGE: StageDesc = iso_stage!(
     "iso.wgsl+preint3d",
     ["preint.wgsl", "preint3d.wgsl", "iso_split.wgsl"],
-    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
+    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf + iso.table_offset, sb + iso.table_offset, l);\n}\n",
     &[
         Binding::Uniform,
         Binding::Table,
@@ -335,7 +346,7 @@ pub static ISO_PREINT3D_STAGE: StageDesc = iso_stage!(
 pub static ISO_PREINT2D_STAGE: StageDesc = iso_stage!(
     "iso.wgsl+preint2d",
     ["preint.wgsl", "preint2d.wgsl", "iso_split.wgsl"],
-    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
+    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf + iso.table_offset, sb + iso.table_offset, l);\n}\n",
     &[
         Binding::Uniform,
         Binding::Table,
@@ -349,7 +360,7 @@ pub static ISO_PREINT2D_STAGE: StageDesc = iso_stage!(
 pub static ISO_PREINT2D_CYL_STAGE: StageDesc = iso_stage!(
     "iso.wgsl+preint2d_cyl",
     ["preint.wgsl", "preint2d_cyl.wgsl", "iso_split.wgsl"],
-    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf, sb, l);\n}\n",
+    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf + iso.table_offset, sb + iso.table_offset, l);\n}\n",
     &[
         Binding::Uniform,
         Binding::Table,
@@ -373,7 +384,8 @@ pub enum Volume {
 pub enum VolumeTwin {
     None,
     Integral(ExactFragTwin),
-    Table(PreintTwin),
+    /// The table's twin and [`IsoParams::table_offset`].
+    Table(PreintTwin, f32),
 }
 
 impl VolumeTwin {
@@ -382,7 +394,7 @@ impl VolumeTwin {
         match self {
             VolumeTwin::None => [0.0; 4],
             VolumeTwin::Integral(t) => t.volume(l, sf, sb),
-            VolumeTwin::Table(t) => t.volume(l, sf, sb),
+            VolumeTwin::Table(t, offset) => t.volume(l, sf + offset, sb + offset),
         }
     }
 }
@@ -612,13 +624,21 @@ impl IsoMode {
     }
 
     /// The map of the stage's scalars for one frame of `tf`: centred on
-    /// the isovalues ([`ScalarMap::centred`]) except for a table volume,
-    /// whose lookups need the transfer function's first node at 0 and its
-    /// last at 1.
+    /// the isovalues ([`ScalarMap::centred`]); a table volume's lookups,
+    /// which need the transfer function's first node at 0 and its last at
+    /// 1, add [`Self::table_offset`].
     pub fn map(&self, tf: &TransferFunction) -> ScalarMap {
+        ScalarMap::centred(tf, &self.set.values)
+    }
+
+    /// The origin of [`Self::map`] in a table volume's terms (the transfer
+    /// function's normalised scalar, [`ScalarMap::of`], whose scale is the
+    /// same): what its lookups add to the fragment's scalars. 0 for the
+    /// other volumes.
+    pub fn table_offset(&self, tf: &TransferFunction) -> f32 {
         match &self.volume {
-            Volume::Table(_) => ScalarMap::of(tf),
-            Volume::None | Volume::Integral => ScalarMap::centred(tf, &self.set.values),
+            Volume::Table(_) => ScalarMap::of(tf).apply(self.map(tf).offset) as f32,
+            Volume::None | Volume::Integral => 0.0,
         }
     }
 
@@ -640,7 +660,9 @@ impl IsoMode {
                 )
                 .for_mesh(mesh),
             ),
-            Volume::Table(p) => VolumeTwin::Table(p.twin_for(mesh, tf, camera)),
+            Volume::Table(p) => {
+                VolumeTwin::Table(p.twin_for(mesh, tf, camera), self.table_offset(tf))
+            }
         };
         IsoTwin::new(&self.set, &map, camera, volume)
     }
@@ -655,7 +677,11 @@ impl IsoTwin {
         camera: &crate::camera::Camera,
         volume: VolumeTwin,
     ) -> IsoTwin {
-        let (params, surfaces) = iso_buffers(set, map);
+        let offset = match volume {
+            VolumeTwin::Table(_, offset) => offset,
+            VolumeTwin::None | VolumeTwin::Integral(_) => 0.0,
+        };
+        let (params, surfaces) = iso_buffers(set, map, offset);
         IsoTwin {
             view: SegmentView::of(camera),
             mapper: ClipMapper::for_camera(camera),
@@ -730,7 +756,7 @@ impl ProjectedMode for IsoMode {
 
     fn bind(&self, gpu: &Context, src: &PieceSource) -> Result<Stage, GpuError> {
         let map = self.map(src.tf);
-        let (params, surfaces) = iso_buffers(&self.set, &map);
+        let (params, surfaces) = iso_buffers(&self.set, &map, self.table_offset(src.tf));
         let extra = [
             Resource::Uniform(bytemuck::bytes_of(&params)),
             Resource::Storage(bytemuck::cast_slice(&surfaces)),

@@ -177,8 +177,9 @@ impl ScalarMap {
 
     /// The map of `tf`'s scale with the middle of the sorted `values`'
     /// range sent to 0 instead of the first node (`tf`'s map without
-    /// values): for stages whose scalars only the isosurfaces and the
-    /// closed-form integral read, which take any origin. An `f32` scalar
+    /// values): for the isosurface stages, whose crossings and closed-form
+    /// integral take any origin (a table volume's lookups add the origin's
+    /// place in the table: `modes::iso::IsoMode::table_offset`). An `f32` scalar
     /// rounds relative to its distance from the origin, and the stages'
     /// levels lie [`crate::numeric::tolerance::ISO_LEVEL_F32`] of it below
     /// the values, so an origin among the values keeps both small next to

@@ -543,8 +543,7 @@ pub struct PartTriangles<'a> {
     /// are decided exactly too.
     pub isovalues: &'a [f64],
     /// The scalar the mode's `f32` stage maps to 0 (the middle of the
-    /// isovalues, or a table mode's first node of the transfer function:
-    /// [`crate::render::modes::segment::ScalarMap`]):
+    /// isovalues: [`crate::render::modes::segment::ScalarMap::centred`]):
     /// the stage's rounding, and the margin of its levels below the
     /// isovalues ([`crate::numeric::tolerance::ISO_LEVEL_F32`]), are
     /// relative to a scalar's distance from it, not to the scalar itself
@@ -562,11 +561,11 @@ pub struct PartTriangles<'a> {
 /// from `origin` ([`PartTriangles::iso_origin`]), and [`ISO_SLIVER_REL`]
 /// of the farther of `lo` and `hi` holds them. In raw terms this is large
 /// where the isovalue lies far from the origin against the field's change
-/// near it: normalised from the first node of a field from -1000 to 1000
-/// (the table modes' map), a surface at 0 where the field changes by 4e-3
-/// per pixel has the stage's level a quarter of a pixel from the value,
-/// and its rounding a tenth; the stages without a table are centred on
-/// the isovalues ([`crate::render::modes::segment::ScalarMap::centred`]).
+/// near it: normalised from the first node of a field from -1000 to 1000,
+/// a surface at 0 where the field changes by 4e-3 per pixel has the
+/// stage's level a quarter of a pixel from the value, and its rounding a
+/// tenth; so the isosurface stages are centred on the isovalues
+/// ([`crate::render::modes::segment::ScalarMap::centred`]).
 #[inline]
 pub fn iso_margin(origin: f64, lo: f64, hi: f64) -> f64 {
     ISO_SLIVER_REL * (lo - origin).abs().max((hi - origin).abs())
