@@ -1,5 +1,6 @@
 //! Isosurfaces: frame time against the number of isovalues (1, 2, 10, 100,
-//! spread over the field's range), alone (`--mode iso`) and mixed with the
+//! spread over the field's range; translucent, and opaque, `-opaque`),
+//! alone (`--mode iso`) and mixed with the
 //! volume (`--iso` with exact-frag; the exact mode with surfaces draws
 //! the same frame), on bluntfin (default field, TF and camera; skipped when the shared data is absent) and a generated 40^3
 //! warped hex grid, at 512^2 on the default adapter. The fragment visits
@@ -41,19 +42,20 @@ fn scenes() -> Vec<(&'static str, Scene)> {
     out
 }
 
-/// `n` translucent isovalues spread over `(lo, hi)`.
-fn isovalues(n: usize, (lo, hi): (f64, f64)) -> IsoOptions {
+/// `n` isovalues spread over `(lo, hi)`, of opacity `opacity` on both
+/// sides.
+fn isovalues(n: usize, (lo, hi): (f64, f64), opacity: f64) -> IsoOptions {
     IsoOptions {
         surfaces: (1..=n)
             .map(|k| IsoSpec {
                 value: lo + (hi - lo) * k as f64 / (n + 1) as f64,
                 front: SideStyle {
                     color: None,
-                    opacity: 0.3,
+                    opacity,
                 },
                 back: SideStyle {
                     color: None,
-                    opacity: 0.3,
+                    opacity,
                 },
             })
             .collect(),
@@ -92,7 +94,7 @@ fn bench(c: &mut Criterion) {
         // The skip: one isovalue alone against the full volume.
         for (label, opts) in [
             ("volume", options(Mode::ExactFrag, IsoOptions::default())),
-            ("iso-1", options(Mode::Iso, isovalues(1, scene.range))),
+            ("iso-1", options(Mode::Iso, isovalues(1, scene.range, 0.3))),
         ] {
             let (_, stats) = r.render(&shading, &opts, |_, _| {}).unwrap();
             if let ModeStats::Projected(p) = &stats.detail {
@@ -102,12 +104,16 @@ fn bench(c: &mut Criterion) {
                 );
             }
         }
-        for mode in [Mode::Iso, Mode::ExactFrag] {
-            for n in [1, 2, 10, 100] {
-                let opts = options(mode, isovalues(n, scene.range));
-                group.bench_function(format!("{name}/{mode}/{n}"), |b| {
-                    b.iter(|| r.render(&shading, &opts, |_, _| {}).unwrap())
-                });
+        // Translucent (0.3), and opaque (the default style: pieces behind
+        // the surfaces are left out, `render::occlusion`).
+        for (opacity, suffix) in [(0.3, ""), (1.0, "-opaque")] {
+            for mode in [Mode::Iso, Mode::ExactFrag] {
+                for n in [1, 2, 10, 100] {
+                    let opts = options(mode, isovalues(n, scene.range, opacity));
+                    group.bench_function(format!("{name}/{mode}/{n}{suffix}"), |b| {
+                        b.iter(|| r.render(&shading, &opts, |_, _| {}).unwrap())
+                    });
+                }
             }
         }
     }
