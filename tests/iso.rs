@@ -20,11 +20,9 @@ mod render_util;
 
 use glam::DVec3;
 use zoovr::camera::{Camera, CameraParams};
-use zoovr::field::ArrayData;
 use zoovr::generate::{warped_hex_grid, Warp};
 use zoovr::image::Image;
 use zoovr::io::{self, ReadOptions};
-use zoovr::mesh::Mesh;
 use zoovr::raycast::FieldModel;
 use zoovr::render::iso::{IsoMix, IsoOptions, IsoSpec, Lighting};
 use zoovr::render::{
@@ -143,19 +141,8 @@ fn box_scene(n: usize, f: impl Fn(DVec3) -> f64) -> Scene {
             seed: 1,
         },
     );
-    set_field(&mut mesh, f);
+    render_util::set_point_field(&mut mesh, f);
     Scene::build(mesh, &SceneSpec::default()).unwrap()
-}
-
-fn set_field(mesh: &mut Mesh, f: impl Fn(DVec3) -> f64) {
-    let values: Vec<f64> = mesh.points.iter().map(|&p| f(p)).collect();
-    let a = mesh
-        .point_data
-        .iter_mut()
-        .find(|a| a.name == "f")
-        .expect("generated field");
-    a.data = ArrayData::F64(values);
-    a.vtk_type = "Float64".into();
 }
 
 /// The closed-form image of the plane `g . p = v` inside the unit cube,
@@ -267,38 +254,25 @@ fn check_plane(scene: &Scene, g: DVec3, value: f64, opacity: f64) {
                 } else {
                     PLANE_TOL
                 };
-                let (mut checked, mut worst) = (0, 0.0f64);
-                let mut bad = Vec::new();
-                for j in 0..SIZE {
-                    for i in 0..SIZE {
-                        let Some(expect) = plane_pixel(&cam, i, j, g, value, 0.01) else {
-                            continue;
-                        };
-                        let want = match expect {
-                            Some(_) => [light * opacity, 0.0, 0.0, opacity],
-                            None => [0.0; 4],
-                        };
-                        let got = img.pixels[(j * SIZE + i) as usize];
-                        let d = (0..4)
-                            .map(|c| (got[c] as f64 - want[c]).abs())
-                            .fold(0.0, f64::max);
-                        if d > tol {
-                            bad.push((i, j, got, want));
-                        }
-                        worst = worst.max(d);
-                        checked += 1;
-                    }
-                }
+                let c = render_util::against_closed_form(&img, tol, |i, j| {
+                    let expect = plane_pixel(&cam, i, j, g, value, 0.01)?;
+                    Some(match expect {
+                        Some(_) => [light * opacity, 0.0, 0.0, opacity],
+                        None => [0.0; 4],
+                    })
+                });
                 eprintln!(
-                    "plane {value} {lighting:?} ortho={ortho} {name}: max {worst:.2e} over {checked} pixels"
+                    "plane {value} {lighting:?} ortho={ortho} {name}: max {:.2e} over {} pixels",
+                    c.worst, c.checked
                 );
-                assert!(checked > (SIZE * SIZE / 2) as usize);
+                assert!(c.checked > (SIZE * SIZE / 2) as usize);
                 assert!(
-                    worst <= tol,
-                    "plane {value} {lighting:?} ortho={ortho} {name}: {worst:.3e} at {} pixels \
+                    c.worst <= tol,
+                    "plane {value} {lighting:?} ortho={ortho} {name}: {:.3e} at {} pixels \
                      (pixel, got, want): {:?}",
-                    bad.len(),
-                    &bad[..bad.len().min(6)]
+                    c.worst,
+                    c.bad.len(),
+                    &c.bad[..c.bad.len().min(6)]
                 );
             }
         }

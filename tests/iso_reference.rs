@@ -6,14 +6,14 @@
 //! largest difference over every pixel and channel (linear premultiplied
 //! RGBA), with the value measured when it was set.
 
+mod render_util;
+
 use glam::{DMat3, DVec3};
 use zoovr::camera::{Camera, CameraParams};
-use zoovr::field::ArrayData;
 use zoovr::generate::{warped_hex_grid, Warp};
 use zoovr::image::Image;
 use zoovr::integrate::{Material, RayMaterial, SegmentValue};
 use zoovr::io::{self, ReadOptions};
-use zoovr::mesh::Mesh;
 use zoovr::raycast::iso::{Empty, IsoReference};
 use zoovr::raycast::{self, FieldModel, RayTracer, RaycastOptions, Raycaster, Traversal};
 use zoovr::render::iso::{IsoMix, IsoOptions, IsoSet, Lighting};
@@ -35,19 +35,8 @@ fn grid_scene(n: usize, map: impl Fn(DVec3) -> DVec3, f: impl Fn(DVec3) -> f64) 
     for p in &mut mesh.points {
         *p = map(*p);
     }
-    set_field(&mut mesh, f);
+    render_util::set_point_field(&mut mesh, f);
     Scene::build(mesh, &SceneSpec::default()).unwrap()
-}
-
-fn set_field(mesh: &mut Mesh, f: impl Fn(DVec3) -> f64) {
-    let values: Vec<f64> = mesh.points.iter().map(|&p| f(p)).collect();
-    let a = mesh
-        .point_data
-        .iter_mut()
-        .find(|a| a.name == "f")
-        .expect("generated field");
-    a.data = ArrayData::F64(values);
-    a.vtk_type = "Float64".into();
 }
 
 fn iso(list: &str, lighting: Lighting, alone: bool, mix: IsoMix) -> IsoOptions {

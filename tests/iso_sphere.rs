@@ -23,7 +23,6 @@ mod render_util;
 
 use glam::DVec3;
 use zoovr::camera::{Camera, CameraParams};
-use zoovr::field::ArrayData;
 use zoovr::generate::{warped_hex_grid, Warp};
 use zoovr::raycast::FieldModel;
 use zoovr::render::iso::{IsoOptions, Lighting};
@@ -66,14 +65,7 @@ fn sphere_scene() -> Scene {
             seed: 1,
         },
     );
-    let values: Vec<f64> = mesh.points.iter().map(|&p| (p - CENTRE).length()).collect();
-    let a = mesh
-        .point_data
-        .iter_mut()
-        .find(|a| a.name == "f")
-        .expect("generated field");
-    a.data = ArrayData::F64(values);
-    a.vtk_type = "Float64".into();
+    render_util::set_point_field(&mut mesh, |p| (p - CENTRE).length());
     let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
     // A volume of zero extinction: the mixed frames draw the surfaces only.
     let (lo, hi) = scene.range;
@@ -187,37 +179,25 @@ fn check(
             assert_eq!(img.count_non_finite(), 0);
             let f16 = opts.projected.compositor == Compositor::Gpu && gpu_accumulates_f16();
             let tol = if f16 { tol_f16 } else { tol };
-            let (mut checked, mut hits, mut worst) = (0, 0, 0.0f64);
-            let mut bad = Vec::new();
-            for j in 0..SIZE {
-                for i in 0..SIZE {
-                    let Some(hit) = sphere_pixel(&cam, i, j, delta()) else {
-                        continue;
-                    };
-                    let want = want(hit);
-                    let got = img.pixels[(j * SIZE + i) as usize];
-                    let d = (0..4)
-                        .map(|c| (got[c] as f64 - want[c]).abs())
-                        .fold(0.0, f64::max);
-                    if d > tol {
-                        bad.push((i, j, got, want));
-                    }
-                    worst = worst.max(d);
-                    checked += 1;
-                    hits += hit.is_some() as usize;
-                }
-            }
+            let mut hits = 0;
+            let c = render_util::against_closed_form(&img, tol, |i, j| {
+                let hit = sphere_pixel(&cam, i, j, delta())?;
+                hits += hit.is_some() as usize;
+                Some(want(hit))
+            });
             eprintln!(
-                "sphere {list} {lighting:?} ortho={ortho} {name}: max {worst:.2e} over {checked} \
-                 pixels ({hits} on the sphere)"
+                "sphere {list} {lighting:?} ortho={ortho} {name}: max {:.2e} over {} pixels \
+                 ({hits} on the sphere)",
+                c.worst, c.checked
             );
-            assert!(hits > 2000 && checked > (SIZE * SIZE * 9 / 10) as usize);
+            assert!(hits > 2000 && c.checked > (SIZE * SIZE * 9 / 10) as usize);
             assert!(
-                worst <= tol,
-                "sphere {list} {lighting:?} ortho={ortho} {name}: {worst:.3e} at {} pixels \
+                c.worst <= tol,
+                "sphere {list} {lighting:?} ortho={ortho} {name}: {:.3e} at {} pixels \
                  (pixel, got, want): {:?}",
-                bad.len(),
-                &bad[..bad.len().min(6)]
+                c.worst,
+                c.bad.len(),
+                &c.bad[..c.bad.len().min(6)]
             );
         }
     }

@@ -136,3 +136,58 @@ pub fn max_outside(
     }
     worst
 }
+
+/// Sets the generated mesh's point field `f` to `f(p)` at every point.
+pub fn set_point_field(mesh: &mut zoovr::mesh::Mesh, f: impl Fn(DVec3) -> f64) {
+    let values: Vec<f64> = mesh.points.iter().map(|&p| f(p)).collect();
+    let a = mesh
+        .point_data
+        .iter_mut()
+        .find(|a| a.name == "f")
+        .expect("generated field");
+    a.data = zoovr::field::ArrayData::F64(values);
+    a.vtk_type = "Float64".into();
+}
+
+/// A pixel beyond the tolerance: where, what it was, what it should be.
+pub type BadPixel = ((u32, u32), [f32; 4], [f64; 4]);
+
+/// An image against a closed form: the pixels checked, the largest
+/// difference (any channel, linear premultiplied), and the pixels beyond
+/// the tolerance.
+pub struct ClosedForm {
+    pub checked: usize,
+    pub worst: f64,
+    pub bad: Vec<BadPixel>,
+}
+
+/// Compares every pixel of `img` for which `expect` gives a value (`None`:
+/// not checked) with it, beyond `tol` a bad pixel.
+pub fn against_closed_form(
+    img: &zoovr::image::Image,
+    tol: f64,
+    mut expect: impl FnMut(u32, u32) -> Option<[f64; 4]>,
+) -> ClosedForm {
+    let mut out = ClosedForm {
+        checked: 0,
+        worst: 0.0,
+        bad: Vec::new(),
+    };
+    for j in 0..img.height {
+        for i in 0..img.width {
+            let Some(want) = expect(i, j) else {
+                continue;
+            };
+            let got = img.pixels[(j * img.width + i) as usize];
+            let d = (0..4)
+                .map(|c| (got[c] as f64 - want[c]).abs())
+                .fold(0.0, f64::max);
+            if d > tol {
+                out.bad.push(((i, j), got, want));
+            }
+            out.worst = out.worst.max(d);
+            out.checked += 1;
+        }
+    }
+    out
+}
