@@ -568,14 +568,7 @@ fn shells_scene(tau: f64) -> Scene {
         },
     );
     let c = glam::DVec3::new(0.48, 0.52, 0.5);
-    let d: Vec<f64> = mesh.points.iter().map(|&p| (p - c).length()).collect();
-    let f = mesh
-        .point_data
-        .iter_mut()
-        .find(|a| a.name == "f")
-        .expect("generated field");
-    f.data = zoovr::field::ArrayData::F64(d);
-    f.vtk_type = "Float64".into();
+    render_util::set_point_field(&mut mesh, |p| (p - c).length());
     let mut scene = Scene::build(mesh, &SceneSpec::default()).unwrap();
     scene.tf = TransferFunction::from_channels(
         &[(0.0, [tau]), (1.0, [tau])],

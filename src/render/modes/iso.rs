@@ -22,8 +22,8 @@
 //!   like the scalars, so they interpolate exactly;
 //! - **stage**: `shaders/iso_vertex.wgsl`, `shaders/segment.wgsl`, the
 //!   volume's files, the segment with its crossings, and
-//!   `shaders/iso.wgsl` with the entry point `fs_iso` ([`fs_iso`] is its
-//!   twin, on the same volume twins as the segment modes). The segment is
+//!   `shaders/iso.wgsl` with the entry point `fs_iso` (one stage per
+//!   volume, [`super::iso_stages`]; [`fs_iso`] is its twin, on the same volume twins as the segment modes). The segment is
 //!   `shaders/iso_split.wgsl` over a one-line `volume(l, s0, s1)` per
 //!   sub-segment (the table lookup, or zero: [`super::iso_split`]) or, for
 //!   the closed-form integral, `shaders/iso_walk.wgsl`, one walk over the
@@ -33,7 +33,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DVec2, DVec3};
 
 use crate::gpu::cpu::{lerp, CpuStage};
-use crate::gpu::{Binding, ClipMapper, Context, GpuError, GpuVertex, Resource, Stage, StageDesc};
+use crate::gpu::{ClipMapper, Context, GpuError, GpuVertex, Resource, Stage, StageDesc};
 use crate::projection::{Polyhedron, Projected};
 use crate::render::driver::ProjectedMode;
 use crate::render::gradients::{barycentric, boundary_gradient, piece_gradient};
@@ -41,12 +41,13 @@ use crate::render::iso::{IsoMix, IsoSet, Lighting, AMBIENT, DIFFUSE};
 use crate::render::pieces::PieceSource;
 use crate::tf::{EmissionModel, TransferFunction};
 
-use super::exact_frag::{
-    bind_integral_stage, integral_stage, longest_segment, ExactFragTwin, IntegralStages,
-    THIN_CONSTANTS,
-};
+use super::exact_frag::{bind_integral_stage, integral_stage, longest_segment, ExactFragTwin};
 use super::integral::TfBuffer;
 pub use super::iso_levels::{decided_end, gpu_level};
+pub use super::iso_stages::{
+    ISO_EXACT_FRAG_STAGE, ISO_EXACT_FRAG_STAGES, ISO_PREINT2D_CYL_STAGE, ISO_PREINT2D_STAGE,
+    ISO_PREINT3D_STAGE, ISO_STAGE,
+};
 use super::preint::{PreintMode, PreintTwin};
 use super::preint_tables::{TableKind, TableStats};
 use super::segment::{segment_at, ScalarMap, Seg, SegmentPayload, SegmentVertex, SegmentView};
@@ -256,119 +257,6 @@ pub fn iso_buffers(
     }
     (params, surfaces)
 }
-
-macro_rules! iso_stage {
-    ($name:literal, [$($file:literal),*], $glue:literal, $bindings:expr) => {
-        iso_stage!($name, [$($file),*], $glue, $bindings, &[])
-    };
-    ($name:literal, [$($file:literal),*], $glue:literal, $bindings:expr, $constants:expr) => {
-        StageDesc {
-            name: $name,
-            fragment: "fs_iso",
-            wgsl: concat!(
-                include_str!("../../../shaders/iso_vertex.wgsl"),
-                include_str!("../../../shaders/segment_view.wgsl"),
-                include_str!("../../../shaders/segment.wgsl"),
-                $(include_str!(concat!("../../../shaders/", $file)),)*
-                $glue,
-                include_str!("../../../shaders/iso.wgsl"),
-            ),
-            vertex: IsoVertex::LAYOUT,
-            bindings: $bindings,
-            constants: $constants,
-        }
-    };
-}
-
-const INTEGRAL_BINDINGS: &[Binding] = &[
-    Binding::Uniform,
-    Binding::Storage,
-    Binding::Storage,
-    Binding::Uniform,
-    Binding::Storage,
-];
-
-/// `--mode iso`: no volume (the integral's bindings are bound, unused).
-pub static ISO_STAGE: StageDesc = iso_stage!(
-    "iso.wgsl",
-    ["integral.wgsl", "iso_split.wgsl"],
-    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return vec4<f32>(0.0);\n}\n",
-    INTEGRAL_BINDINGS
-);
-
-/// The isosurface stage with exact-frag's volume, as `name` with the
-/// integral's `constants`: one walk over nodes and crossings
-/// (`shaders/iso_walk.wgsl`).
-macro_rules! iso_exact_frag_stage {
-    ($name:literal, $constants:expr) => {
-        iso_stage!(
-            $name,
-            ["integral.wgsl", "iso_walk.wgsl"],
-            "",
-            INTEGRAL_BINDINGS,
-            $constants
-        )
-    };
-}
-
-/// `--iso` with `exact-frag`: the closed-form integral, walked over the
-/// transfer function's nodes and the crossings together.
-pub static ISO_EXACT_FRAG_STAGE: StageDesc = iso_exact_frag_stage!("iso.wgsl+exact_frag", &[]);
-
-/// `--iso` with `exact-frag`, by segment thickness and Gauss rule (as
-/// [`super::exact_frag::EXACT_FRAG_STAGES`]).
-pub static ISO_EXACT_FRAG_STAGES: IntegralStages = IntegralStages {
-    full: &ISO_EXACT_FRAG_STAGE,
-    thin: [
-        &iso_exact_frag_stage!("iso.wgsl+exact_frag+thin4", THIN_CONSTANTS[0]),
-        &iso_exact_frag_stage!("iso.wgsl+exact_frag+thin5", THIN_CONSTANTS[1]),
-        &iso_exact_frag_stage!("iso.wgsl+exact_frag+thin6", THIN_CONSTANTS[2]),
-    ],
-};
-
-/// `--iso` with `preint3d`. The table stages' `volume` looks up each
-/// sub-segment with its centred scalars offset into the table's terms
-/// ([`IsoParams::table_offset`]).
-pub static ISO_PREINT3D_STAGE: StageDesc = iso_stage!(
-    "iso.wgsl+preint3d",
-    ["preint.wgsl", "preint3d.wgsl", "iso_split.wgsl"],
-    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf + iso.table_offset, sb + iso.table_offset, l);\n}\n",
-    &[
-        Binding::Uniform,
-        Binding::Table,
-        Binding::Uniform,
-        Binding::Uniform,
-        Binding::Storage
-    ]
-);
-
-/// `--iso` with `preint2d`.
-pub static ISO_PREINT2D_STAGE: StageDesc = iso_stage!(
-    "iso.wgsl+preint2d",
-    ["preint.wgsl", "preint2d.wgsl", "iso_split.wgsl"],
-    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf + iso.table_offset, sb + iso.table_offset, l);\n}\n",
-    &[
-        Binding::Uniform,
-        Binding::Table,
-        Binding::Uniform,
-        Binding::Uniform,
-        Binding::Storage
-    ]
-);
-
-/// `--iso` with `preint2d-cyl`.
-pub static ISO_PREINT2D_CYL_STAGE: StageDesc = iso_stage!(
-    "iso.wgsl+preint2d_cyl",
-    ["preint.wgsl", "preint2d_cyl.wgsl", "iso_split.wgsl"],
-    "\nfn volume(l: f32, sf: f32, sb: f32) -> vec4<f32> {\n    return preint_segment(sf + iso.table_offset, sb + iso.table_offset, l);\n}\n",
-    &[
-        Binding::Uniform,
-        Binding::Table,
-        Binding::Uniform,
-        Binding::Uniform,
-        Binding::Storage
-    ]
-);
 
 /// The volume between the crossings.
 pub enum Volume {

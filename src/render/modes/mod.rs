@@ -31,6 +31,7 @@ pub mod iso;
 pub mod iso_levels;
 pub mod iso_seams;
 pub mod iso_split;
+pub mod iso_stages;
 pub mod iso_walk;
 pub mod piece_quad;
 pub mod preint;
