@@ -204,6 +204,29 @@ impl TransferFunction {
         (self.s[0], self.s[self.s.len() - 1])
     }
 
+    /// The same function of `s - origin`: every node moved by `-origin`
+    /// (for a field shifted by the same origin). `None` where the rounding
+    /// of the moved nodes would merge two of them (nodes far from the
+    /// origin, closer together than its ulps), so that the shifted function
+    /// is the same one.
+    pub fn shifted(&self, origin: f64) -> Option<TransferFunction> {
+        let mov = |v: &[f64]| v.iter().map(|&x| x - origin).collect::<Vec<f64>>();
+        let (s, breaks) = (mov(&self.s), mov(&self.breaks));
+        let same_order = |a: &[f64], b: &[f64]| {
+            a.windows(2)
+                .zip(b.windows(2))
+                .all(|(a, b)| (a[0] < a[1]) == (b[0] < b[1]))
+        };
+        if !s.iter().all(|x| x.is_finite()) || !same_order(&self.s, &s) {
+            return None;
+        }
+        Some(TransferFunction {
+            s,
+            breaks,
+            ..self.clone()
+        })
+    }
+
     /// Largest extinction of any node (the maximum of the function).
     pub fn max_tau(&self) -> f64 {
         self.tau.iter().copied().fold(0.0, f64::max)
@@ -405,6 +428,40 @@ mod tests {
             color: [c, c, c],
             emission: [0.0; 3],
         }
+    }
+
+    #[test]
+    fn a_shifted_function_is_the_same_function_of_the_moved_scalar() {
+        let o = 1.0;
+        let tf = TransferFunction::from_nodes(
+            &[
+                n(o, 1.0, 0.0),
+                n(o + 0.5e-12, 3.0, 1.0),
+                n(o + 0.5e-12, 10.0, 0.5),
+                n(o + 1e-12, 0.0, 0.5),
+            ],
+            EmissionModel::Glow,
+        )
+        .unwrap();
+        let moved = tf.shifted(o).unwrap();
+        assert_eq!(moved.breakpoints_slice().len(), 3);
+        for k in 0..=8 {
+            let s = o + 0.125e-12 * k as f64;
+            assert_eq!(moved.tau_at(s - o), tf.tau_at(s), "{k}");
+            assert_eq!(moved.color_at(s - o), tf.color_at(s), "{k}");
+        }
+        // Two nodes 1e-6 apart at 1e12 from the origin round together.
+        let far = TransferFunction::from_nodes(
+            &[
+                n(-1e12, 1.0, 0.0),
+                n(-1e12 + 1e-3, 1.0, 0.0),
+                n(0.0, 1.0, 1.0),
+            ],
+            EmissionModel::Glow,
+        )
+        .unwrap();
+        assert!(far.shifted(1e16).is_none());
+        assert!(far.shifted(1.0).is_some());
     }
 
     #[test]
