@@ -35,12 +35,14 @@ const P999: f64 = 1e-2;
 /// Isosurfaces against the ray caster's: a pixel is off beyond 2/255.
 const ISO_PIXEL_TOL: f64 = 2.0 / 255.0;
 /// Pixels off per view (surface silhouettes and the edges of faces that
-/// hold the isovalue may differ on single pixels). Measured up to 2, in
-/// the field spanning 1e-12 around 1 (up to 38 before the reference moved
-/// such a field's scalars to an origin in its middle,
-/// `zoovr::render::iso::reference_origin`: interpolating the raw values,
-/// whose ulps are 2.2e-4 of that range, moved its crossings).
-const ISO_OFF_MAX: usize = 8;
+/// hold the isovalue may differ on single pixels). Measured 0 in every
+/// scene and view, Vulkan and GL; the field spanning 1e-12 around 1 had
+/// up to 38 before every renderer moved such a field's scalars to an
+/// origin in its middle (`zoovr::render::origin`: interpolating the raw
+/// values, whose ulps are 2.2e-4 of that range, moved the reference's
+/// crossings, and the projected modes' decisions at shared faces read
+/// them too).
+const ISO_OFF_MAX: usize = 2;
 const RMS: f64 = 2e-3;
 /// exact-frag whole cells against `faces`: cells with nonplanar faces are
 /// drawn as tets (model difference, measured up to 4.86e-2).

@@ -300,28 +300,6 @@ pub struct IsoSet {
     pub mix: IsoMix,
 }
 
-/// The origin the reference ray caster moves a field's scalars by before
-/// it interpolates them (with its transfer function and isovalues): the
-/// middle of the finite values' range, where `f64` cannot place a surface
-/// within the span margin of the levels from the raw values, that is where
-/// [`ISO_LEVEL_ULPS`] ulps of the middle exceed [`ISO_LEVEL_F64`] of the
-/// span (a field more than about 1100 times as far from zero as it is
-/// wide). `None` elsewhere, and for fields without two different finite
-/// values.
-pub fn reference_origin(values: &[f64]) -> Option<f64> {
-    let (lo, hi) = values
-        .iter()
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        });
-    let (span, mid) = (hi - lo, 0.5 * lo + 0.5 * hi);
-    (span > 0.0
-        && span.is_finite()
-        && ISO_LEVEL_ULPS * f64::EPSILON * mid.abs() > ISO_LEVEL_F64 * span)
-        .then_some(mid)
-}
-
 impl IsoSet {
     /// Resolves `opts` against `tf`.
     pub fn new(opts: &IsoOptions, tf: &TransferFunction) -> IsoSet {
@@ -491,25 +469,6 @@ mod tests {
                 .collect(),
             lighting: Lighting::None,
             mix: IsoMix::Exact,
-        }
-    }
-
-    #[test]
-    fn the_reference_moves_only_fields_far_from_zero_next_to_their_span() {
-        let narrow: Vec<f64> = (0..=10).map(|k| 1.0 + 1e-13 * k as f64).collect();
-        let o = reference_origin(&narrow).unwrap();
-        assert!((o - (1.0 + 0.5e-12)).abs() <= 2.0 * f64::EPSILON);
-        // Every moved value is exact (within a factor two of the origin).
-        assert!(narrow.iter().all(|&v| (v - o) + o == v));
-        // NaN is left out of the range; the rest is as before.
-        let mut with_nan = narrow.clone();
-        with_nan.push(f64::NAN);
-        assert_eq!(reference_origin(&with_nan), Some(o));
-        // 1e3 times as far as wide: the span margin still holds.
-        assert_eq!(reference_origin(&[1e3, 1e3 + 1.0]), None);
-        assert!(reference_origin(&[1e4, 1e4 + 1.0]).is_some());
-        for unmoved in [&[0.0, 1.0][..], &[-5.0, 7.0], &[3.0, 3.0], &[], &[f64::NAN]] {
-            assert_eq!(reference_origin(unmoved), None, "{unmoved:?}");
         }
     }
 

@@ -26,6 +26,7 @@ pub mod modes;
 pub mod occlusion;
 mod options;
 mod order_cache;
+pub mod origin;
 pub mod pieces;
 mod projected_mode;
 pub mod scene;
@@ -150,6 +151,8 @@ pub struct Renderer {
     kept: Option<driver::kept::KeptProjection>,
     /// Each part's regions, with `keep_regions` ([`driver::regions`]).
     regions: driver::regions::RegionStore,
+    /// The last field moved to its origin ([`origin`]).
+    moved: origin::MovedField,
 }
 
 impl Renderer {
@@ -165,6 +168,7 @@ impl Renderer {
             pending_gpu: None,
             kept: None,
             regions: Default::default(),
+            moved: Default::default(),
         }
     }
 
@@ -301,6 +305,12 @@ impl Renderer {
             });
         }
         shading.check(&self.geometry)?;
+        // A field far from zero next to its span is rendered from offsets.
+        let moved = self.moved.frame(shading, opts);
+        let (shading, opts) = match &moved {
+            Some((s, o)) => (s, o),
+            None => (shading, opts),
+        };
         // The frame's scene: the geometry and the field shared, not copied.
         let scene = Scene::new(self.geometry.clone(), shading.clone());
         let (image, detail, setup_s) = match opts.mode {
@@ -393,6 +403,7 @@ impl Renderer {
             pending_gpu,
             kept,
             regions,
+            moved: _,
         } = self;
         // The min/max tree, for the occlusion pass where it may hide
         // something (the visible subset builds it anyway).

@@ -4,7 +4,6 @@
 //! boundary and bounding-volume hierarchy, or the brute force's pieces) are
 //! built per frame: they hold the frame's scalars.
 
-use std::borrow::Cow;
 use std::time::Instant;
 
 use crate::camera::Camera;
@@ -13,11 +12,11 @@ use crate::raycast::brute::Brute;
 use crate::raycast::iso::{BruteIsoReference, Empty, IsoReference};
 use crate::raycast::{self, RayTracer, RaycastOptions, Raycaster, Traversal};
 use crate::render::gradients::point_gradients;
-use crate::render::iso::{reference_origin, IsoError, IsoOptions, IsoSet, Lighting};
+use crate::render::iso::{IsoError, IsoSet, Lighting};
 use crate::render::scene::{ScalarsRef, Scene};
 use crate::render::stats::RaycastStats;
 use crate::render::{RenderError, RenderOptions};
-use crate::tf::{EmissionModel, TransferFunction};
+use crate::tf::EmissionModel;
 
 use super::ModeInfo;
 
@@ -104,6 +103,11 @@ pub fn render_iso(
     let ScalarsRef::Point(values) = scene.scalars() else {
         return Err(IsoError::CellData.into());
     };
+    let rs = raycast::Scene {
+        mesh: &scene.mesh,
+        topology: &scene.topology,
+        scalars: raycast::Scalars::Point(values),
+    };
     let ro = RaycastOptions {
         model: opts.reference.model,
         traversal: opts.reference.traversal,
@@ -114,15 +118,8 @@ pub fn render_iso(
         },
         ..Default::default()
     };
-    let shift = Shifted::new(values, &scene.tf, &opts.iso);
-    let (values, tf) = (&shift.values[..], &*shift.tf);
-    let set = IsoSet::new(&shift.iso, tf);
+    let set = IsoSet::new(&opts.iso, &scene.tf);
     let grads = (set.lighting == Lighting::Smooth).then(|| point_gradients(&scene.mesh, values));
-    let rs = raycast::Scene {
-        mesh: &scene.mesh,
-        topology: &scene.topology,
-        scalars: raycast::Scalars::Point(values),
-    };
     let mut native = Default::default();
     let mut brute = Default::default();
     let (setup_s, (img, terminated_rays)) = match opts.reference.traversal {
@@ -132,7 +129,7 @@ pub fn render_iso(
             let setup_s = t0.elapsed().as_secs_f64();
             let before = rc.native_stats();
             let out = if volume {
-                iso.render_counting(tf, camera, &ro, progress)
+                iso.render_counting(&scene.tf, camera, &ro, progress)
             } else {
                 iso.render_counting(&Empty, camera, &ro, progress)
             };
@@ -145,7 +142,7 @@ pub fn render_iso(
             let setup_s = t0.elapsed().as_secs_f64();
             let before = b.stats();
             let out = if volume {
-                iso.render_counting(tf, camera, &ro, progress)
+                iso.render_counting(&scene.tf, camera, &ro, progress)
             } else {
                 iso.render_counting(&Empty, camera, &ro, progress)
             };
@@ -162,45 +159,4 @@ pub fn render_iso(
         brute,
     };
     Ok((img, stats, setup_s))
-}
-
-/// The reference's scalars, transfer function and isovalues, moved
-/// together by an origin in the middle of the field where the field's
-/// values lie far from zero next to their span
-/// ([`crate::render::iso::reference_origin`]): the ray caster interpolates
-/// the scalars in `f64`, and a field spanning 1e-12 around 1 has only about
-/// 4500 values in its range, so its crossings moved by a few thousandths
-/// of the range. The moved values are exact (Sterbenz) wherever they lie
-/// within a factor two of the origin, and every quantity of the image (the
-/// transfer function's pieces, the surfaces' places, colours and
-/// gradients) is the same function of the moved scalar.
-struct Shifted<'a> {
-    values: Cow<'a, [f64]>,
-    tf: Cow<'a, TransferFunction>,
-    iso: Cow<'a, IsoOptions>,
-}
-
-impl<'a> Shifted<'a> {
-    fn new(values: &'a [f64], tf: &'a TransferFunction, iso: &'a IsoOptions) -> Shifted<'a> {
-        let unmoved = Shifted {
-            values: Cow::Borrowed(values),
-            tf: Cow::Borrowed(tf),
-            iso: Cow::Borrowed(iso),
-        };
-        let Some(origin) = reference_origin(values) else {
-            return unmoved;
-        };
-        let Some(moved_tf) = tf.shifted(origin) else {
-            return unmoved;
-        };
-        let mut moved_iso = iso.clone();
-        for s in &mut moved_iso.surfaces {
-            s.value -= origin;
-        }
-        Shifted {
-            values: Cow::Owned(values.iter().map(|&v| v - origin).collect()),
-            tf: Cow::Owned(moved_tf),
-            iso: Cow::Owned(moved_iso),
-        }
-    }
 }
