@@ -73,7 +73,8 @@ pub struct AnimateArgs {
     /// looping forever).
     #[arg(long, value_name = "FILE")]
     pub gif: Option<PathBuf>,
-    /// Also write an MP4 (H.264) of the frames, encoded by ffmpeg from PATH.
+    /// Also write an MP4 (H.264, Constrained Baseline) of the frames,
+    /// encoded in process (OpenH264); odd sizes are padded by one pixel.
     #[arg(long, value_name = "FILE")]
     pub mp4: Option<PathBuf>,
     /// Frames per second of the GIF and MP4.
@@ -366,7 +367,7 @@ fn render_series(args: &AnimateArgs, series: &Path, out: &Path) -> Result<()> {
         );
     let frames = plan(args, series, &steps)?;
     if args.mp4.is_some() {
-        assemble::check_mp4_encoder()?;
+        assemble::check_mp4_size(args.view.size)?;
     }
     std::fs::create_dir_all(out)
         .with_context(|| format!("{}: cannot make the output folder", out.display()))?;

@@ -22,9 +22,10 @@ pub struct AssembleArgs {
     pub only: Option<Vec<usize>>,
 }
 
-/// Fails early, before rendering, when `--mp4` cannot be written.
-pub fn check_mp4_encoder() -> Result<()> {
-    video::mp4::find_encoder()?;
+/// Fails early, before rendering, when `--mp4` cannot hold frames of
+/// `width x height` (the encoder's largest frame).
+pub fn check_mp4_size((width, height): (u32, u32)) -> Result<()> {
+    video::mp4::check_size(width, height).context("--mp4")?;
     Ok(())
 }
 

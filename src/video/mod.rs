@@ -1,4 +1,5 @@
-//! Animations from frames: an animated GIF ([`gif`]) and an MP4 ([`mp4`]).
+//! Animations from frames: an animated GIF ([`gif`]) and an MP4 ([`mp4`],
+//! H.264 encoded in process).
 //!
 //! Both take the frames as 8-bit RGB, fetched one at a time by index, so a
 //! long run never holds every frame in memory, and both write to a
@@ -19,8 +20,6 @@ pub enum VideoError {
     Write { path: PathBuf, msg: String },
     #[error("{0}")]
     Invalid(String),
-    #[error("{0}")]
-    NoEncoder(String),
 }
 
 /// The temporary file written before it is renamed to `path`.
