@@ -14,8 +14,9 @@
 //! 10 frames per second gets 1.3 Mbit/s), in OpenH264's quality mode, and
 //! a key frame every [`KEY_FRAME_SECONDS`] so a player can seek. Should
 //! the rate control skip a frame (not seen at these rates), the previous
-//! picture stays on screen for its time. Frames up to [`MAX_SIZE`]. Sample times are in a 90 kHz time base, each frame's start
-//! rounded from `index / fps`, so fractional rates (29.97) do not drift.
+//! picture stays on screen for its time. Frames up to [`MAX_SIZE`].
+//! Sample times are in a 90 kHz time base, each frame's start rounded
+//! from `index / fps`, so fractional rates (29.97) do not drift.
 //! The encoder is single-threaded, so the same frames give the same file,
 //! byte for byte.
 
