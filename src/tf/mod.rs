@@ -450,7 +450,8 @@ mod tests {
             assert_eq!(moved.tau_at(s - o), tf.tau_at(s), "{k}");
             assert_eq!(moved.color_at(s - o), tf.color_at(s), "{k}");
         }
-        // Two nodes 1e-6 apart at 1e12 from the origin round together.
+        // Two nodes 1e-3 apart, 1e12 from zero: moved by 1e16 (ulp 2) they
+        // round together; moved by 1 they stay apart.
         let far = TransferFunction::from_nodes(
             &[
                 n(-1e12, 1.0, 0.0),
