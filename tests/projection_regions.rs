@@ -177,6 +177,7 @@ fn hex_from_view(c: [DVec3; 8]) -> Polyhedron {
         scalars: (0..8).map(|i| i as f64 * 0.25).collect(),
         triangles: Vec::new(),
         gradients: Vec::new(),
+        holes: Vec::new(),
         world: Vec::new(),
     };
     cells.for_each_face(0, |_, f| {
@@ -294,6 +295,7 @@ fn vertex_on_edge_and_vertex_on_vertex() {
             scalars: vec![0.0, 1.0, 2.0, 3.0, 4.0],
             triangles: Vec::new(),
             gradients: Vec::new(),
+            holes: Vec::new(),
             world: Vec::new(),
         };
         cells.for_each_face(0, |_, f| {

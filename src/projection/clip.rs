@@ -322,6 +322,7 @@ mod tests {
             scalars,
             triangles: tris,
             gradients: Vec::new(),
+            holes: Vec::new(),
             world,
         };
         poly.orient_outward();

@@ -45,11 +45,20 @@ pub struct Polyhedron {
     /// cuts, with the same canonical edge order and weight as the view
     /// position.
     pub world: Vec<DVec3>,
+    /// Points whose scalar is not a number in the field, ascending: their
+    /// entries in `scalars` (and `gradients`) are finite stand-ins, and a
+    /// boundary triangle holding one has no scalar anywhere, so every ray
+    /// entering or leaving the piece through it is empty, as the
+    /// reference's segments with a NaN end are (the driver leaves out the
+    /// regions in front of or behind such a triangle). Set by the piece's
+    /// source for whole cells ([`crate::render::pieces`]); empty elsewhere.
+    pub holes: Vec<u32>,
 }
 
 impl Polyhedron {
     /// Empties the piece, keeping its allocations.
     pub fn clear(&mut self) {
+        self.holes.clear();
         self.points.clear();
         self.scalars.clear();
         self.triangles.clear();

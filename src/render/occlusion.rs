@@ -659,8 +659,8 @@ fn cell_credit(
 ) {
     let mesh = src.mesh;
     let nodes = mesh.cells.nodes(c as usize);
-    // A cell with a non-finite scalar is drawn empty (`PieceSource::parts`):
-    // it hides nothing.
+    // A cell with a non-finite scalar is drawn empty or with holes
+    // (`PieceSource::parts`): it hides nothing.
     if src.field_span.is_none() && nodes.iter().any(|&p| !src.scalar(c, p).is_finite()) {
         return;
     }

@@ -11,8 +11,13 @@
 //!   breakpoints its slabs (back to front along the tet's gradient,
 //!   [`tet_slabs`], the slab expansion the order uses too). Pieces whose scalar range maps to zero extinction
 //!   everywhere are left out ([`PieceSource::invisible`]): they neither emit
-//!   nor absorb in the glow model; so are pieces with a non-finite scalar
-//!   at a node, empty as the reference's segments with a NaN end are. The tet of consecutive slabs is built
+//!   nor absorb in the glow model; so are tets, slabs and fragments with a
+//!   non-finite scalar at a corner, empty as the reference's segments with
+//!   a NaN end are, and whole cells with an infinite one. A whole cell with
+//!   NaN corners keeps the rays between two of its boundary triangles
+//!   without one: its NaN points become the part's holes
+//!   ([`Polyhedron::holes`], finite stand-ins in their place), whose
+//!   triangles the driver leaves out. The tet of consecutive slabs is built
 //!   once ([`PartScratch`]).
 
 use super::ties::TieRays;
@@ -53,6 +58,36 @@ pub fn value_range(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(v), hi.max(v))
         })
+}
+
+/// Marks the points of `poly` whose scalar is NaN as its holes
+/// ([`Polyhedron::holes`]), with another point's scalar and a zero
+/// gradient as their stand-ins (finite, so that projection and
+/// payload run; the driver draws no region whose front or back triangle
+/// holds a hole). False where no scalar is a number: nothing to draw.
+fn mark_holes(poly: &mut Polyhedron) -> bool {
+    poly.holes.clear();
+    let mut stand_in = None;
+    for (i, s) in poly.scalars.iter().enumerate() {
+        if s.is_nan() {
+            poly.holes.push(i as u32);
+        } else {
+            stand_in = stand_in.or(Some(*s));
+        }
+    }
+    if poly.holes.is_empty() {
+        return true;
+    }
+    let Some(stand_in) = stand_in else {
+        return false;
+    };
+    for &h in &poly.holes {
+        poly.scalars[h as usize] = stand_in;
+        if let Some(g) = poly.gradients.get_mut(h as usize) {
+            *g = DVec3::ZERO;
+        }
+    }
+    true
 }
 
 /// What a view needs to turn pieces into polyhedra; see the module docs.
@@ -183,19 +218,26 @@ impl PieceSource<'_> {
     ) -> Result<Parts, PieceError> {
         let cell = piece.cell();
         let mut done = Parts::default();
-        // A piece with a non-finite scalar at a node is drawn empty. The
+        // A tet with a non-finite scalar at a corner is drawn empty. The
         // reference integrates a segment with a NaN end as nothing
         // (`integrate::segment`), and every ray through a tet with a NaN
         // corner enters or leaves it through a face holding that corner,
-        // so such a tet is empty to the `tets` field exactly; the `faces`
+        // so such a tet is empty to the `tets` field exactly. The `faces`
         // field of a whole cell keeps the rays between two faces without
-        // it, and the reference clamps infinities to 1e300 (README, "Bad
-        // values").
+        // it: a whole cell with NaN corners is drawn with them as holes
+        // ([`Polyhedron::holes`]). The reference clamps infinities to
+        // 1e300, which `f32` stages cannot: a piece with an infinite
+        // scalar is drawn empty (README, "Bad values").
         // (Only looked at where the field has such a value: its span.)
         let finite = |n: &u32| self.scalar(cell, *n).is_finite();
         let all_finite = self.field_span.is_some()
             || match *piece {
-                Piece::Cell(c) => self.mesh.cells.nodes(c as usize).iter().all(finite),
+                Piece::Cell(c) => self
+                    .mesh
+                    .cells
+                    .nodes(c as usize)
+                    .iter()
+                    .all(|&n| !self.scalar(c, n).is_infinite()),
                 Piece::Tet { tet, .. } | Piece::Slab { tet, .. } | Piece::Frag { tet, .. } => {
                     tet.iter().all(finite)
                 }
@@ -221,6 +263,10 @@ impl PieceSource<'_> {
                 }
                 self.cell(c, poly)?;
                 self.point_gradients(nodes.iter().copied(), poly);
+                if self.field_span.is_none() && !mark_holes(poly) {
+                    done.invisible = true;
+                    return Ok(done);
+                }
                 draw(poly)?;
             }
             Piece::Tet { tet, .. } => {

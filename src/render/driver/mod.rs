@@ -194,6 +194,9 @@ struct Worker<P, V> {
     /// triangles of the centres next to the outline ([`super::ties`]).
     drawn: Vec<DrawnTriangle>,
     ties: TieScratch,
+    /// Whether each boundary triangle of a part with holes holds one
+    /// ([`leave_out_holes`]).
+    hole_faces: Vec<bool>,
     /// The transfer function's largest rate anywhere (a bound on every
     /// part's, [`PieceSource::max_rate`]).
     rate_bound: f64,
@@ -220,6 +223,7 @@ impl<P: Default, V> Worker<P, V> {
             snap: Vec::new(),
             drawn: Vec::new(),
             ties: TieScratch::default(),
+            hole_faces: Vec::new(),
             rate_bound: {
                 let (lo, hi) = src.tf.scalar_range();
                 src.max_rate(lo, hi)
@@ -246,10 +250,16 @@ fn draw_part<M: ProjectedMode>(
     // not settle a question.
     let part_rate_once = std::cell::OnceCell::new();
     let rate = || *part_rate_once.get_or_init(|| part_rate(src, part));
-    if let Some(v) = mode.whole_part(src, part, &mut w.payload, &rate) {
-        draw_whole(src.camera, part, v, out);
-        return Ok(());
+    let holes = !part.holes.is_empty();
+    if !holes {
+        if let Some(v) = mode.whole_part(src, part, &mut w.payload, &rate) {
+            draw_whole(src.camera, part, v, out);
+            return Ok(());
+        }
     }
+    // A part with holes is projected afresh every frame (which regions it
+    // draws depends on where its scalars are NaN).
+    let store = store.filter(|_| !holes);
     match (store, key) {
         (Some(store), Some((cell, pk))) => {
             let kept = store.get(cell, pk, part);
@@ -265,7 +275,18 @@ fn draw_part<M: ProjectedMode>(
         }
         _ => w.projector.project(part, src.camera, &mut w.proj)?,
     }
+    // The faces the regions index are those of the part beyond the near
+    // plane when it reached it.
+    let projected = w.projector.projected_piece(part);
     let proj = &mut w.proj;
+    if holes {
+        // Clipped at the near plane, the points are no longer the part's:
+        // drawn empty, as a tet with a NaN corner is.
+        if !std::ptr::eq(projected, part) {
+            return Ok(());
+        }
+        leave_out_holes(part, proj, &mut w.hole_faces);
+    }
     if proj.triangles.is_empty() {
         return Ok(());
     }
@@ -279,9 +300,6 @@ fn draw_part<M: ProjectedMode>(
             used[i as usize] = true;
         }
     }
-    // The faces the regions index are those of the part beyond the near
-    // plane when it reached it.
-    let projected = w.projector.projected_piece(part);
     mode.payload(src, projected, proj, used, &mut w.payload, &mut out.refined);
     let mapper = ClipMapper::for_camera(src.camera);
     let piece = out.pieces;
@@ -367,6 +385,15 @@ fn draw_part<M: ProjectedMode>(
     scan_triangles(&part_tris, ties && !thin, &mut w.ties);
     if ties {
         decide_ties(&part_tris, !thin, part, &src.ties, &mut w.ties);
+        if holes {
+            // A centre whose ray enters or leaves through a triangle
+            // holding a hole is empty: a blocker.
+            for d in &mut w.ties.decisions {
+                if d.value.is_some() && d.faces.iter().any(|&f| w.hole_faces[f as usize]) {
+                    d.value = None;
+                }
+            }
+        }
         out.tie_pixels += emit_tie_triangles(mode, src, part, piece, &mapper, w, out);
     }
     for d in w.drawn.iter() {
@@ -381,6 +408,39 @@ fn draw_part<M: ProjectedMode>(
         }
     }
     Ok(())
+}
+
+/// Leaves out of `proj` the triangles of the regions whose front or back
+/// boundary triangle holds one of `part`'s holes ([`Polyhedron::holes`]):
+/// no ray through them has a scalar at both ends. `hole_faces` is set to
+/// whether each boundary triangle holds one. The part's outline then runs
+/// along the holes too, so the centres next to them are decided on the
+/// exact geometry (the ties, which give a centre whose ray meets a hole's
+/// triangle a blocker), and the outline is not left to the rasteriser.
+fn leave_out_holes(part: &Polyhedron, proj: &mut Projected, hole_faces: &mut Vec<bool>) {
+    hole_faces.clear();
+    hole_faces.extend(
+        part.triangles
+            .iter()
+            .map(|t| t.iter().any(|i| part.holes.binary_search(i).is_ok())),
+    );
+    let bad = |f: u32| hole_faces.get(f as usize).copied().unwrap_or(true);
+    let mut w = 0;
+    for r in 0..proj.triangles.len() {
+        let region = proj.triangle_region[r] as usize;
+        let keep = proj
+            .region_faces
+            .get(region)
+            .is_some_and(|&[front, back]| !bad(front) && !bad(back));
+        if keep {
+            proj.triangles[w] = proj.triangles[r];
+            proj.triangle_region[w] = proj.triangle_region[r];
+            w += 1;
+        }
+    }
+    proj.triangles.truncate(w);
+    proj.triangle_region.truncate(w);
+    proj.outline_profile = false;
 }
 
 /// The largest rate on `part`'s scalar range.
