@@ -480,7 +480,7 @@ fn nan_values_are_rendered_with_a_warning() {
     let file = dir.path().join("nan.vtu");
     write_vtu(&file, &m, Compression::None).unwrap();
     for (mode, says) in [
-        ("exact-frag", "drawn empty"),
+        ("exact-frag", "through a face holding a NaN are empty"),
         ("raycast", "NaN end are empty"),
     ] {
         let o = render(&file, &out, &["--size", "24x24", "--mode", mode]);

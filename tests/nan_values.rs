@@ -1,8 +1,9 @@
 //! Fields with NaN and infinite values ("Bad values" in README): every
-//! projected mode renders them (no error), a part holding a non-finite
-//! scalar is drawn empty, and split into tets that is the reference's
-//! image (`--model tets`: a ray through a tet with a NaN corner has a NaN
-//! end, an empty segment), at every pixel.
+//! projected mode renders them (no error); a tet holding a non-finite
+//! scalar is drawn empty, which split into tets is the reference's image
+//! (`--model tets`: a ray through a tet with a NaN corner has a NaN end,
+//! an empty segment), at every pixel; a whole cell keeps the rays between
+//! its boundary triangles without a NaN corner, as the `faces` field does.
 //!
 //! The projected modes run on their CPU twin, so no adapter is needed.
 

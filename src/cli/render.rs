@@ -267,7 +267,9 @@ impl ViewArgs {
         };
         let n = field.values.iter().filter(|v| !v.is_finite()).count();
         let what = if self.mode.info().gpu {
-            "the cells (or tets, slabs) holding one are drawn empty"
+            "ray segments entering or leaving a cell through a face holding a NaN are empty \
+             (a tet, slab or cell cut by the near plane with one wholly), \
+             cells with an infinite value are empty"
         } else {
             "ray segments with a NaN end are empty, infinities are clamped to 1e300"
         };
