@@ -17,7 +17,7 @@ use zoovr::io::{self, ReadOptions};
 use zoovr::raycast::FieldModel;
 use zoovr::render::iso::{IsoOptions, IsoSpec, SideStyle};
 use zoovr::render::{
-    Compositor, Geometry, Mode, ModeStats, RenderOptions, Renderer, SceneSpec, Shading,
+    Compositor, Geometry, Mode, ModeStats, PieceDraw, RenderOptions, Renderer, SceneSpec, Shading,
 };
 use zoovr::testdata::mesh_file;
 use zoovr::tf::{EmissionModel, TransferFunction};
@@ -204,8 +204,16 @@ fn whole_cells_with_nan_corners_keep_their_rays() {
                     Mode::Preint2dCyl,
                 ]
             };
-            for &mode in modes {
-                let o = opts(mode, false);
+            // exact-frag also with its pieces drawn whole (a part with
+            // holes is projected as regions instead).
+            let runs = modes.iter().map(|&m| (m, PieceDraw::Auto)).chain(
+                [(Mode::ExactFrag, PieceDraw::Quads)]
+                    .into_iter()
+                    .filter(|_| !with_iso),
+            );
+            for (mode, piece_draw) in runs {
+                let mut o = opts(mode, false);
+                o.projected.piece_draw = piece_draw;
                 let img = renderer.render(&nan, &o, |_, _| {}).unwrap().0;
                 assert_eq!(img.count_non_finite(), 0);
                 let split = render_util::split_cells(&renderer, geometry.mesh.cells.len());
@@ -214,7 +222,7 @@ fn whole_cells_with_nan_corners_keep_their_rays() {
                 let (worst, at) = render_util::max_outside(&img, &reference, &mask);
                 if worst > 2.0 / 255.0 {
                     failures.push(format!(
-                        "{mode:?} ortho {ortho} iso {with_iso}: {worst} at {at:?}"
+                        "{mode:?} {piece_draw:?} ortho {ortho} iso {with_iso}: {worst} at {at:?}"
                     ));
                 }
             }
