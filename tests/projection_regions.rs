@@ -446,3 +446,53 @@ fn vertex_values_equal_ray_hits() {
     }
     assert!(checked > 2000, "{checked} vertices checked");
 }
+
+/// `Projected::leave_out_regions_on` keeps exactly the triangles of the
+/// regions whose front and back triangles are not flagged (the regions of
+/// a whole cell with a NaN corner: its holes' triangles flagged).
+#[test]
+fn regions_on_flagged_faces_are_left_out() {
+    let cam = ortho_camera();
+    let mut rng = Rng(11);
+    for _ in 0..20 {
+        let (jx, jy) = (0.1 * (rng.f64() - 0.5), 0.1 * (rng.f64() - 0.5));
+        let c = cube(|p| {
+            let q = p + DVec3::new(-0.5, -0.5, 2.0);
+            DVec3::new(
+                q.x + 0.3 * q.z + jx * q.y,
+                q.y + 0.2 * q.z + jy * q.x,
+                q.z + 0.4 * q.x,
+            )
+        });
+        let poly = hex_from_view(c);
+        let mut out = Projected::default();
+        projector().project(&poly, &cam, &mut out).unwrap();
+        let before: Vec<([u32; 3], u32)> = out
+            .triangles
+            .iter()
+            .copied()
+            .zip(out.triangle_region.iter().copied())
+            .collect();
+        // The boundary triangles holding point 3 (as a NaN at point 3).
+        let flags: Vec<bool> = poly.triangles.iter().map(|t| t.contains(&3)).collect();
+        out.leave_out_regions_on(&flags);
+        let clear = |r: u32| {
+            let [f, b] = out.region_faces[r as usize];
+            !flags[f as usize] && !flags[b as usize]
+        };
+        let expected: Vec<([u32; 3], u32)> =
+            before.iter().copied().filter(|&(_, r)| clear(r)).collect();
+        let kept: Vec<([u32; 3], u32)> = out
+            .triangles
+            .iter()
+            .copied()
+            .zip(out.triangle_region.iter().copied())
+            .collect();
+        assert_eq!(kept, expected);
+        assert!(
+            kept.len() < before.len(),
+            "point 3 is on the outline or inside"
+        );
+        assert!(!out.outline_profile);
+    }
+}

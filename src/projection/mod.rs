@@ -496,6 +496,31 @@ impl Projected {
         self.outline_inputs = [false; 2];
     }
 
+    /// Leaves out the triangles of the regions whose front or back
+    /// boundary triangle is flagged in `faces` (indexed as
+    /// [`Projected::faces`]; one beyond it counts as flagged), and marks
+    /// the outline as no longer the piece's ([`Projected::outline_profile`]
+    /// false): the rays through those regions are not drawn.
+    pub fn leave_out_regions_on(&mut self, faces: &[bool]) {
+        let flagged = |f: u32| faces.get(f as usize).copied().unwrap_or(true);
+        let mut w = 0;
+        for r in 0..self.triangles.len() {
+            let region = self.triangle_region[r] as usize;
+            let keep = self
+                .region_faces
+                .get(region)
+                .is_some_and(|&[front, back]| !flagged(front) && !flagged(back));
+            if keep {
+                self.triangles[w] = self.triangles[r];
+                self.triangle_region[w] = self.triangle_region[r];
+                w += 1;
+            }
+        }
+        self.triangles.truncate(w);
+        self.triangle_region.truncate(w);
+        self.outline_profile = false;
+    }
+
     /// Each vertex's [`coverage::Span`]: the pixel centres within
     /// [`crate::numeric::tolerance::COVERAGE_MARGIN_PX`] of it per axis, as
     /// [`Projected::cull_to_pixels`] left them; `None` where the projection

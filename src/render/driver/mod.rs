@@ -389,7 +389,8 @@ fn draw_part<M: ProjectedMode>(
             // A centre whose ray enters or leaves through a triangle
             // holding a hole is empty: a blocker.
             for d in &mut w.ties.decisions {
-                if d.value.is_some() && d.faces.iter().any(|&f| w.hole_faces[f as usize]) {
+                let hole = |f: &u32| w.hole_faces.get(*f as usize).copied().unwrap_or(true);
+                if d.value.is_some() && d.faces.iter().any(hole) {
                     d.value = None;
                 }
             }
@@ -410,8 +411,8 @@ fn draw_part<M: ProjectedMode>(
     Ok(())
 }
 
-/// Leaves out of `proj` the triangles of the regions whose front or back
-/// boundary triangle holds one of `part`'s holes ([`Polyhedron::holes`]):
+/// Leaves out of `proj` the regions in front of or behind a boundary
+/// triangle of `part` that holds one of its holes ([`Polyhedron::holes`]):
 /// no ray through them has a scalar at both ends. `hole_faces` is set to
 /// whether each boundary triangle holds one. The part's outline then runs
 /// along the holes too, so the centres next to them are decided on the
@@ -424,23 +425,7 @@ fn leave_out_holes(part: &Polyhedron, proj: &mut Projected, hole_faces: &mut Vec
             .iter()
             .map(|t| t.iter().any(|i| part.holes.binary_search(i).is_ok())),
     );
-    let bad = |f: u32| hole_faces.get(f as usize).copied().unwrap_or(true);
-    let mut w = 0;
-    for r in 0..proj.triangles.len() {
-        let region = proj.triangle_region[r] as usize;
-        let keep = proj
-            .region_faces
-            .get(region)
-            .is_some_and(|&[front, back]| !bad(front) && !bad(back));
-        if keep {
-            proj.triangles[w] = proj.triangles[r];
-            proj.triangle_region[w] = proj.triangle_region[r];
-            w += 1;
-        }
-    }
-    proj.triangles.truncate(w);
-    proj.triangle_region.truncate(w);
-    proj.outline_profile = false;
+    proj.leave_out_regions_on(hole_faces);
 }
 
 /// The largest rate on `part`'s scalar range.
