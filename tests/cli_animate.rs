@@ -27,6 +27,12 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// `zoovr animate --assemble DIR FLAG OUT --fps FPS`: the frames of `dir`
+/// assembled into a GIF or MP4 (`flag`).
+fn assemble(dir: &Path, flag: &str, out: &Path, fps: &str) -> Output {
+    zoovr(&["animate", "--assemble", s(dir), flag, s(out), "--fps", fps])
+}
+
 /// Writes `meshes` as `step_K.vtu` and a `.pvd` of them into `dir`; returns
 /// the collection.
 fn write_steps(dir: &Path, meshes: &[(f64, Mesh)]) -> PathBuf {
@@ -298,15 +304,7 @@ fn frame_ranges_add_up_to_one_run_and_assemble_into_a_gif() {
         );
     }
     let assembled = dir.path().join("parts.gif");
-    let o = zoovr(&[
-        "animate",
-        "--assemble",
-        s(&parts),
-        "--gif",
-        s(&assembled),
-        "--fps",
-        "4",
-    ]);
+    let o = assemble(&parts, "--gif", &assembled, "4");
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
         std::fs::read(&gif_path).unwrap(),
@@ -576,15 +574,7 @@ fn mp4_is_written_in_process() {
     assert!(first.is_sync && first.bytes.len() > 8);
     // --assemble from the folder gives the same file, byte for byte.
     let again = dir.path().join("b.mp4");
-    let o = zoovr(&[
-        "animate",
-        "--assemble",
-        s(&frames),
-        "--mp4",
-        s(&again),
-        "--fps",
-        "5",
-    ]);
+    let o = assemble(&frames, "--mp4", &again, "5");
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
         std::fs::read(&mp4_path).unwrap(),

@@ -467,12 +467,14 @@ fn regions_on_flagged_faces_are_left_out() {
         let poly = hex_from_view(c);
         let mut out = Projected::default();
         projector().project(&poly, &cam, &mut out).unwrap();
-        let before: Vec<([u32; 3], u32)> = out
-            .triangles
-            .iter()
-            .copied()
-            .zip(out.triangle_region.iter().copied())
-            .collect();
+        let with_regions = |p: &Projected| -> Vec<([u32; 3], u32)> {
+            p.triangles
+                .iter()
+                .copied()
+                .zip(p.triangle_region.iter().copied())
+                .collect()
+        };
+        let before = with_regions(&out);
         // The boundary triangles holding point 3 (as a NaN at point 3).
         let flags: Vec<bool> = poly.triangles.iter().map(|t| t.contains(&3)).collect();
         out.leave_out_regions_on(&flags);
@@ -482,12 +484,7 @@ fn regions_on_flagged_faces_are_left_out() {
         };
         let expected: Vec<([u32; 3], u32)> =
             before.iter().copied().filter(|&(_, r)| clear(r)).collect();
-        let kept: Vec<([u32; 3], u32)> = out
-            .triangles
-            .iter()
-            .copied()
-            .zip(out.triangle_region.iter().copied())
-            .collect();
+        let kept = with_regions(&out);
         assert_eq!(kept, expected);
         assert!(
             kept.len() < before.len(),
