@@ -23,7 +23,9 @@ pub struct ScalarField {
     pub name: String,
     /// Point or cell values.
     pub association: Association,
-    /// One value per point or per cell.
+    /// One value per point or per cell. Infinities are stored as NaN:
+    /// every renderer treats a non-finite value as missing
+    /// ([`ScalarField::new`]).
     pub values: Vec<f64>,
     /// Min and max of the finite values (`(0, 0)` when none).
     pub range: (f64, f64),
@@ -36,7 +38,18 @@ impl ScalarField {
     /// The field of `values`, with its range and finiteness computed once
     /// (one pass), so that per-frame questions about the whole field
     /// ([`ScalarField::span`]) cost nothing.
-    pub fn new(name: String, association: Association, values: Vec<f64>) -> ScalarField {
+    ///
+    /// An infinite value becomes NaN, a missing value, as NaN is: a ray
+    /// segment with a missing value at an end is empty in the reference,
+    /// and the projected modes leave out the regions in front of and
+    /// behind the boundary triangles holding one (README, "Bad values").
+    /// No value the renderers could integrate saturates every ray near
+    /// such a point (a clamped infinity did, in the reference), and the
+    /// `f32` stages never see one.
+    pub fn new(name: String, association: Association, mut values: Vec<f64>) -> ScalarField {
+        for v in values.iter_mut().filter(|v| v.is_infinite()) {
+            *v = f64::NAN;
+        }
         let range = finite_range(&values);
         let all_finite = values.iter().all(|v| v.is_finite());
         ScalarField {
@@ -354,6 +367,8 @@ mod tests {
             let g = f(vec![2.0, bad, 5.0]);
             assert_eq!(g.range, (2.0, 5.0), "the finite range stays");
             assert_eq!(g.span(), None, "{bad}");
+            // Every non-finite value is stored as a missing one, NaN.
+            assert!(g.values[1].is_nan() && g.values[0] == 2.0, "{bad}");
         }
     }
 

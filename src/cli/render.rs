@@ -267,14 +267,14 @@ impl ViewArgs {
         };
         let n = field.values.iter().filter(|v| !v.is_finite()).count();
         let what = if self.mode.info().gpu {
-            "ray segments entering or leaving a cell through a face holding a NaN are empty \
-             (a tet, slab or cell cut by the near plane with one wholly), \
-             cells with an infinite value are empty"
+            "ray segments entering or leaving a cell through a face holding one are empty \
+             (a tet, slab or cell cut by the near plane with one wholly)"
         } else {
-            "ray segments with a NaN end are empty, infinities are clamped to 1e300"
+            "ray segments with one at an end are empty"
         };
         eprintln!(
-            "zoovr: warning: {}: {n} values of field '{}' are NaN or infinite; {what}",
+            "zoovr: warning: {}: {n} values of field '{}' are NaN or infinite, \
+             taken as missing: {what}",
             file.display(),
             field.name
         );

@@ -12,8 +12,9 @@
 //!   [`tet_slabs`], the slab expansion the order uses too). Pieces whose scalar range maps to zero extinction
 //!   everywhere are left out ([`PieceSource::invisible`]): they neither emit
 //!   nor absorb in the glow model; so are tets, slabs and fragments with a
-//!   non-finite scalar at a corner, empty as the reference's segments with
-//!   a NaN end are, and whole cells with an infinite one. A whole cell with
+//!   missing (NaN) scalar at a corner, empty as the reference's segments
+//!   with a NaN end are (a field holds no infinities: they are missing
+//!   values too, `crate::field::ScalarField::new`). A whole cell with
 //!   NaN corners keeps the rays between two of its boundary triangles
 //!   without one: its NaN points become the part's holes
 //!   ([`Polyhedron::holes`], finite stand-ins in their place), whose
@@ -218,26 +219,20 @@ impl PieceSource<'_> {
     ) -> Result<Parts, PieceError> {
         let cell = piece.cell();
         let mut done = Parts::default();
-        // A tet with a non-finite scalar at a corner is drawn empty. The
-        // reference integrates a segment with a NaN end as nothing
+        // A tet with a missing (NaN) scalar at a corner is drawn empty.
+        // The reference integrates a segment with a NaN end as nothing
         // (`integrate::segment`), and every ray through a tet with a NaN
         // corner enters or leaves it through a face holding that corner,
         // so such a tet is empty to the `tets` field exactly. The `faces`
         // field of a whole cell keeps the rays between two faces without
         // it: a whole cell with NaN corners is drawn with them as holes
-        // ([`Polyhedron::holes`]). The reference clamps infinities to
-        // 1e300, which `f32` stages cannot: a piece with an infinite
-        // scalar is drawn empty (README, "Bad values").
+        // ([`Polyhedron::holes`]). A field holds no infinities (they are
+        // missing values too: `ScalarField::new`; README, "Bad values").
         // (Only looked at where the field has such a value: its span.)
         let finite = |n: &u32| self.scalar(cell, *n).is_finite();
         let all_finite = self.field_span.is_some()
             || match *piece {
-                Piece::Cell(c) => self
-                    .mesh
-                    .cells
-                    .nodes(c as usize)
-                    .iter()
-                    .all(|&n| !self.scalar(c, n).is_infinite()),
+                Piece::Cell(_) => true,
                 Piece::Tet { tet, .. } | Piece::Slab { tet, .. } | Piece::Frag { tet, .. } => {
                     tet.iter().all(finite)
                 }
