@@ -708,7 +708,11 @@ impl ProjectedMode for IsoMode {
         }
         payload.grads.clear();
         payload.grads.resize(proj.vertices.len(), [DVec3::ZERO; 2]);
-        if self.set.lighting == Lighting::None {
+        // No light, or no isovalue within the part's range: no fragment
+        // of it lights a surface (its search window is empty), so its
+        // gradients are never read (most parts with one value).
+        let [first, end] = payload.candidates;
+        if self.set.lighting == Lighting::None || first >= end {
             return;
         }
         let flat = piece_gradient(part) * scale;
