@@ -54,6 +54,13 @@ pub trait ProjectedMode: Sync {
         &[]
     }
 
+    /// Of [`ProjectedMode::fragment_isovalues`], those the fragments of
+    /// the part whose payload is `payload` can cross (all by default): the
+    /// decisions about the others change nothing that part draws.
+    fn part_isovalues(&self, _payload: &Self::Payload) -> &[f64] {
+        self.fragment_isovalues()
+    }
+
     /// The scalar of `src` that the stage finding
     /// [`ProjectedMode::fragment_isovalues`] maps to 0: its rounding is
     /// relative to the distance from it

@@ -372,7 +372,7 @@ fn draw_part<M: ProjectedMode>(
         snap: &w.snap,
         weighed: src.colour_draw && src.iso.is_none() && mode.fragment_isovalues().is_empty(),
         clipped: !std::ptr::eq(projected, part),
-        isovalues: mode.fragment_isovalues(),
+        isovalues: mode.part_isovalues(&w.payload),
         iso_origin: mode.fragment_iso_origin(src),
     };
     // Steep triangles (`snap_is_steep`) take the exact triangle's values

@@ -435,6 +435,14 @@ fn part_candidates(part: &Polyhedron, map: &ScalarMap, set: &IsoSet) -> [f32; 2]
     [first as f32, end.max(first) as f32]
 }
 
+/// The values of a part's search window ([`part_candidates`]): the only
+/// ones its fragments can cross (a line where a face's scalar is another
+/// lies where neither piece sharing the face crosses it).
+fn window(values: &[f64], [first, end]: [f32; 2]) -> &[f64] {
+    let end = (end as usize).min(values.len());
+    &values[(first as usize).min(end)..end]
+}
+
 /// Isosurfaces alone or over a volume, on the projected-cell driver.
 pub struct IsoMode {
     volume: Volume,
@@ -627,6 +635,10 @@ impl ProjectedMode for IsoMode {
         &self.set.values
     }
 
+    fn part_isovalues(&self, payload: &IsoPayload) -> &[f64] {
+        window(&self.set.values, payload.candidates)
+    }
+
     fn fragment_iso_origin(&self, src: &PieceSource) -> f64 {
         self.map(src.tf).offset
     }
@@ -697,10 +709,11 @@ impl ProjectedMode for IsoMode {
         // surface twice). The driver decides such centres exactly
         // ([`crate::render::ties`]), with the ray caster's crossing of the
         // face, the same in both. (Tie values have no faces.)
+        let values = window(&self.set.values, payload.candidates);
         for face in &proj.faces {
             super::iso_seams::iso_lines(
                 face,
-                &self.set.values,
+                values,
                 payload.seg.ortho,
                 payload.seg.map.offset,
                 &mut proj.seam_lines,
