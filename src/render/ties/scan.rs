@@ -199,6 +199,59 @@ const ISO_STEEP_CENTRES: i64 = 64;
 /// (perspective-correct). True for a triangle holding more than
 /// [`ISO_STEEP_CENTRES`] centres' box, or one that is degenerate.
 fn iso_centre_near(part: &PartTriangles, t: &[u32; 3], p: [DVec2; 3], shift: f64) -> bool {
+    // Per side: the corner scalars, their weights' factors and the margin.
+    let sides = [0, 1].map(|side| {
+        let (s, q) = side_corners(part, t, side);
+        let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
+        (s, q, shift + iso_margin(part.iso_origin, lo, hi))
+    });
+    centre_near_values(p, &sides, part.isovalues, part.width, part.height)
+}
+
+/// One side of a triangle for [`centre_near_values`]: the corner scalars,
+/// their perspective weight factors (`q = 1/z`, [`side_corners`]) and the
+/// margin.
+type Side = ([f64; 3], [f64; 3], f64);
+
+/// The box of pixel centres `(i0, i1, j0, j1)` (inclusive) around a
+/// triangle grown by [`TIE_BAND_PX`].
+type CentreBox = (i64, i64, i64, i64);
+
+/// Whether a pixel centre of the `width` x `height` image inside the
+/// triangle at `p` grown by [`TIE_BAND_PX`] has, on one of the `sides`,
+/// its scalar ([`at_centre`]) within that side's margin of one of the
+/// sorted `values` (NaN counts as near): the test of [`iso_centre_near`].
+/// True for a degenerate triangle or one whose box holds more than
+/// [`ISO_STEEP_CENTRES`] centres.
+///
+/// The centres that can be near a value lie in a thin strip along the
+/// value's line across the triangle, so the search walks those strips
+/// ([`near_strips`]) and tests only the centres in them, each with the
+/// box search's own test; where it cannot bound the strips (a non-finite
+/// input, a steep perspective, more strip rows than centres) it tests
+/// every centre of the box ([`centre_near_values_box`]). Both give the
+/// same answer.
+fn centre_near_values(
+    p: [DVec2; 3],
+    sides: &[Side; 2],
+    values: &[f64],
+    width: u32,
+    height: u32,
+) -> bool {
+    let Some(bx) = centre_box(p, width, height) else {
+        return true;
+    };
+    let (i0, i1, j0, j1) = bx;
+    if (i1 - i0 + 1).max(0) * (j1 - j0 + 1).max(0) > ISO_STEEP_CENTRES {
+        return true;
+    }
+    near_strips(p, sides, values, bx)
+        .unwrap_or_else(|| centre_near_values_box(p, sides, values, bx))
+}
+
+/// The box of centres around the triangle at `p` grown by the band, within
+/// the image; `None` for a degenerate triangle or a non-finite box.
+fn centre_box(p: [DVec2; 3], width: u32, height: u32) -> Option<CentreBox> {
     let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
     let (lo, hi) = (
         p[0].min(p[1]).min(p[2]) - TIE_BAND_PX,
@@ -206,42 +259,127 @@ fn iso_centre_near(part: &PartTriangles, t: &[u32; 3], p: [DVec2; 3], shift: f64
     );
     let (i0, i1) = (
         (lo.x - 0.5).ceil().max(0.0),
-        (hi.x - 0.5).floor().min(part.width as f64 - 1.0),
+        (hi.x - 0.5).floor().min(width as f64 - 1.0),
     );
     let (j0, j1) = (
         (lo.y - 0.5).ceil().max(0.0),
-        (hi.y - 0.5).floor().min(part.height as f64 - 1.0),
+        (hi.y - 0.5).floor().min(height as f64 - 1.0),
     );
-    if !(area != 0.0 && i0.is_finite() && i1.is_finite() && j0.is_finite() && j1.is_finite()) {
-        return true;
+    (area != 0.0 && i0.is_finite() && i1.is_finite() && j0.is_finite() && j1.is_finite())
+        .then_some((i0 as i64, i1 as i64, j0 as i64, j1 as i64))
+}
+
+/// Whether the centre `c`, if inside the triangle at `p` grown by the
+/// band, is near a value on one of the sides (NaN: near).
+fn centre_is_near(p: [DVec2; 3], sides: &[Side; 2], values: &[f64], c: DVec2) -> bool {
+    if !in_grown_triangle(p, c) {
+        return false;
     }
-    let (i0, i1, j0, j1) = (i0 as i64, i1 as i64, j0 as i64, j1 as i64);
-    if (i1 - i0 + 1).max(0) * (j1 - j0 + 1).max(0) > ISO_STEEP_CENTRES {
-        return true;
+    let b = centre_weights(p, (p[1] - p[0]).perp_dot(p[2] - p[0]), c);
+    sides.iter().any(|(s, q, margin)| {
+        let d = to_nearest(values, at_centre(b, s, q));
+        d.is_nan() || d <= *margin
+    })
+}
+
+/// [`centre_near_values`] by testing every centre of the box `bx`.
+fn centre_near_values_box(p: [DVec2; 3], sides: &[Side; 2], values: &[f64], bx: CentreBox) -> bool {
+    let (i0, i1, j0, j1) = bx;
+    (j0..=j1).any(|j| {
+        (i0..=i1)
+            .any(|i| centre_is_near(p, sides, values, DVec2::new(i as f64 + 0.5, j as f64 + 0.5)))
+    })
+}
+
+/// [`centre_near_values`] by the strips along the values' lines: for each
+/// side and each value `V` its scalars can reach, the centres `c` of the
+/// box where the affine `N(c) = sum b_k q_k (s_k - V)` (the scalar's
+/// distance from `V` times the affine weight sum `W(c) = sum b_k q_k`) is
+/// at most the margin times the largest `W` in the grown triangle, row by
+/// row (or column by column, across the line's steeper direction), each
+/// tested by [`centre_is_near`]. `None` where that cannot be bounded: a
+/// non-finite corner, weights that may not stay positive in the grown
+/// triangle (a steep perspective), a side at one value throughout, or more
+/// strip lines than the box has centres.
+fn near_strips(p: [DVec2; 3], sides: &[Side; 2], values: &[f64], bx: CentreBox) -> Option<bool> {
+    let (i0, i1, j0, j1) = bx;
+    let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+    // Outside the triangle by at most the band, a centre's barycentric
+    // weights are at least -band / altitude; the triangle is wide (its
+    // least altitude at least SLIVER_TIE_PX), so each is above -NEG and
+    // their absolute sum below 1 + 2 NEG (with room).
+    const NEG: f64 = 2.0 * TIE_BAND_PX / SLIVER_TIE_PX;
+    let longest = (0..3)
+        .map(|k| (p[(k + 1) % 3] - p[k]).length())
+        .fold(0.0, f64::max);
+    // Also for NaN.
+    if area.abs().partial_cmp(&(SLIVER_TIE_PX * longest)) != Some(std::cmp::Ordering::Greater) {
+        return None;
     }
-    // Per side: the corner scalars, their weights' factors and the margin.
-    let sides = [0, 1].map(|side| {
-        let (s, q) = side_corners(part, t, side);
+    let mut lines = 0i64;
+    for (s, q, margin) in sides {
+        if !(s.iter().chain(q).all(|v| v.is_finite()) && margin.is_finite()) {
+            return None;
+        }
+        let (q_min, q_max) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
+        // W(c) >= q_min - 2 NEG (q_min + q_max) > 0 in the grown triangle.
+        let w_min = q_min - 2.0 * NEG * (q_min + q_max);
+        if !(q_min > 0.0 && w_min >= 0.5 * q_min) {
+            return None;
+        }
+        let w_max = q_max * (1.0 + 2.0 * NEG);
+        // The scalar at a centre there lies within `reach` of the
+        // corners' middle.
         let (lo, hi) = (s[0].min(s[1]).min(s[2]), s[0].max(s[1]).max(s[2]));
-        (s, q, shift + iso_margin(part.iso_origin, lo, hi))
-    });
-    for j in j0..=j1 {
-        for i in i0..=i1 {
-            let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
-            if !in_grown_triangle(p, c) {
-                continue;
+        let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+        let reach = half * (1.0 + 2.0 * NEG) * q_max / w_min + margin;
+        let first = values.partition_point(|&v| v < mid - reach);
+        let end = values.partition_point(|&v| v <= mid + reach);
+        for &v in &values[first..end.max(first)] {
+            let n = [0, 1, 2].map(|k| q[k] * (s[k] - v));
+            let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+            let (d1, d2) = (n[1] - n[0], n[2] - n[0]);
+            let g = DVec2::new(d1 * e2.y - d2 * e1.y, d2 * e1.x - d1 * e2.x) / area;
+            if !(g.x.is_finite() && g.y.is_finite()) || (g.x == 0.0 && g.y == 0.0) {
+                return None;
             }
-            let b = centre_weights(p, area, c);
-            for (s, q, margin) in &sides {
-                let d = to_nearest(part.isovalues, at_centre(b, s, q));
-                // NaN: as near.
-                if d.is_nan() || d <= *margin {
-                    return true;
+            // |N(c)| <= h holds every centre within the margin of v, with
+            // room for the rounding of N.
+            let h = margin * w_max + 1e-12 * (n[0].abs() + n[1].abs() + n[2].abs());
+            let by_rows = g.x.abs() >= g.y.abs();
+            let (u0, u1, a0, a1) = if by_rows {
+                (j0, j1, i0, i1)
+            } else {
+                (i0, i1, j0, j1)
+            };
+            lines += u1 - u0 + 1;
+            if lines > ISO_STEEP_CENTRES {
+                return None;
+            }
+            let (gu, ga, pu, pa) = if by_rows {
+                (g.y, g.x, p[0].y, p[0].x)
+            } else {
+                (g.x, g.y, p[0].x, p[0].y)
+            };
+            for u in u0..=u1 {
+                // N = n0 + gu (u + 1/2 - pu) + ga (a + 1/2 - pa) within
+                // [-h, h]: the centres a in an interval.
+                let base = n[0] + gu * (u as f64 + 0.5 - pu) - ga * pa;
+                let (x0, x1) = ((-h - base) / ga, (h - base) / ga);
+                let (x0, x1) = (x0.min(x1), x0.max(x1));
+                let a_lo = ((x0 - 0.5).ceil() as i64).max(a0);
+                let a_hi = ((x1 - 0.5).floor() as i64).min(a1);
+                for a in a_lo..=a_hi {
+                    let (i, j) = if by_rows { (a, u) } else { (u, a) };
+                    let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+                    if centre_is_near(p, sides, values, c) {
+                        return Some(true);
+                    }
                 }
             }
         }
     }
-    false
+    Some(false)
 }
 
 /// The entry (`side` 0) or exit (1) scalars at the corners of the exact
@@ -287,4 +425,76 @@ fn to_nearest(values: &[f64], s: f64) -> f64 {
     let above = values.get(k).map_or(f64::INFINITY, |&v| v - s);
     let below = k.checked_sub(1).map_or(f64::INFINITY, |k| s - values[k]);
     above.min(below)
+}
+
+#[cfg(test)]
+mod strip_tests {
+    use super::*;
+
+    /// A small xorshift generator: the same triangles on every run.
+    struct Rng(u64);
+
+    impl Rng {
+        fn unit(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// The strip search answers as the box search does, on random wide
+    /// and narrow triangles, orthographic and perspective weights, values
+    /// at, near and between the corners' scalars, and margins from the
+    /// `f32` stage's to a large part of the scalars' spread; and it
+    /// answers (rather than falling back) on most of them.
+    #[test]
+    fn the_strip_search_agrees_with_the_box_search() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let (mut near, mut decided, mut compared) = (0, 0, 0);
+        for n in 0..40_000 {
+            let p = [0; 3].map(|_| DVec2::new(rng.unit() * 9.0 - 1.0, rng.unit() * 9.0 - 1.0));
+            let perspective = n % 2 == 1;
+            let side = |rng: &mut Rng| {
+                let s = [0; 3].map(|_| rng.unit() * 4.0 - 2.0);
+                let q = [0; 3].map(|_| {
+                    if perspective {
+                        0.3 + rng.unit() * 2.0
+                    } else {
+                        1.0
+                    }
+                });
+                let margin = 10f64.powf(-6.0 + 5.5 * rng.unit());
+                (s, q, margin)
+            };
+            let sides = [side(&mut rng), side(&mut rng)];
+            // Values: random, one of them sometimes at a corner's scalar.
+            let mut values: Vec<f64> = (0..1 + (rng.unit() * 6.0) as usize)
+                .map(|_| rng.unit() * 5.0 - 2.5)
+                .collect();
+            if n % 3 == 0 {
+                values.push(sides[0].0[n % 3]);
+            }
+            values.sort_by(f64::total_cmp);
+            let Some(bx) = centre_box(p, 8, 8) else {
+                continue;
+            };
+            let (i0, i1, j0, j1) = bx;
+            if (i1 - i0 + 1).max(0) * (j1 - j0 + 1).max(0) > ISO_STEEP_CENTRES {
+                continue;
+            }
+            let by_box = centre_near_values_box(p, &sides, &values, bx);
+            if let Some(by_strips) = near_strips(p, &sides, &values, bx) {
+                assert_eq!(by_strips, by_box, "{p:?} {sides:?} {values:?}");
+                decided += 1;
+            }
+            assert_eq!(centre_near_values(p, &sides, &values, 8, 8), by_box);
+            near += by_box as usize;
+            compared += 1;
+        }
+        assert!(
+            decided > compared / 3 && near > compared / 10 && near < compared * 9 / 10,
+            "{decided} {near} {compared}"
+        );
+    }
 }
