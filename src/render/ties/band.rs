@@ -225,6 +225,30 @@ pub(super) fn centres_within(
     }
 }
 
+/// Keeps, of the centres `out[from..]`, those within `band` pixels of
+/// segment `a b` (the searches above return supersets).
+pub(super) fn within_band(out: &mut Vec<(u32, u32)>, from: usize, a: DVec2, b: DVec2, band: f64) {
+    let d = b - a;
+    let l2 = d.length_squared();
+    let mut k = from;
+    for n in from..out.len() {
+        let (i, j) = out[n];
+        let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+        let t = if l2 > 0.0 {
+            ((c - a).dot(d) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        // NaN keeps the centre (decided exactly).
+        let dist2 = (a + d * t - c).length_squared();
+        if dist2.is_nan() || dist2 <= band * band {
+            out[k] = out[n];
+            k += 1;
+        }
+    }
+    out.truncate(k);
+}
+
 /// `x.floor()` as an integer (saturating), without the libm call the
 /// baseline x86-64 target makes of `floor`, and without a branch.
 #[inline]

@@ -105,7 +105,7 @@ mod scan;
 
 use glam::{DVec2, DVec3};
 
-use band::{centres_within, inside_by_float, near_centres, near_edge};
+use band::{centres_within, inside_by_float, near_centres, near_edge, within_band};
 pub use scan::scan_triangles;
 
 use crate::camera::Camera;
@@ -614,11 +614,15 @@ pub fn decide_ties(
     }
     for line in &part.proj.seam_lines {
         let [a, b] = line.ends;
+        let from = forced.len();
         if line.band <= TIE_BAND_PX {
             near_centres(a, b, part.width, part.height, forced);
         } else {
             centres_within(a, b, line.band, part.width, part.height, forced);
         }
+        // The searches return a superset (up to `sqrt(2)` times the band
+        // across the line): only the centres within the band are forced.
+        within_band(forced, from, a, b, line.band.max(TIE_BAND_PX));
     }
     centres.extend_from_slice(forced);
     if centres.is_empty() {
