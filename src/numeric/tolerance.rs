@@ -535,3 +535,13 @@ pub const OCCLUSION_NODE_MARGIN_PX: f64 = 1e-6;
 /// against the bound).
 pub const THIN_OUTLINE_PX: f64 =
     2.0 * (crate::render::ties::TIE_BAND_PX + crate::render::ties::SNAP_PX);
+
+/// Boundary triangles narrower than this on screen (pixels: twice the area
+/// over the longest edge) have the smooth gradients of the region vertices
+/// on them interpolated in view space (`render::modes::iso::face_gradient`)
+/// rather than from the vertices' pixel positions
+/// (`render::modes::iso::face_gradient_at`): the screen weights of a face
+/// seen nearly edge-on are moved by the rounding of the positions (by
+/// about the rounding over this width: 1e-13 of the gradients' change
+/// across the face, far below the `f32` stage's).
+pub const GRADIENT_FACE_WIDTH_PX: f64 = 1e-3;

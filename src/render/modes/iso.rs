@@ -603,6 +603,51 @@ pub(super) fn face_gradient(part: &Polyhedron, t: u32, x: DVec3) -> Option<DVec3
     Some(g0 * w[0] + g1 * w[1] + g2 * w[2])
 }
 
+/// [`face_gradient`] at the region vertex at pixel position `q` on
+/// boundary triangle `t` of `part`, whose projection is `faces[t]`: the
+/// corners' gradients weighted as [`crate::projection::FaceTri::eval`]
+/// weights the scalar (perspective-correct: in view space, the
+/// barycentric weights of the point there, clamped to the triangle as
+/// [`face_gradient`] clamps them), from the pixel position alone. `None`
+/// where the projected triangle is narrower than
+/// [`crate::numeric::tolerance::GRADIENT_FACE_WIDTH_PX`], whose
+/// weights on screen are ill-conditioned ([`face_gradient`] then).
+fn face_gradient_at(
+    part: &Polyhedron,
+    faces: &[crate::projection::FaceTri],
+    ortho: bool,
+    t: u32,
+    q: DVec2,
+) -> Option<DVec3> {
+    let tri = part.triangles.get(t as usize)?;
+    let f = faces.get(t as usize)?;
+    let g = tri.map(|i| part.gradients.get(i as usize).copied());
+    let (Some(g0), Some(g1), Some(g2)) = (g[0], g[1], g[2]) else {
+        return None;
+    };
+    let [a, b, c] = f.p;
+    let den = (b - a).perp_dot(c - a);
+    let longest = (b - a)
+        .length_squared()
+        .max((c - b).length_squared())
+        .max((a - c).length_squared());
+    // Twice the area over the longest edge: the width; false for NaN.
+    let min = crate::numeric::tolerance::GRADIENT_FACE_WIDTH_PX;
+    if !(den * den >= min * min * longest && den != 0.0) {
+        return None;
+    }
+    let lb = ((q - a).perp_dot(c - a) / den).max(0.0);
+    let lc = ((b - a).perp_dot(q - a) / den).max(0.0);
+    let la = (1.0 - ((q - a).perp_dot(c - a) + (b - a).perp_dot(q - a)) / den).max(0.0);
+    let w = if ortho {
+        [la, lb, lc]
+    } else {
+        [la / f.z[0], lb / f.z[1], lc / f.z[2]]
+    };
+    let sum = w[0] + w[1] + w[2];
+    (sum > 0.0 && sum.is_finite()).then(|| (g0 * w[0] + g1 * w[1] + g2 * w[2]) / sum)
+}
+
 /// A region vertex's entry (`side` 0) or exit point in view space.
 pub(super) fn view_point(proj: &Projected, i: usize, side: usize) -> DVec3 {
     let v = &proj.vertices[i];
@@ -752,8 +797,10 @@ impl ProjectedMode for IsoMode {
                     continue;
                 }
                 done[v] = true;
+                let q = proj.vertices[v].pos();
                 payload.grads[v] = [0, 1].map(|side| {
-                    face_gradient(part, faces[side], view_point(proj, v, side))
+                    face_gradient_at(part, &proj.faces, proj.view.ortho, faces[side], q)
+                        .or_else(|| face_gradient(part, faces[side], view_point(proj, v, side)))
                         .unwrap_or(flat / scale)
                         * scale
                 });

@@ -252,14 +252,14 @@ pub(super) fn within_band(out: &mut Vec<(u32, u32)>, from: usize, a: DVec2, b: D
 /// `x.floor()` as an integer (saturating), without the libm call the
 /// baseline x86-64 target makes of `floor`, and without a branch.
 #[inline]
-fn floor_i(x: f64) -> i64 {
+pub(super) fn floor_i(x: f64) -> i64 {
     let i = x as i64;
     i.saturating_sub(((i as f64) > x) as i64)
 }
 
 /// `x.ceil()` as an integer (saturating); see [`floor_i`].
 #[inline]
-fn ceil_i(x: f64) -> i64 {
+pub(super) fn ceil_i(x: f64) -> i64 {
     let i = x as i64;
     i.saturating_add(((i as f64) < x) as i64)
 }

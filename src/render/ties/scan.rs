@@ -8,7 +8,7 @@
 
 use glam::DVec2;
 
-use super::band::{centres_within, in_grown_triangle};
+use super::band::{ceil_i, centres_within, floor_i, in_grown_triangle};
 use super::{
     iso_margin, snap_is_steep_at, PartTriangles, TieScratch, SLIVER_DEPTH_TOL, SLIVER_TIE_PX,
     SNAP_PX, TIE_BAND_PX,
@@ -257,16 +257,15 @@ fn centre_box(p: [DVec2; 3], width: u32, height: u32) -> Option<CentreBox> {
         p[0].min(p[1]).min(p[2]) - TIE_BAND_PX,
         p[0].max(p[1]).max(p[2]) + TIE_BAND_PX,
     );
-    let (i0, i1) = (
-        (lo.x - 0.5).ceil().max(0.0),
-        (hi.x - 0.5).floor().min(width as f64 - 1.0),
-    );
-    let (j0, j1) = (
-        (lo.y - 0.5).ceil().max(0.0),
-        (hi.y - 0.5).floor().min(height as f64 - 1.0),
-    );
-    (area != 0.0 && i0.is_finite() && i1.is_finite() && j0.is_finite() && j1.is_finite())
-        .then_some((i0 as i64, i1 as i64, j0 as i64, j1 as i64))
+    if !(area != 0.0 && lo.is_finite() && hi.is_finite()) {
+        return None;
+    }
+    Some((
+        ceil_i(lo.x - 0.5).max(0),
+        floor_i(hi.x - 0.5).min(width as i64 - 1),
+        ceil_i(lo.y - 0.5).max(0),
+        floor_i(hi.y - 0.5).min(height as i64 - 1),
+    ))
 }
 
 /// Whether the centre `c`, if inside the triangle at `p` grown by the
@@ -367,8 +366,8 @@ fn near_strips(p: [DVec2; 3], sides: &[Side; 2], values: &[f64], bx: CentreBox) 
                 let base = n[0] + gu * (u as f64 + 0.5 - pu) - ga * pa;
                 let (x0, x1) = ((-h - base) / ga, (h - base) / ga);
                 let (x0, x1) = (x0.min(x1), x0.max(x1));
-                let a_lo = ((x0 - 0.5).ceil() as i64).max(a0);
-                let a_hi = ((x1 - 0.5).floor() as i64).min(a1);
+                let a_lo = ceil_i(x0 - 0.5).max(a0);
+                let a_hi = floor_i(x1 - 0.5).min(a1);
                 for a in a_lo..=a_hi {
                     let (i, j) = if by_rows { (a, u) } else { (u, a) };
                     let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
