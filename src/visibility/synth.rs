@@ -22,10 +22,12 @@ pub struct GridSpec {
     pub planar_boundary: bool,
 }
 
-struct Rng(u64);
+/// A small xorshift generator (reproducible meshes and test inputs).
+pub(crate) struct Rng(pub(crate) u64);
 
 impl Rng {
-    fn next_f64(&mut self) -> f64 {
+    /// The next number, uniform in `[0, 1)`.
+    pub(crate) fn next_f64(&mut self) -> f64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;

@@ -429,18 +429,7 @@ fn to_nearest(values: &[f64], s: f64) -> f64 {
 #[cfg(test)]
 mod strip_tests {
     use super::*;
-
-    /// A small xorshift generator: the same triangles on every run.
-    struct Rng(u64);
-
-    impl Rng {
-        fn unit(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::visibility::synth::Rng;
 
     /// The strip search answers as the box search does, on random wide
     /// and narrow triangles, orthographic and perspective weights, values
@@ -452,24 +441,25 @@ mod strip_tests {
         let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
         let (mut near, mut decided, mut compared) = (0, 0, 0);
         for n in 0..40_000 {
-            let p = [0; 3].map(|_| DVec2::new(rng.unit() * 9.0 - 1.0, rng.unit() * 9.0 - 1.0));
+            let p =
+                [0; 3].map(|_| DVec2::new(rng.next_f64() * 9.0 - 1.0, rng.next_f64() * 9.0 - 1.0));
             let perspective = n % 2 == 1;
             let side = |rng: &mut Rng| {
-                let s = [0; 3].map(|_| rng.unit() * 4.0 - 2.0);
+                let s = [0; 3].map(|_| rng.next_f64() * 4.0 - 2.0);
                 let q = [0; 3].map(|_| {
                     if perspective {
-                        0.3 + rng.unit() * 2.0
+                        0.3 + rng.next_f64() * 2.0
                     } else {
                         1.0
                     }
                 });
-                let margin = 10f64.powf(-6.0 + 5.5 * rng.unit());
+                let margin = 10f64.powf(-6.0 + 5.5 * rng.next_f64());
                 (s, q, margin)
             };
             let sides = [side(&mut rng), side(&mut rng)];
             // Values: random, one of them sometimes at a corner's scalar.
-            let mut values: Vec<f64> = (0..1 + (rng.unit() * 6.0) as usize)
-                .map(|_| rng.unit() * 5.0 - 2.5)
+            let mut values: Vec<f64> = (0..1 + (rng.next_f64() * 6.0) as usize)
+                .map(|_| rng.next_f64() * 5.0 - 2.5)
                 .collect();
             if n % 3 == 0 {
                 values.push(sides[0].0[n % 3]);
