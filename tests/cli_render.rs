@@ -460,7 +460,8 @@ fn malformed_ghost_arrays_are_named() {
 }
 
 /// A field with NaN values renders in a projected mode and in the
-/// reference, each saying what it makes of them, naming the file.
+/// reference, each saying what it makes of them (missing values), naming
+/// the file.
 #[test]
 fn nan_values_are_rendered_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
@@ -480,13 +481,16 @@ fn nan_values_are_rendered_with_a_warning() {
     let file = dir.path().join("nan.vtu");
     write_vtu(&file, &m, Compression::None).unwrap();
     for (mode, says) in [
-        ("exact-frag", "through a face holding a NaN are empty"),
-        ("raycast", "NaN end are empty"),
+        ("exact-frag", "through a face holding one are empty"),
+        ("raycast", "with one at an end are empty"),
     ] {
         let o = render(&file, &out, &["--size", "24x24", "--mode", mode]);
         let e = stderr(&o);
         assert!(o.status.success(), "{mode}: {e}");
-        assert!(e.contains("nan.vtu") && e.contains(says), "{mode}: {e}");
+        assert!(
+            e.contains("nan.vtu") && e.contains("taken as missing") && e.contains(says),
+            "{mode}: {e}"
+        );
         assert!(out.exists());
     }
 }
