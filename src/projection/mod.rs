@@ -245,6 +245,23 @@ impl FaceTri {
         }
     }
 
+    /// The screen-space barycentric weights of pixel position `q` in the
+    /// projected triangle (summing to 1, not clamped); `None` for a
+    /// triangle of no area. In perspective a value linear on the triangle
+    /// in space takes the weights `lambda_i / z_i`, normalised
+    /// ([`FaceTri::eval`]).
+    #[inline]
+    pub fn barycentric(&self, q: DVec2) -> Option<[f64; 3]> {
+        let [a, b, c] = self.p;
+        let den = (b - a).perp_dot(c - a);
+        if den == 0.0 {
+            return None;
+        }
+        let lb = (q - a).perp_dot(c - a) / den;
+        let lc = (b - a).perp_dot(q - a) / den;
+        Some([1.0 - lb - lc, lb, lc])
+    }
+
     /// Depth and scalar of the triangle's plane along the ray through pixel
     /// position `q` (exactly the corner's data when `q` is a corner).
     ///
@@ -261,15 +278,9 @@ impl FaceTri {
                 return (self.z[k], self.s[k]);
             }
         }
-        let [a, b, c] = self.p;
-        let den = (b - a).perp_dot(c - a);
-        if den == 0.0 {
+        let Some(lam) = self.barycentric(q) else {
             return (self.z[0], self.s[0]);
-        }
-        let lb = (q - a).perp_dot(c - a) / den;
-        let lc = (b - a).perp_dot(q - a) / den;
-        let la = 1.0 - lb - lc;
-        let lam = [la, lb, lc];
+        };
         let (z, s) = if view.ortho {
             let z = lam[0] * self.z[0] + lam[1] * self.z[1] + lam[2] * self.z[2];
             let s = lam[0] * self.s[0] + lam[1] * self.s[1] + lam[2] * self.s[2];

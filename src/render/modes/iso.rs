@@ -625,24 +625,15 @@ fn face_gradient_at(
     let (Some(g0), Some(g1), Some(g2)) = (g[0], g[1], g[2]) else {
         return None;
     };
-    let [a, b, c] = f.p;
-    let den = (b - a).perp_dot(c - a);
-    let longest = (b - a)
-        .length_squared()
-        .max((c - b).length_squared())
-        .max((a - c).length_squared());
-    // Twice the area over the longest edge: the width; false for NaN.
-    let min = crate::numeric::tolerance::GRADIENT_FACE_WIDTH_PX;
-    if !(den * den >= min * min * longest && den != 0.0) {
+    // (0 for a degenerate or non-finite triangle.)
+    if f.width() < crate::numeric::tolerance::GRADIENT_FACE_WIDTH_PX {
         return None;
     }
-    let lb = ((q - a).perp_dot(c - a) / den).max(0.0);
-    let lc = ((b - a).perp_dot(q - a) / den).max(0.0);
-    let la = (1.0 - ((q - a).perp_dot(c - a) + (b - a).perp_dot(q - a)) / den).max(0.0);
+    let lam = f.barycentric(q)?.map(|l| l.max(0.0));
     let w = if ortho {
-        [la, lb, lc]
+        lam
     } else {
-        [la / f.z[0], lb / f.z[1], lc / f.z[2]]
+        [lam[0] / f.z[0], lam[1] / f.z[1], lam[2] / f.z[2]]
     };
     let sum = w[0] + w[1] + w[2];
     (sum > 0.0 && sum.is_finite()).then(|| (g0 * w[0] + g1 * w[1] + g2 * w[2]) / sum)

@@ -15,7 +15,7 @@
 use glam::DVec2;
 
 use crate::projection::{FaceTri, SeamLine};
-use crate::render::ties::{iso_margin, TIE_BAND_PX};
+use crate::render::ties::{affine_gradient, iso_margin, TIE_BAND_PX};
 
 /// Appends to `out` the lines where the scalar of the boundary triangle
 /// `face` equals one of `values` (sorted): the segment between the two
@@ -130,15 +130,6 @@ pub fn iso_lines(
             });
         }
     }
-}
-
-/// The screen gradient of the function that is affine on the triangle at
-/// pixel positions `p` with values `f` at its corners (infinite or NaN for
-/// a triangle of no area).
-fn affine_gradient(p: [DVec2; 3], f: [f64; 3]) -> DVec2 {
-    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-    let (d1, d2) = (f[1] - f[0], f[2] - f[0]);
-    DVec2::new(d1 * e2.y - d2 * e1.y, d2 * e1.x - d1 * e2.x) / e1.perp_dot(e2)
 }
 
 #[cfg(test)]

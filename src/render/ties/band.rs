@@ -59,17 +59,29 @@ pub(super) fn in_grown_triangle(p: [DVec2; 3], c: DVec2) -> bool {
     if (e[0] >= 0.0 && e[1] >= 0.0 && e[2] >= 0.0) || (e[0] <= 0.0 && e[1] <= 0.0 && e[2] <= 0.0) {
         return true;
     }
-    (0..3).any(|k| {
-        let (a, b) = (p[k], p[(k + 1) % 3]);
-        let d = b - a;
-        let l2 = d.length_squared();
-        let t = if l2 > 0.0 {
-            ((c - a).dot(d) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (a + d * t - c).length_squared() <= TIE_BAND_PX * TIE_BAND_PX
-    })
+    (0..3).any(|k| dist2_to_segment(p[k], p[(k + 1) % 3], c) <= TIE_BAND_PX * TIE_BAND_PX)
+}
+
+/// The screen gradient of the function that is affine on the triangle at
+/// pixel positions `p` with values `f` at its corners (infinite or NaN for
+/// a triangle of no area).
+pub(crate) fn affine_gradient(p: [DVec2; 3], f: [f64; 3]) -> DVec2 {
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let (d1, d2) = (f[1] - f[0], f[2] - f[0]);
+    DVec2::new(d1 * e2.y - d2 * e1.y, d2 * e1.x - d1 * e2.x) / e1.perp_dot(e2)
+}
+
+/// The squared distance from `c` to segment `a b` (NaN where an input is).
+#[inline]
+fn dist2_to_segment(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    let d = b - a;
+    let l2 = d.length_squared();
+    let t = if l2 > 0.0 {
+        ((c - a).dot(d) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + d * t - c).length_squared()
 }
 
 /// Appends the image's pixel centres within [`TIE_BAND_PX`] of segment
@@ -228,19 +240,12 @@ pub(super) fn centres_within(
 /// Keeps, of the centres `out[from..]`, those within `band` pixels of
 /// segment `a b` (the searches above return supersets).
 pub(super) fn within_band(out: &mut Vec<(u32, u32)>, from: usize, a: DVec2, b: DVec2, band: f64) {
-    let d = b - a;
-    let l2 = d.length_squared();
     let mut k = from;
     for n in from..out.len() {
         let (i, j) = out[n];
         let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
-        let t = if l2 > 0.0 {
-            ((c - a).dot(d) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
         // NaN keeps the centre (decided exactly).
-        let dist2 = (a + d * t - c).length_squared();
+        let dist2 = dist2_to_segment(a, b, c);
         if dist2.is_nan() || dist2 <= band * band {
             out[k] = out[n];
             k += 1;

@@ -105,6 +105,7 @@ mod scan;
 
 use glam::{DVec2, DVec3};
 
+pub(crate) use band::affine_gradient;
 use band::{centres_within, inside_by_float, near_centres, near_edge, within_band};
 pub use scan::scan_triangles;
 

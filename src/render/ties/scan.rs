@@ -8,7 +8,7 @@
 
 use glam::DVec2;
 
-use super::band::{ceil_i, centres_within, floor_i, in_grown_triangle};
+use super::band::{affine_gradient, ceil_i, centres_within, floor_i, in_grown_triangle};
 use super::{
     iso_margin, snap_is_steep_at, PartTriangles, TieScratch, SLIVER_DEPTH_TOL, SLIVER_TIE_PX,
     SNAP_PX, TIE_BAND_PX,
@@ -336,9 +336,7 @@ fn near_strips(p: [DVec2; 3], sides: &[Side; 2], values: &[f64], bx: CentreBox) 
         let end = values.partition_point(|&v| v <= mid + reach);
         for &v in &values[first..end.max(first)] {
             let n = [0, 1, 2].map(|k| q[k] * (s[k] - v));
-            let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-            let (d1, d2) = (n[1] - n[0], n[2] - n[0]);
-            let g = DVec2::new(d1 * e2.y - d2 * e1.y, d2 * e1.x - d1 * e2.x) / area;
+            let g = affine_gradient(p, n);
             if !(g.x.is_finite() && g.y.is_finite()) || (g.x == 0.0 && g.y == 0.0) {
                 return None;
             }
